@@ -1,0 +1,120 @@
+"""Capture this machine's hardware profile: CPU, memory, GPU where one exists.
+
+GPU details come from CuPy's runtime API when CuPy and a device are present
+(name, memory, compute capability, SM count, clocks, driver and runtime
+versions) and from the datasheet table below for peak rates, which are
+marked as datasheet values, not measurements.
+"""
+from __future__ import annotations
+
+import functools
+import os
+import platform
+import re
+
+# Datasheet peaks for cards we know (FP32/FP64 TFLOP/s without tensor cores, TB/s).
+DATASHEET = {
+    "H100 80GB HBM3": {"fp32_tflops": 66.9, "fp64_tflops": 33.5, "bandwidth_tbs": 3.35},
+    "H100 PCIe": {"fp32_tflops": 51.2, "fp64_tflops": 25.6, "bandwidth_tbs": 2.0},
+    "H200": {"fp32_tflops": 66.9, "fp64_tflops": 33.5, "bandwidth_tbs": 4.8},
+    "A100-SXM4-80GB": {"fp32_tflops": 19.5, "fp64_tflops": 9.7, "bandwidth_tbs": 2.04},
+}
+
+
+def _cpu_model() -> str:
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def _memory_bytes() -> int:
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 0
+
+
+def _slug(text: str) -> str:
+    text = re.sub(r"\(R\)|\(TM\)|CPU|Processor|@.*$|NVIDIA|GeForce", "", text, flags=re.I)
+    return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")[:40] or "unknown"
+
+
+@functools.lru_cache(maxsize=None)
+def gpu_info() -> dict | None:
+    """The first CUDA device as seen by CuPy, or None without CuPy or a device."""
+    if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
+        return None
+    try:
+        import cupy
+        if cupy.cuda.runtime.getDeviceCount() < 1:
+            return None
+        props = cupy.cuda.runtime.getDeviceProperties(0)
+        name = props["name"].decode() if isinstance(props["name"], bytes) else str(props["name"])
+        free, total = cupy.cuda.runtime.memGetInfo()
+        info = {
+            "name": name,
+            "memory_bytes": int(total),
+            "compute_capability": f"{props['major']}.{props['minor']}",
+            "multiprocessors": int(props["multiProcessorCount"]),
+            "clock_mhz": int(props.get("clockRate", 0)) // 1000,
+            "memory_clock_mhz": int(props.get("memoryClockRate", 0)) // 1000,
+            "memory_bus_bits": int(props.get("memoryBusWidth", 0)),
+            "l2_bytes": int(props.get("l2CacheSize", 0)),
+            "driver_version": cupy.cuda.runtime.driverGetVersion(),
+            "runtime_version": cupy.cuda.runtime.runtimeGetVersion(),
+            "cupy_version": cupy.__version__,
+        }
+        if info["memory_clock_mhz"] and info["memory_bus_bits"]:
+            info["peak_bandwidth_tbs_from_clocks"] = round(
+                2 * info["memory_clock_mhz"] * 1e6 * info["memory_bus_bits"] / 8 / 1e12, 3)
+        for key, peaks in DATASHEET.items():
+            if key.lower() in name.lower():
+                info["datasheet"] = dict(peaks, note="datasheet value, not measured")
+                break
+        try:
+            import subprocess
+            smi = subprocess.run(["nvidia-smi", "--query-gpu=driver_version", "--format=csv,noheader"],
+                                 capture_output=True, text=True, timeout=20).stdout.strip()
+            if smi:
+                info["driver"] = smi.splitlines()[0]
+        except (OSError, Exception):  # noqa: BLE001 - nvidia-smi is optional
+            pass
+        return info
+    except Exception:  # noqa: BLE001 - no CuPy, no driver, no device: no GPU
+        return None
+
+
+def profile_id(cpu: str | None = None, gpu: dict | None = None) -> str:
+    """A short stable id: the GPU name (if any) and the CPU model."""
+    cpu = cpu or _cpu_model()
+    parts = [_slug(gpu["name"])] if gpu else []
+    parts.append(_slug(cpu))
+    return "__".join(parts)
+
+
+def capture(with_gpu: bool = True) -> dict:
+    """This machine's profile as a dict (source: measured)."""
+    import numba
+
+    cpu = _cpu_model()
+    gpu = gpu_info() if with_gpu else None
+    profile = {
+        "id": profile_id(cpu, gpu),
+        "source": "measured",
+        "cpu": {
+            "model": cpu,
+            "logical_cores": os.cpu_count(),
+            "cores_usable": len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count(),
+            "numba_threads": numba.config.NUMBA_NUM_THREADS,
+            "machine": platform.machine(),
+        },
+        "memory_bytes": _memory_bytes(),
+        "os": platform.platform(),
+        "gpu": gpu,
+    }
+    return profile

@@ -1,0 +1,7 @@
+"""pcabench: benchmarking harness and study suite for SPH acoustics.
+
+Data flow: scene -> solver (pcabench.solvers) -> stage clock (pcabench.clock)
+-> run record (pcabench.record) -> results store (pcabench.store)
+-> reports (pcabench.reports).
+"""
+__version__ = "0.1.0"

@@ -1,0 +1,87 @@
+"""Run one scene on one solver: the six timed stages, blow-up detection, errors.
+
+A run that blows up (non-finite fields, or max|u| past the scene's bound) stops
+at once and is recorded with status ``unstable`` and its step; a device
+out-of-memory is recorded as ``out-of-memory``. Neither is a crash.
+"""
+from __future__ import annotations
+
+import math
+
+from pcabench.solvers import Scene, SceneError, make_solver
+from pcabench.solvers.analytic import errors as analytic_errors
+from pcabench.solvers.integrators import step_program
+
+from .clock import clock_for
+from .provenance import git_commit, package_versions
+from .record import RunRecord
+
+
+def _is_oom(exc: BaseException) -> bool:
+    text = f"{type(exc).__name__} {exc}".lower()
+    return isinstance(exc, MemoryError) or "out of memory" in text or "outofmemory" in text \
+        or "cudaerrormemoryallocation" in text
+
+
+def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int | None = None,
+        fields_path=None, progress=None, profile_id: str | None = None) -> RunRecord:
+    """Run ``scene`` with ``solver_name``; return its record. Never raises for a failed run."""
+    solver = make_solver(solver_name, threads=threads)
+    stages = {s: 0.0 for s in ("input", "init", "snp", "pi", "su", "output")}
+    record = RunRecord(
+        solver=solver_name, precision=scene.precision, model=scene.model,
+        integrator=scene.integrator, dx=scene.dx, n_particles=scene.n_particles, steps=0,
+        t_end=0.0, stages=stages, jit_seconds=0.0, mse=math.nan, me=math.nan,
+        mean_neighbours=math.nan, status="error", failed_step=None, threads=threads or 1,
+        steps_requested=scene.n_steps, scene=scene.as_dict(), profile_id=profile_id or "",
+        commit=git_commit(), versions=package_versions())
+    step = 0
+    try:
+        clock = None
+        # JIT compilation and the first launch, on a tiny scene, outside the timed region.
+        solver.input(scene)
+        record.jit_seconds = solver.warmup()
+        solver = make_solver(solver_name, threads=threads)
+        clock = clock_for(solver)
+        clock.time("input", solver.input, scene)
+        clock.time("init", solver.init)
+        bound = scene.blowup_factor * scene.mach * scene.c0
+        for step in range(1, scene.n_steps + 1):
+            for stage, op in step_program(scene.integrator, solver, first=(step == 1)):
+                clock.time(stage, op)
+            amp = solver.amplitude()
+            if not math.isfinite(amp) or amp > bound:
+                record.status, record.failed_step = "unstable", step
+                record.message = (f"max|u| = {amp:.3g} m/s at step {step} "
+                                  f"(bound {bound:.3g} = blowup_factor * mach * c0)")
+                break
+            if progress is not None:
+                progress(step, scene.n_steps)
+        record.steps = step
+        fields = clock.time("output", solver.output)
+        if fields_path is not None:
+            fields.save(fields_path)
+        record.stages = clock.totals()
+        record.t_end = fields.t
+        if record.status != "unstable":
+            record.status = "ok"
+            err = analytic_errors(scene, fields.x, fields.u, fields.t)
+            record.mse, record.me = err.mse, err.me
+            record.mean_neighbours = solver.mean_neighbours()
+    except SceneError:
+        raise  # bad input is the caller's to report, not a run result
+    except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
+        record.steps = step
+        record.failed_step = step or None
+        record.status = "out-of-memory" if _is_oom(exc) else "error"
+        record.message = f"{type(exc).__name__}: {exc}"
+        if clock is not None:
+            try:
+                record.stages = clock.totals()
+            except Exception:  # noqa: BLE001
+                pass
+        if record.status == "error":
+            import traceback
+
+            record.message += "\n" + traceback.format_exc(limit=8)
+    return record

@@ -1,0 +1,39 @@
+"""The paper's analytic pulse (eq. 10) and error measures (eq. 11).
+
+u(t, x) = c0 Ma exp(-((x - x_c - c0 t) / w)^2), v = 0, drho = rho0 u / c0:
+a right-travelling solution of the linear wave equation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def pulse_velocity(scene, x, t):
+    """Analytic x-velocity at positions ``x`` (m) and time ``t`` (s), m/s."""
+    x = np.asarray(x, dtype=np.float64)
+    xi = (x - scene.pulse_center - scene.c0 * t) / scene.pulse_width
+    return scene.c0 * scene.mach * np.exp(-xi * xi)
+
+
+def pulse_density(scene, x, t):
+    """Analytic density perturbation, kg/m^3."""
+    return scene.rho0 * pulse_velocity(scene, x, t) / scene.c0
+
+
+@dataclass(frozen=True)
+class Errors:
+    """Relative RMS error (the paper's "MSE") and max error ME (m/s) of u."""
+
+    mse: float
+    me: float
+
+
+def errors(scene, x, u, t) -> Errors:
+    """Paper eq. 11 over all particles: sqrt(mean((u-u_the)^2)/mean(u_the^2)), max|u-u_the|."""
+    u_the = pulse_velocity(scene, x, t)
+    diff = np.asarray(u, dtype=np.float64) - u_the
+    if not np.all(np.isfinite(diff)):
+        return Errors(float("nan"), float("nan"))
+    return Errors(float(np.sqrt(np.mean(diff**2) / np.mean(u_the**2))), float(np.max(np.abs(diff))))

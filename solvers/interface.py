@@ -1,0 +1,207 @@
+"""The common solver interface: the paper's six stages as primitives.
+
+A solver holds the particle state and offers the primitives that a step is
+made of. The integrator (solvers/integrators.py) composes them into a step
+program of (stage, operation) pairs, and the stage clock times every
+operation from outside, the same way for every solver:
+
+    input   ``input(scene)``      validate the scene for this solver, bring the device up
+    init    ``init()``            allocate and place the particles
+    snp     ``snp()``             neighbour search (cell build, or nothing for all-pair)
+    pi      ``rates(cont, mom)``  particle interaction: continuity and/or momentum sweep
+    su      ``kick/advance/save/restore``  system update
+    output  ``output()``          copy back, in particle-id order
+
+The state lives in arrays of the array module ``xp`` (NumPy on the CPU,
+CuPy on the GPU), so the system update is written once for every solver.
+All per-particle arrays sit in ``self.arrays`` so that a neighbour search
+that reorders particles can permute all of them together.
+"""
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import kernel
+from .scene import Scene, SceneError
+
+STAGES = ("input", "init", "snp", "pi", "su", "output")
+STATE = ("lx", "ly", "sx", "sy", "u", "v", "drho")
+RATES = ("ax", "ay", "dd")
+COEFFS = ("mass", "vol", "pr")
+
+
+@dataclass
+class Fields:
+    """Final particle fields in particle-id order (id = ly * nx + lx). SI units."""
+
+    x: np.ndarray
+    y: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    drho: np.ndarray
+    t: float
+
+    def save(self, path) -> None:
+        np.savez(path, x=self.x, y=self.y, u=self.u, v=self.v, drho=self.drho, t=self.t)
+
+
+class SolverUnavailable(RuntimeError):
+    """The solver cannot run on this machine (no GPU, missing library)."""
+
+
+class Solver(abc.ABC):
+    """Base class: state, system update, output. Subclasses: ``snp`` and ``_sweep``."""
+
+    name: str = "abstract"
+    device: str = "cpu"
+    xp = np
+
+    def __init__(self, threads: int | None = None):
+        self.threads = threads
+        self.scene: Scene | None = None
+        self.arrays: dict = {}
+        self.saved: dict = {}
+        self.t = 0.0
+
+    # ------------------------------------------------------------ stages
+    def input(self, scene: Scene) -> None:
+        """Validate ``scene`` for this solver and prepare constants."""
+        if not isinstance(scene, Scene):
+            raise SceneError(f"scene must be a Scene (got {type(scene).__name__})")
+        self.check_scene(scene)
+        self.scene = scene
+        self.dtype = np.dtype(scene.precision)
+        self.k = kernel.constants(scene, self.dtype)
+        self.moving = scene.model == "lagrangian"
+        self.dt = self.dtype.type(scene.dt)
+
+    def check_scene(self, scene: Scene) -> None:
+        """Solver-specific limits; raise SceneError naming the parameter."""
+
+    def init(self) -> None:
+        """Allocate and place the particles on the lattice with the analytic pulse."""
+        s, xp, dt = self.scene, self.xp, self.dtype
+        ids = xp.arange(s.n_particles, dtype=xp.int64)
+        lx = (ids % s.nx).astype(dt)
+        ly = (ids // s.nx).astype(dt)
+        x = s.x_lo + (lx.astype(xp.float64) + 0.5) * s.dx
+        xi = (x - s.pulse_center) / s.pulse_width
+        u = s.c0 * s.mach * xp.exp(-xi * xi)
+        drho = s.rho0 * u / s.c0
+        # Lagrangian and fixed: m_j = rho_j(0) dx^2, so m/rho is the true volume at t = 0.
+        rho_init = s.rho0 + (0.0 if s.model == "linear" else 1.0) * drho
+        a = {
+            "lx": lx, "ly": ly,
+            "sx": xp.zeros(s.n_particles, dt), "sy": xp.zeros(s.n_particles, dt),
+            "u": u.astype(dt), "v": xp.zeros(s.n_particles, dt), "drho": drho.astype(dt),
+            "mass": (rho_init * s.dx * s.dx).astype(dt),
+        }
+        for name in RATES + ("vol", "pr"):
+            a[name] = xp.zeros(s.n_particles, dt)
+        self.arrays = a
+        self.saved = {}
+        self.t = 0.0
+        self.after_init()
+
+    def after_init(self) -> None:
+        """Hook for device-specific setup after the arrays exist."""
+
+    @abc.abstractmethod
+    def snp(self) -> None:
+        """Neighbour search for the current positions."""
+
+    def rates(self, continuity: bool, momentum: bool) -> None:
+        """PI: fill dd (continuity) and/or ax, ay (momentum) from the current state."""
+        a, k = self.arrays, self.k
+        rho = k[5] + k[7] * a["drho"]  # rho0 + nonlin * drho
+        if continuity:
+            self.xp.divide(a["mass"], rho, out=a["vol"])
+        if momentum:
+            self.xp.divide(k[6] * a["drho"], rho * rho, out=a["pr"])
+        self._sweep(continuity, momentum)
+
+    @abc.abstractmethod
+    def _sweep(self, continuity: bool, momentum: bool) -> None:
+        """The neighbour loops themselves."""
+
+    # ------------------------------------------------------------ system update
+    def kick(self, f: float) -> None:
+        """u += f dt a."""
+        a, c = self.arrays, self.dtype.type(f * self.scene.dt)
+        a["u"] += c * a["ax"]
+        a["v"] += c * a["ay"]
+
+    def advance(self, f: float) -> None:
+        """drho += f dt D and, for moving particles, x += f dt u; time += f dt."""
+        a, c = self.arrays, self.dtype.type(f * self.scene.dt)
+        a["drho"] += c * a["dd"]
+        if self.moving:
+            a["sx"] += c * a["u"]
+            a["sy"] += c * a["v"]
+        self.t += f * self.scene.dt
+
+    def save(self) -> None:
+        """Keep a copy of the state (for two-stage integrators)."""
+        for name in ("sx", "sy", "u", "v", "drho"):
+            self.saved[name] = self.arrays[name].copy()
+        self.saved_t = self.t
+
+    def restore(self, names) -> None:
+        """Put back the saved copies of ``names`` (time goes back with drho)."""
+        for name in names:
+            self.arrays[name][...] = self.saved[name]
+        if "drho" in names:
+            self.t = self.saved_t
+
+    def permute(self, order) -> None:
+        """Reorder every per-particle array (state, rates, saved copies) by ``order``."""
+        xp = self.xp
+        for store in (self.arrays, self.saved):
+            for name, arr in store.items():
+                store[name] = xp.take(arr, order)
+
+    # ------------------------------------------------------------ output and checks
+    def output(self) -> Fields:
+        """Copy the fields back to the host in particle-id order."""
+        s = self.scene
+        h = {name: self.to_host(self.arrays[name]) for name in STATE}
+        ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + np.rint(h["lx"]).astype(np.int64)
+        order = np.argsort(ids, kind="stable")
+        x = s.x_lo + (h["lx"].astype(np.float64) + 0.5) * s.dx + h["sx"]
+        y = s.y_lo + (h["ly"].astype(np.float64) + 0.5) * s.dx + h["sy"]
+        return Fields(x=x[order], y=y[order], u=h["u"][order].astype(np.float64),
+                      v=h["v"][order].astype(np.float64), drho=h["drho"][order].astype(np.float64),
+                      t=self.t)
+
+    def to_host(self, arr) -> np.ndarray:
+        return np.asarray(arr)
+
+    def amplitude(self) -> float:
+        """max |u|, |v| over particles (NaN or inf if the state is not finite), m/s."""
+        a = self.arrays
+        m = max(float(abs(a["u"]).max()), float(abs(a["v"]).max()), 0.0)
+        if not np.isfinite(float(self.xp.sum(a["drho"]))):
+            return float("nan")
+        return m
+
+    @abc.abstractmethod
+    def mean_neighbours(self) -> float:
+        """Mean count of neighbours within the cutoff at the current positions."""
+
+    # ------------------------------------------------------------ timing support
+    def warmup(self) -> float:
+        """Compile every kernel this solver will use on a tiny scene; wall seconds."""
+        return 0.0
+
+    def synchronize(self) -> None:
+        """Wait for queued device work (no-op on the CPU)."""
+
+
+def tiny_scene(scene: Scene) -> Scene:
+    """A few hundred particles with the same model, integrator and precision (for JIT warm-up)."""
+    return scene.replace(dx=1.0, x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0,
+                         strip_height=None, steps=2, t_end=None, h_factor=2.13,
+                         cutoff_factor=min(scene.cutoff_factor, 3.0))

@@ -1,0 +1,236 @@
+"""The scene: what to simulate, as one frozen, validated value.
+
+Defaults are the reference paper's: a square lattice of spacing ``dx`` on
+x in [-10, 40] m, y in [-10, 10] m (periodic in y, free left/right edges),
+a medium at rest (rho0 = 1 kg/m^3, c0 = 1 m/s) carrying a right-travelling
+Gaussian pulse of Mach 0.05, a Gaussian kernel with h = 2.13 dx truncated at
+3 h, and dt = 0.2 dx / c0.
+
+A scene states its particle count and memory before anything is allocated
+(:meth:`Scene.memory_bytes`) and rejects nonsense with a message that names
+the parameter and the allowed range (:class:`SceneError`).
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import asdict, dataclass, field, replace
+
+MODELS = ("lagrangian", "fixed", "linear")
+INTEGRATORS = ("verlet", "kdk1", "euler", "rk2")
+PRECISIONS = ("float64", "float32")
+
+# Arrays a solver holds per particle (state, rates, sort buffers, rk2 copies),
+# counted generously so that the estimate is an upper bound for every solver.
+FLOAT_ARRAYS_PER_PARTICLE = 26
+INT_ARRAYS_PER_PARTICLE = 4  # cell id, permutation, sort scratch (int32/int64)
+
+
+class SceneError(ValueError):
+    """A scene parameter is outside its allowed range."""
+
+
+def _host_memory_bytes() -> int:
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return 16 * 2**30
+
+
+def bytes_per_particle(precision: str) -> int:
+    """Upper bound of the memory one particle costs a solver, in bytes."""
+    item = 8 if precision == "float64" else 4
+    return FLOAT_ARRAYS_PER_PARTICLE * item + INT_ARRAYS_PER_PARTICLE * 8
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One simulation, fully specified. Lengths in m, times in s, density in kg/m^3."""
+
+    dx: float
+    x_min: float = -10.0
+    x_max: float = 40.0
+    y_min: float = -10.0
+    y_max: float = 10.0
+    strip_height: float | None = None  # replaces [y_min, y_max] by a centred strip
+    rho0: float = 1.0
+    c0: float = 1.0
+    mach: float = 0.05
+    pulse_width: float = 3.0  # the 3 in exp(-((x - c0 t)/3)^2), m
+    pulse_center: float = 0.0  # pulse position at t = 0, m
+    h_factor: float = 2.13  # h = h_factor * dx
+    cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h
+    cfl: float = 0.2  # dt = cfl * dx / c0 (lowered slightly to land on t_end)
+    model: str = "lagrangian"
+    integrator: str = "verlet"
+    precision: str = "float64"
+    steps: int | None = None
+    t_end: float | None = None
+    blowup_factor: float = 4.0  # unstable once max|u| > blowup_factor * mach * c0
+    memory_limit_bytes: int | None = field(default=None, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.steps is None and self.t_end is None:
+            object.__setattr__(self, "steps", 100)  # the paper's protocol
+        self._validate()
+
+    # ------------------------------------------------------------ validation
+    def _validate(self) -> None:
+        def need(ok: bool, msg: str) -> None:
+            if not ok:
+                raise SceneError(msg)
+
+        def finite(name: str) -> float:
+            value = getattr(self, name)
+            need(isinstance(value, (int, float)) and not isinstance(value, bool)
+                 and math.isfinite(value), f"{name} must be a finite number (got {value!r})")
+            return float(value)
+
+        for name in ("dx", "x_min", "x_max", "y_min", "y_max", "rho0", "c0", "mach",
+                     "pulse_width", "pulse_center", "h_factor", "cutoff_factor", "cfl",
+                     "blowup_factor"):
+            finite(name)
+        need(self.dx > 0, f"dx must be > 0 m (got {self.dx})")
+        need(self.x_max > self.x_min, f"x_max must be > x_min (got {self.x_min}..{self.x_max})")
+        need(self.y_max > self.y_min, f"y_max must be > y_min (got {self.y_min}..{self.y_max})")
+        need(self.rho0 > 0, f"rho0 must be > 0 kg/m^3 (got {self.rho0})")
+        need(self.c0 > 0, f"c0 must be > 0 m/s (got {self.c0})")
+        need(0 < self.mach < 1, f"mach must be in (0, 1) (got {self.mach})")
+        need(self.pulse_width > 0, f"pulse_width must be > 0 m (got {self.pulse_width})")
+        need(0.5 <= self.h_factor <= 10, f"h_factor (h/dx) must be in [0.5, 10] (got {self.h_factor})")
+        need(self.cutoff_factor >= 1.0,
+             f"cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core (got {self.cutoff_factor})")
+        need(self.cutoff_factor <= 5.0,
+             f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7")
+        need(self.cfl > 0, f"cfl (dt*c0/dx) must be > 0 (got {self.cfl}); dt must be positive")
+        need(self.cfl <= 50, f"cfl (dt*c0/dx) must be <= 50 (got {self.cfl})")
+        need(self.blowup_factor > 1, f"blowup_factor must be > 1 (got {self.blowup_factor})")
+        need(self.model in MODELS, f"model must be one of {', '.join(MODELS)} (got {self.model!r})")
+        need(self.integrator in INTEGRATORS,
+             f"integrator must be one of {', '.join(INTEGRATORS)} (got {self.integrator!r})")
+        need(self.precision in PRECISIONS,
+             f"precision must be one of {', '.join(PRECISIONS)} (got {self.precision!r})")
+        need(self.steps is None or self.t_end is None, "give steps or t_end, not both")
+        if self.steps is not None:
+            need(isinstance(self.steps, int) and not isinstance(self.steps, bool) and self.steps >= 1,
+                 f"steps must be an integer >= 1 (got {self.steps!r})")
+            need(self.steps <= 10_000_000, f"steps must be <= 1e7 (got {self.steps})")
+        if self.t_end is not None:
+            finite("t_end")
+            need(self.t_end > 0, f"t_end must be > 0 s (got {self.t_end})")
+            need(self.t_end / self.dt_max <= 10_000_000,
+                 f"t_end = {self.t_end} s needs more than 1e7 steps at dt = {self.dt_max:g} s")
+        if self.strip_height is not None:
+            finite("strip_height")
+            need(self.strip_height > 0, f"strip_height must be > 0 m (got {self.strip_height})")
+        # The y-periodic height must hold the kernel support (2 cutoffs) and the
+        # cell list's 3-row stencil without seeing a neighbour twice: 3 cutoffs.
+        least = 3.0 * self.cutoff
+        need(self.height >= least * (1 - 1e-9),
+             f"{'strip_height' if self.strip_height is not None else 'y_max - y_min'} must be at least "
+             f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
+             f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)")
+        need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
+        need(self.nx * self.ny <= 2**31 - 1,
+             f"dx = {self.dx} m gives {self.nx * self.ny:.3g} particles; at most 2^31-1 are supported")
+        limit = self.memory_limit_bytes if self.memory_limit_bytes is not None else _host_memory_bytes()
+        need(self.memory_bytes() <= limit,
+             f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
+             f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
+             f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m")
+
+    # ------------------------------------------------------------ geometry
+    @property
+    def h(self) -> float:
+        """Smoothing length, m."""
+        return self.h_factor * self.dx
+
+    @property
+    def cutoff(self) -> float:
+        """Kernel truncation radius, m."""
+        return self.cutoff_factor * self.h
+
+    @property
+    def nx(self) -> int:
+        """Lattice columns."""
+        return max(int(round((self.x_max - self.x_min) / self.dx)), 0)
+
+    @property
+    def ny(self) -> int:
+        """Lattice rows; the periodic height is ny * dx."""
+        span = self.strip_height if self.strip_height is not None else self.y_max - self.y_min
+        return max(int(round(span / self.dx)), 0)
+
+    @property
+    def height(self) -> float:
+        """Periodic height in y, m (a whole number of rows)."""
+        return self.ny * self.dx
+
+    @property
+    def y_lo(self) -> float:
+        """Bottom of the periodic box, m (the strip is centred on the domain)."""
+        if self.strip_height is None:
+            return self.y_min
+        return 0.5 * (self.y_min + self.y_max) - 0.5 * self.height
+
+    @property
+    def x_lo(self) -> float:
+        return self.x_min
+
+    @property
+    def n_particles(self) -> int:
+        return self.nx * self.ny
+
+    # ------------------------------------------------------------ time
+    @property
+    def dt_max(self) -> float:
+        return self.cfl * self.dx / self.c0
+
+    @property
+    def n_steps(self) -> int:
+        if self.steps is not None:
+            return self.steps
+        return max(1, math.ceil(self.t_end / self.dt_max - 1e-9))
+
+    @property
+    def dt(self) -> float:
+        """Time step, s: cfl*dx/c0, or a little less so that t_end is hit exactly."""
+        if self.steps is not None:
+            return self.dt_max
+        return self.t_end / self.n_steps
+
+    @property
+    def t_final(self) -> float:
+        return self.n_steps * self.dt
+
+    # ------------------------------------------------------------ memory
+    def memory_bytes(self) -> int:
+        """Upper bound of the memory the particle arrays need, bytes."""
+        return self.n_particles * bytes_per_particle(self.precision)
+
+    def smallest_dx_fitting(self, limit_bytes: float) -> float:
+        """The smallest lattice spacing whose arrays fit in ``limit_bytes``, m."""
+        area = (self.x_max - self.x_min) * self.height_span
+        return math.sqrt(area * bytes_per_particle(self.precision) / max(limit_bytes, 1))
+
+    @property
+    def height_span(self) -> float:
+        return self.strip_height if self.strip_height is not None else self.y_max - self.y_min
+
+    # ------------------------------------------------------------ helpers
+    def replace(self, **changes) -> "Scene":
+        return replace(self, **changes)
+
+    def as_dict(self) -> dict:
+        d = asdict(self)
+        d.pop("memory_limit_bytes")
+        d.update(n_particles=self.n_particles, dt=self.dt, n_steps=self.n_steps,
+                 t_final=self.t_final, h=self.h, cutoff=self.cutoff, height=self.height)
+        return d
+
+    def describe(self) -> str:
+        return (f"{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
+                f"h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
+                f"{self.n_steps} steps to t = {self.t_final:.4g} s, "
+                f"{self.model}/{self.integrator}/{self.precision}, "
+                f"arrays <= {self.memory_bytes() / 2**20:.1f} MiB")
