@@ -17,7 +17,7 @@ import math
 import sys
 import time
 
-from pcabench.solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError
+from pcabench.solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
 
 
 class Progress:
@@ -129,6 +129,12 @@ def cmd_profile(args) -> int:
     return 0
 
 
+def cmd_gpu_check(args) -> int:
+    from pcabench.gpu_check import main as gpu_main
+
+    return gpu_main(args.rest)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="pcabench", description=__doc__.split("\n")[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -148,21 +154,24 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-gpu", action="store_true")
     p.set_defaults(func=cmd_profile)
 
-    try:
-        from pcabench.study import add_study_commands
-        add_study_commands(sub)
-    except ImportError:
-        pass
+    p = sub.add_parser("gpu-check", add_help=False,
+                       help="on a GPU machine: GPU tests, CPU comparison, timing sweep, profile")
+    p.set_defaults(func=cmd_gpu_check)
     return parser
 
 
 def main(argv=None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, rest = parser.parse_known_args(argv)
+    if args.command != "gpu-check" and rest:
+        parser.error(f"unrecognized arguments: {' '.join(rest)}")
+    args.rest = rest
     try:
         return args.func(args)
     except SceneError as exc:
         parser.exit(2, f"pcabench: error: {exc}\n")
+    except SolverUnavailable as exc:
+        parser.exit(3, f"pcabench: {exc}\n")
     except KeyboardInterrupt:
         parser.exit(130, "pcabench: interrupted\n")
 

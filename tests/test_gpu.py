@@ -1,0 +1,118 @@
+"""linkedlist-gpu: the kernels agree with linkedlist-cpu.
+
+CI has no GPU: the simulator tests run the same numba-cuda kernels in numba's
+CUDA simulator (NUMBA_ENABLE_CUDASIM=1, NumPy in place of CuPy) in a
+subprocess, on a few hundred particles. The ``gpu`` tests run on a real GPU
+and skip cleanly without one.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from pcabench.solvers import Scene, SceneError, SolverUnavailable, make_solver
+
+from .conftest import run_fields
+
+SIM_SCRIPT = r"""
+import json, sys, tempfile, numpy as np
+from pathlib import Path
+from pcabench.run import run
+from pcabench.solvers import Scene
+precision, model, steps = sys.argv[1], sys.argv[2], int(sys.argv[3])
+scene = Scene(dx=1.0, x_min=-8.0, x_max=8.0, steps=steps, model=model, precision=precision)
+out = {}
+with tempfile.TemporaryDirectory() as d:
+    for solver in ("linkedlist-cpu", "linkedlist-gpu"):
+        p = Path(d) / (solver + ".npz")
+        rec = run(scene, solver, fields_path=p)
+        out[solver] = {"status": rec.status, "message": rec.message[:500], "neighbours": rec.mean_neighbours}
+        if rec.status == "ok":
+            out[solver]["fields"] = {k: np.load(p)[k].tolist() for k in ("u", "drho", "x")}
+print(json.dumps(out))
+"""
+
+
+def _simulate(precision, model, steps):
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps)],
+                          capture_output=True, text=True, env=env, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def _max_rel(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+
+
+@pytest.mark.parametrize("precision,model,steps,tol", [
+    ("float64", "lagrangian", 20, 1e-12),
+    ("float32", "linear", 8, 2e-5),
+])
+def test_simulated_gpu_kernels_match_cpu(precision, model, steps, tol):
+    out = _simulate(precision, model, steps)
+    cpu, gpu = out["linkedlist-cpu"], out["linkedlist-gpu"]
+    assert cpu["status"] == "ok" and gpu["status"] == "ok", (cpu["message"], gpu["message"])
+    assert gpu["neighbours"] == pytest.approx(cpu["neighbours"])
+    for name in ("u", "drho", "x"):
+        assert _max_rel(gpu["fields"][name], cpu["fields"][name]) < tol, name
+
+
+def test_gpu_solver_without_gpu_says_so(monkeypatch):
+    from pcabench.solvers import linkedlist_gpu
+
+    if not linkedlist_gpu.simulated():
+        try:
+            linkedlist_gpu.device_backend()
+        except SolverUnavailable as exc:
+            assert "GPU" in str(exc)
+            return
+    pytest.skip("a GPU (or the simulator) is present here")
+
+
+def test_gpu_cli_without_gpu_exits_clearly():
+    from .conftest import gpu_available
+
+    if gpu_available():
+        pytest.skip("a GPU is present")
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_ENABLE_CUDASIM"}
+    proc = subprocess.run([sys.executable, "-m", "pcabench.cli", "run", "--solver", "linkedlist-gpu",
+                           "--dx", "1"], capture_output=True, text=True, env=env, timeout=300)
+    assert proc.returncode == 3
+    assert "GPU" in proc.stderr and "Traceback" not in proc.stderr
+
+
+# ------------------------------------------------------------ on a real GPU
+@pytest.mark.gpu
+@pytest.mark.parametrize("model", ["lagrangian", "fixed", "linear"])
+def test_gpu_float64_matches_cpu(requires_gpu, tmp_path, model):
+    scene = Scene(dx=0.25, steps=20, model=model)
+    cpu_rec, cpu = run_fields(scene, "linkedlist-cpu", tmp_path)
+    gpu_rec, gpu = run_fields(scene, "linkedlist-gpu", tmp_path)
+    assert cpu_rec.status == gpu_rec.status == "ok", gpu_rec.message
+    for name in ("u", "drho", "x"):
+        assert _max_rel(gpu[name], cpu[name]) < 1e-12, name
+
+
+@pytest.mark.gpu
+def test_gpu_float32_matches_float64(requires_gpu, tmp_path):
+    scene = Scene(dx=0.1, steps=100, model="linear", strip_height=2.0)
+    r64, f64 = run_fields(scene, "linkedlist-gpu", tmp_path)
+    r32, f32 = run_fields(scene.replace(precision="float32"), "linkedlist-gpu", tmp_path)
+    assert r64.status == r32.status == "ok"
+    assert _max_rel(f32["u"], f64["u"]) < 1e-4
+    assert abs(r32.mse - r64.mse) < 1e-4
+
+
+@pytest.mark.gpu
+def test_gpu_refuses_scene_larger_than_card(requires_gpu):
+    solver = make_solver("linkedlist-gpu")
+    scene = Scene(dx=0.001, memory_limit_bytes=2**50)  # 1e9 particles, ~240 GB
+    with pytest.raises(SceneError, match="smallest dx that fits"):
+        solver.input(scene)
