@@ -119,7 +119,7 @@ def compare_with_cpu(dx: float = 0.5, steps: int = 20) -> list[dict]:
     return rows
 
 
-def timing_sweep(sizes, steps: int, store_path: Path, profile_id: str) -> list[dict]:
+def timing_sweep(sizes, steps: int, store_path: Path, profile_id: str, models=MODELS) -> list[dict]:
     from pcabench import store
     from pcabench.run import run
     from pcabench.solvers import Scene
@@ -127,7 +127,7 @@ def timing_sweep(sizes, steps: int, store_path: Path, profile_id: str) -> list[d
     rows = []
     for dx in sizes:
         for precision in PRECISIONS:
-            for model in MODELS:
+            for model in models:
                 scene = Scene(dx=dx, steps=steps, model=model, precision=precision,
                               memory_limit_bytes=2**40)  # the GPU solver checks its own memory
                 t0 = time.perf_counter()
@@ -185,6 +185,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default="gpu_check_out", help="folder for the results")
     parser.add_argument("--sizes", type=float, nargs="+", default=list(PAPER_SIZES))
     parser.add_argument("--steps", type=int, default=100)
+    parser.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
     parser.add_argument("--skip-tests", action="store_true")
     parser.add_argument("--skip-compare", action="store_true")
     parser.add_argument("--only-ceilings", action="store_true", help="profile and measured ceilings only")
@@ -213,7 +214,8 @@ def gpu_check(args) -> int:
                                 stdout=log, stderr=subprocess.STDOUT).returncode
         print(f"pytest -m gpu: exit {rc} (log in {out / 'pytest_gpu.log'})", flush=True)
     compare_rows = [] if args.skip_compare else compare_with_cpu()
-    timing_rows = timing_sweep(args.sizes, args.steps, out / "gpu_results.jsonl", profile["id"])
+    timing_rows = timing_sweep(args.sizes, args.steps, out / "gpu_results.jsonl", profile["id"],
+                               models=args.models)
     text = markdown(profile, compare_rows, timing_rows, args.steps)
     (out / "gpu_check.md").write_text(text)
     print(text, flush=True)

@@ -71,16 +71,22 @@ def device_backend():
 
 
 @lru_cache(maxsize=None)
-def kernels():
-    """The device kernels (compiled lazily by numba-cuda on first launch per dtype)."""
+def kernels(precision: str):
+    """The device kernels for ``precision`` (compiled by numba-cuda on first launch).
+
+    float32 kernels use fastmath (the hardware's approximate expf, ~2 ulp);
+    float64 kernels use the accurate libdevice exp.
+    """
     from .backend import compile_pairs
     from .kernel import exp_neg_math
 
     global cuda
     cuda, _ = device_backend()
-    P = compile_pairs(cuda.jit(device=True), exp_neg_math, "cuda")
+    fast = precision == "float32"
+    P = compile_pairs(cuda.jit(device=True, fastmath=fast), exp_neg_math, f"cuda_{precision}")
+    jit = cuda.jit(fastmath=fast)
 
-    @cuda.jit
+    @jit
     def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, height, cw, ch, ncx, ncy):
         i = cuda.grid(1)
         if i < lx.shape[0]:
@@ -93,13 +99,13 @@ def kernels():
             cy = min(max(cy, 0), ncy - 1)
             cell[i] = cy * ncx + cx
 
-    @cuda.jit
+    @jit
     def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
         i = cuda.grid(1)
         if i < lx.shape[0]:
             out[i] = P.continuity_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, k)
 
-    @cuda.jit
+    @jit
     def momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
         i = cuda.grid(1)
         if i < lx.shape[0]:
@@ -107,7 +113,7 @@ def kernels():
             ax[i] = bx
             ay[i] = by
 
-    @cuda.jit
+    @jit
     def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, counts, k):
         i = cuda.grid(1)
         if i < lx.shape[0]:
@@ -156,7 +162,7 @@ class LinkedListGPU(Solver):
         self.cells_valid = False
 
     def launch(self, name, *args):
-        kernels()[name][self.blocks, THREADS_PER_BLOCK](*args)
+        kernels(self.scene.precision)[name][self.blocks, THREADS_PER_BLOCK](*args)
 
     def snp(self) -> None:
         if self.cells_valid and not self.moving:
@@ -169,7 +175,8 @@ class LinkedListGPU(Solver):
         else:
             order = np.argsort(self.cell, kind="stable")
         self.cell = xp.take(self.cell, order)
-        self.begin = xp.searchsorted(self.cell, self.cell_range).astype(xp.int64)
+        # unsigned cell bounds: no negative-index wraparound on each neighbour load
+        self.begin = xp.searchsorted(self.cell, self.cell_range).astype(xp.uint32)
         self.permute(order)
         self.cells_valid = True
 
