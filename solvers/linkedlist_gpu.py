@@ -158,11 +158,13 @@ class LinkedListGPU(Solver):
         self.cell = xp.empty(s.n_particles, xp.int32)
         self.cell_range = xp.arange(self.ncells + 1, dtype=xp.int32)
         self.begin = None
-        self.blocks = (s.n_particles + THREADS_PER_BLOCK - 1) // THREADS_PER_BLOCK
+        # the simulator runs every thread of a block as a Python thread: keep blocks small there
+        self.threads_per_block = 32 if self.cupy is None else THREADS_PER_BLOCK
+        self.blocks = (s.n_particles + self.threads_per_block - 1) // self.threads_per_block
         self.cells_valid = False
 
     def launch(self, name, *args):
-        kernels(self.scene.precision)[name][self.blocks, THREADS_PER_BLOCK](*args)
+        kernels(self.scene.precision)[name][self.blocks, self.threads_per_block](*args)
 
     def snp(self) -> None:
         if self.cells_valid and not self.moving:

@@ -131,13 +131,13 @@ class Scene:
              f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
              f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)")
         need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
-        need(self.nx * self.ny <= 2**31 - 1,
-             f"dx = {self.dx} m gives {self.nx * self.ny:.3g} particles; at most 2^31-1 are supported")
         limit = self.memory_limit_bytes if self.memory_limit_bytes is not None else _host_memory_bytes()
         need(self.memory_bytes() <= limit,
              f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
              f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
              f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m")
+        need(self.nx * self.ny <= 2**31 - 1,
+             f"dx = {self.dx} m gives {self.nx * self.ny:.3g} particles; at most 2^31-1 are supported")
 
     # ------------------------------------------------------------ geometry
     @property

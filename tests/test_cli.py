@@ -1,0 +1,90 @@
+"""The command line contract: the stage table, --json, --fields, and clear errors on bad input."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from pcabench.solvers import Scene, SceneError
+
+
+def pcabench(*args, timeout=600):
+    return subprocess.run([sys.executable, "-m", "pcabench.cli", *args], capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def test_run_prints_stage_table_and_errors():
+    proc = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "10")
+    assert proc.returncode == 0, proc.stderr
+    for word in ("input", "init", "snp", "pi", "su", "output", "jit", "particles", "mean neighbours",
+                 "MSE", "ME", "1,000"):
+        assert word in proc.stdout
+
+
+def test_json_is_one_object_with_the_contract(tmp_path):
+    fields = tmp_path / "f.npz"
+    proc = pcabench("run", "--solver", "allpair-cpu", "--dx", "1", "--t-end", "2", "--model", "linear",
+                    "--json", "--fields", str(fields))
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    for key in ("solver", "precision", "model", "integrator", "dx", "n_particles", "steps", "t_end",
+                "stages", "jit_seconds", "mse", "me", "mean_neighbours", "status", "failed_step"):
+        assert key in out
+    assert set(out["stages"]) == {"input", "init", "snp", "pi", "su", "output"}
+    assert out["n_particles"] == 1000 and out["steps"] == 10 and out["t_end"] == pytest.approx(2.0)
+    assert 0 < out["mse"] < 1 and out["status"] == "ok" and out["failed_step"] is None
+    f = np.load(fields)
+    assert set(f.files) == {"x", "y", "u", "v", "drho", "t"} and f["u"].shape == (1000,)
+    assert float(f["t"]) == pytest.approx(2.0)
+
+
+def test_unstable_run_reports_status_and_step_with_exit_1():
+    proc = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
+                    "--model", "linear", "--json")
+    assert proc.returncode == 1
+    out = json.loads(proc.stdout)
+    assert out["status"] == "unstable" and out["failed_step"] >= 1
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--dx", "0"], ["dx", "> 0"]),
+    (["--dx", "-1"], ["dx", "> 0"]),
+    (["--dx", "nan"], ["--dx", "finite"]),
+    (["--dx", "0.00001"], ["dx", "smallest dx that fits"]),
+    (["--dx", "1", "--cutoff", "0.5"], ["cutoff", ">= 1"]),
+    (["--dx", "1", "--cfl", "0"], ["cfl", "> 0"]),
+    (["--dx", "1", "--steps", "0"], ["--steps", ">= 1"]),
+    (["--dx", "1", "--t-end", "-5"], ["t_end", "> 0"]),
+    (["--dx", "0.1", "--strip-height", "0.5"], ["strip_height", "3 cutoffs"]),
+    (["--dx", "1", "--threads", "0"], ["--threads", ">= 1"]),
+    (["--dx", "1", "--threads", "100000"], ["threads", "between 1 and"]),
+    (["--dx", "1", "--precision", "float16"], ["precision", "float64"]),
+    (["--dx", "1", "--integrator", "leapfrog"], ["integrator", "verlet"]),
+    (["--dx", "1", "--model", "eulerian"], ["model", "lagrangian"]),
+])
+def test_bad_input_exits_2_with_a_clear_message(args, words):
+    proc = pcabench("run", "--solver", "linkedlist-cpu", *args)
+    assert proc.returncode == 2, (proc.stdout, proc.stderr)
+    assert "Traceback" not in proc.stderr
+    for word in words:
+        assert word in proc.stderr, proc.stderr
+
+
+def test_unknown_solver_is_refused():
+    proc = pcabench("run", "--solver", "quantum-cpu", "--dx", "1")
+    assert proc.returncode == 2 and "solver" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_scene_states_particles_and_memory_before_allocating():
+    scene = Scene(dx=0.004)
+    assert scene.n_particles == 62_500_000
+    assert 0 < scene.memory_bytes() < 62_500_000 * 300
+    with pytest.raises(SceneError, match="smallest dx that fits"):
+        Scene(dx=0.004, memory_limit_bytes=2**30)
+
+
+def test_paper_particle_counts():
+    assert [Scene(dx=d).n_particles for d in (1, 0.1, 0.05, 0.01)] == [1000, 100_000, 400_000, 10_000_000]
