@@ -15,17 +15,20 @@ PACKAGES = ("pcabench", "numpy", "numba", "numba-cuda", "cupy-cuda12x", "cupy-cu
 @functools.lru_cache(maxsize=None)
 def git_commit() -> str:
     """The commit of the source tree (with '+dirty' if it has local changes), or 'unknown'."""
+    if os.environ.get("PCABENCH_COMMIT"):
+        return os.environ["PCABENCH_COMMIT"]  # a copy without git history (e.g. a GPU machine)
     here = Path(__file__).resolve().parent
     try:
-        sha = subprocess.run(["git", "rev-parse", "HEAD"], cwd=here, capture_output=True,
-                             text=True, timeout=10).stdout.strip()
-        if not sha:
-            return os.environ.get("PCABENCH_COMMIT", "unknown")
+        proc = subprocess.run(["git", "rev-parse", "--verify", "HEAD"], cwd=here, capture_output=True,
+                              text=True, timeout=10)
+        sha = proc.stdout.strip()
+        if proc.returncode != 0 or len(sha) != 40:
+            return "unknown"
         dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=here,
                                capture_output=True, text=True, timeout=10).stdout.strip()
         return sha + ("+dirty" if dirty else "")
     except (OSError, subprocess.SubprocessError):
-        return os.environ.get("PCABENCH_COMMIT", "unknown")
+        return "unknown"
 
 
 @functools.lru_cache(maxsize=None)
