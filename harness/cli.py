@@ -154,6 +154,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-gpu", action="store_true")
     p.set_defaults(func=cmd_profile)
 
+    from pcabench.study import add_study_commands
+
+    add_study_commands(sub)
     p = sub.add_parser("gpu-check", add_help=False,
                        help="on a GPU machine: GPU tests, CPU comparison, timing sweep, profile")
     p.set_defaults(func=cmd_gpu_check)
