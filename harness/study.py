@@ -145,6 +145,11 @@ def cmd_study(args) -> int:
     from pcabench import hardware_profiles
     from pcabench.reports import write_reports
 
+    from pcabench.solvers import SceneError
+
+    for flag, value in (("--run-budget", args.run_budget), ("--sweep-budget", args.sweep_budget)):
+        if not value > 0:
+            raise SceneError(f"{flag} must be > 0 seconds (got {value})")
     name = "paper" if args.paper else "quick"
     runs = preset(name)
     profile = hardware_profiles.capture()
