@@ -20,6 +20,7 @@ that reorders particles can permute all of them together.
 from __future__ import annotations
 
 import abc
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -198,6 +199,14 @@ class Solver(abc.ABC):
 
     def synchronize(self) -> None:
         """Wait for queued device work (no-op on the CPU)."""
+
+
+def cell_grid(scene: Scene) -> tuple:
+    """(cw, ch, ncx, ncy): cells one cutoff wide (one spare each side in x for particles
+    drifting past the edges) and at least one cutoff tall, filling the periodic height."""
+    ncy = max(int(math.floor(scene.height / scene.cutoff)), 1)
+    ncx = int(math.ceil((scene.x_max - scene.x_min) / scene.cutoff)) + 2
+    return scene.cutoff, scene.height / ncy, ncx, ncy
 
 
 def tiny_scene(scene: Scene) -> Scene:

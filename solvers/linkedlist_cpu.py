@@ -14,7 +14,6 @@ threads, one particle per iteration, as the honest multi-core peer.
 """
 from __future__ import annotations
 
-import math
 import time
 from functools import lru_cache
 
@@ -22,26 +21,9 @@ import numba
 import numpy as np
 
 from .backend import cpu_pairs
-from .interface import Solver, tiny_scene
+from .interface import Solver, cell_grid, tiny_scene
 from .scene import SceneError
 
-
-
-def _cell_ids(lx, ly, sx, sy, cell, dx, x_grid, height, cw, ch, ncx, ncy):
-    """particleIndex: the cell of every particle (float64 positions, clamped in x).
-
-    x_grid is the left edge of the cell grid relative to the first lattice
-    column's left edge; y is taken modulo the periodic height.
-    """
-    for i in numba.prange(lx.shape[0]):
-        x = (np.float64(lx[i]) + 0.5) * dx + np.float64(sx[i])
-        y = (np.float64(ly[i]) + 0.5) * dx + np.float64(sy[i])
-        y = y - math.floor(y / height) * height
-        cx = int(math.floor((x - x_grid) / cw))
-        cy = int(y / ch)
-        cx = min(max(cx, 0), ncx - 1)
-        cy = min(max(cy, 0), ncy - 1)
-        cell[i] = cy * ncx + cx
 
 
 def _counting_sort(cell, ncells, begin, order, sorted_cell):
@@ -79,9 +61,13 @@ def sweeps(precision: str, parallel: bool) -> dict:
             total += P.neighbours_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k)
         return total
 
+    def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, height, cw, ch, ncx, ncy):
+        for i in prange(lx.shape[0]):
+            cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, height, cw, ch, ncx, ncy)
+
     jit = numba.njit(nogil=True, parallel=parallel)
     return {"continuity": jit(continuity), "momentum": jit(momentum), "neighbours": jit(neighbours),
-            "cell_ids": numba.njit(nogil=True, parallel=parallel, cache=True)(_cell_ids)}
+            "cell_ids": jit(cell_ids)}
 
 
 counting_sort = numba.njit(cache=True, nogil=True)(_counting_sort)
@@ -110,11 +96,7 @@ class LinkedListCPU(Solver):
 
     def after_init(self) -> None:
         s = self.scene
-        self.cw = s.cutoff
-        self.ncy = max(int(math.floor(s.height / s.cutoff)), 1)
-        self.ch = s.height / self.ncy
-        # one spare cell each side in x for particles that drift past the edges
-        self.ncx = int(math.ceil((s.x_max - s.x_min) / self.cw)) + 2
+        self.cw, self.ch, self.ncx, self.ncy = cell_grid(s)
         n, ncells = s.n_particles, self.ncx * self.ncy
         self.cell = np.empty(n, np.int32)
         self.sorted_cell = np.empty(n, np.int32)

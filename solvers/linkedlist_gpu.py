@@ -16,14 +16,13 @@ CI checks the GPU code. Without either, the solver says there is no GPU.
 """
 from __future__ import annotations
 
-import math
 import os
 import time
 from functools import lru_cache
 
 import numpy as np
 
-from .interface import Solver, SolverUnavailable, tiny_scene
+from .interface import Solver, SolverUnavailable, cell_grid, tiny_scene
 from .scene import SceneError
 
 THREADS_PER_BLOCK = 256
@@ -90,14 +89,7 @@ def kernels(precision: str):
     def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, height, cw, ch, ncx, ncy):
         i = cuda.grid(1)
         if i < lx.shape[0]:
-            x = (float(lx[i]) + 0.5) * dx + float(sx[i])
-            y = (float(ly[i]) + 0.5) * dx + float(sy[i])
-            y = y - math.floor(y / height) * height
-            cx = int(math.floor((x - x_grid) / cw))
-            cy = int(y / ch)
-            cx = min(max(cx, 0), ncx - 1)
-            cy = min(max(cy, 0), ncy - 1)
-            cell[i] = cy * ncx + cx
+            cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, height, cw, ch, ncx, ncy)
 
     @jit
     def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
@@ -150,10 +142,7 @@ class LinkedListGPU(Solver):
 
     def after_init(self) -> None:
         s, xp = self.scene, self.xp
-        self.cw = s.cutoff
-        self.ncy = max(int(math.floor(s.height / s.cutoff)), 1)
-        self.ch = s.height / self.ncy
-        self.ncx = int(math.ceil((s.x_max - s.x_min) / self.cw)) + 2
+        self.cw, self.ch, self.ncx, self.ncy = cell_grid(s)
         self.ncells = self.ncx * self.ncy
         self.cell = xp.empty(s.n_particles, xp.int32)
         self.cell_range = xp.arange(self.ncells + 1, dtype=xp.int32)

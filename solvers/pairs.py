@@ -85,6 +85,21 @@ def neighbours_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, k):
 
 # ---------------------------------------------------------------- cell list
 @jit
+def cell_index(lx, ly, sx, sy, dx, x_grid, height, cw, ch, ncx, ncy):
+    """particleIndex of one particle: cy * ncx + cx from float64 positions.
+
+    x_grid is the grid's left edge relative to the first lattice column's left
+    edge; x is clamped to the grid, y taken modulo the periodic height.
+    """
+    x = (float(lx) + 0.5) * dx + float(sx)
+    y = (float(ly) + 0.5) * dx + float(sy)
+    y = y - math.floor(y / height) * height
+    cx = min(max(int(math.floor((x - x_grid) / cw)), 0), ncx - 1)
+    cy = min(max(int(y / ch), 0), ncy - 1)
+    return cy * ncx + cx
+
+
+@jit
 def stencil_row(i, dcy, cell, begin, ncx, ncy, ly, k):
     """Row ``dcy`` (-1, 0, 1) of particle i's 3x3 cell stencil: (j0, j1, lyi shifted).
 
