@@ -14,7 +14,11 @@ PACKAGES = ("pcabench", "numpy", "numba", "numba-cuda", "cupy-cuda12x", "cupy-cu
 
 @functools.lru_cache(maxsize=None)
 def git_commit() -> str:
-    """The commit of the source tree (with '+dirty' if it has local changes), or 'unknown'."""
+    """The commit of the source tree (with '+dirty' if its code has local changes), or 'unknown'.
+
+    Results, reports and stored profiles are outputs, not code: a sweep that
+    appends to a tracked results file does not make its own later runs dirty.
+    """
     if os.environ.get("PCABENCH_COMMIT"):
         return os.environ["PCABENCH_COMMIT"]  # a copy without git history (e.g. a GPU machine)
     here = Path(__file__).resolve().parent
@@ -24,7 +28,8 @@ def git_commit() -> str:
         sha = proc.stdout.strip()
         if proc.returncode != 0 or len(sha) != 40:
             return "unknown"
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=here,
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ":/",
+                                ":(exclude,top)reports", ":(exclude,top)hardware_profiles/*.json"], cwd=here,
                                capture_output=True, text=True, timeout=10).stdout.strip()
         return sha + ("+dirty" if dirty else "")
     except (OSError, subprocess.SubprocessError):

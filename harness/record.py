@@ -33,6 +33,7 @@ class RunRecord:
     profile_id: str = ""
     commit: str = ""
     versions: dict = field(default_factory=dict)
+    preset: str = ""  # the study preset that asked for the run (quick, paper, stability, matrix), if any
     timestamp: str = field(default_factory=lambda: _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
 
     CONTRACT = ("solver", "precision", "model", "integrator", "dx", "n_particles", "steps", "t_end",

@@ -79,8 +79,16 @@ def load(paths):
         scene = row.get("scene") or {}
         for key in ("strip_height", "cutoff_factor", "h_factor", "cfl", "t_final", "height"):
             r[key] = scene.get(key)
+        # how the run ends: the paper's fixed step count, or a fixed physical time
+        r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
+        r["domain"] = "strip" if scene.get("strip_height") else "full"
+        r["scene_key"] = json.dumps({k: v for k, v in scene.items() if k != "memory_limit_bytes"},
+                                    sort_keys=True)
+        r.setdefault("preset", "")
+        r["threads"] = int(r.get("threads") or 1)
         flat.append(r)
     df = pd.DataFrame(flat)
     if not df.empty:
         df["t_step"] = (df["t_snp"] + df["t_pi"] + df["t_su"]) / df["steps"].clip(lower=1)
+        df["t_solution"] = df["t_init"] + df["t_snp"] + df["t_pi"] + df["t_su"]  # s, without JIT and I/O
     return df

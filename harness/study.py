@@ -2,12 +2,15 @@
 
     pcabench study --quick     # a few minutes on a laptop CPU, then the report
     pcabench study --paper     # the paper's CPU matrix, as far as the budgets allow
+    pcabench study --stability # where methods fail: CFL, h/dx, integrator, precision, run length
+    pcabench study --solver allpair-cpu linkedlist-cpu --dx 1 0.5 --steps 10   # a matrix
 
 Each run is a child process with a time budget: a crash, hang or
 out-of-memory in one run is recorded (status error / timeout /
 out-of-memory) and the sweep goes on. Every finished run is appended to the
 store at once; a rerun skips the runs the store already holds for this
-machine and commit, so an interrupted sweep resumes where it stopped.
+machine, commit and preset, so an interrupted sweep resumes where it stopped.
+Runs predicted to take longer than the run budget are stored as ``skipped``.
 """
 from __future__ import annotations
 
@@ -27,55 +30,30 @@ from pcabench.solvers import Scene
 RESULTS_DIR = Path("reports/results")
 
 
-def strip_height(dx: float, cutoff_factor: float = 3.0, h_factor: float = 2.13) -> float:
-    """The thinnest y-periodic strip the cell list accepts at ``dx``, m."""
-    import math
+def all_cores() -> int:
+    """Threads a ``threads: 0`` spec means: every core numba may use here."""
+    import os
 
-    return math.ceil(3 * cutoff_factor * h_factor * (1 + 1e-9)) * dx
+    import numba
+
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return max(1, min(usable, numba.config.NUMBA_NUM_THREADS))
 
 
-def preset(name: str) -> list[dict]:
-    """The run matrix of a preset: dicts of solver, threads and Scene keyword arguments."""
-    runs = []
-    if name == "quick":
-        # Table 4/5 and Fig. 10: stage times of the paper's scene (lagrangian, full domain)
-        for dx in (1.0, 0.5, 0.25):
-            runs.append({"solver": "linkedlist-cpu", "scene": {"dx": dx, "steps": 20}})
-        # Fig. 9: all-pair against linked list
-        for dx in (1.0, 0.5):
-            runs.append({"solver": "allpair-cpu", "scene": {"dx": dx, "steps": 20}})
-        # Fig. 8: error against dx at a fixed physical time, on the strip
-        for model in ("linear", "lagrangian"):
-            for dx in (0.4, 0.2, 0.1):
-                runs.append({"solver": "linkedlist-cpu",
-                             "scene": {"dx": dx, "t_end": 10.0, "model": model, "strip_height": strip_height(dx)}})
-    elif name == "paper":
-        for dx in (1.0, 0.5, 0.25, 0.1, 0.05):
-            runs.append({"solver": "linkedlist-cpu", "scene": {"dx": dx, "steps": 100}})
-            runs.append({"solver": "linkedlist-cpu", "threads": 2, "scene": {"dx": dx, "steps": 100}})
-        for dx in (1.0, 0.5, 0.25, 0.1):
-            runs.append({"solver": "allpair-cpu", "scene": {"dx": dx, "steps": 100}})
-        for model in ("linear", "fixed", "lagrangian"):
-            for precision in ("float64", "float32"):
-                for dx in (0.4, 0.2, 0.1, 0.05, 0.025):
-                    runs.append({"solver": "linkedlist-cpu", "threads": 2, "scene": {
-                        "dx": dx, "t_end": 10.0, "model": model, "precision": precision,
-                        "strip_height": strip_height(dx)}})
-                for dx in (0.1, 0.05, 0.01, 0.004):
-                    runs.append({"solver": "linkedlist-cpu", "threads": 2, "scene": {
-                        "dx": dx, "steps": 100, "model": model, "precision": precision,
-                        "strip_height": strip_height(dx)}})
-    else:
-        raise ValueError(f"preset must be quick or paper (got {name!r})")
-    return runs
+def resolve(spec: dict) -> dict:
+    """``spec`` with ``threads: 0`` replaced by this machine's core count."""
+    if spec.get("threads", 1) == 0:
+        spec = dict(spec, threads=all_cores() if spec["solver"] == "linkedlist-cpu" else 1)
+    return spec
 
 
 def _key(spec: dict, profile: str, commit: str) -> str:
-    return json.dumps([spec["solver"], spec.get("threads", 1), Scene(**spec["scene"]).as_dict(), profile, commit],
-                      sort_keys=True, default=str)
+    """What identifies a run for resuming: solver, threads, scene, preset, machine and commit."""
+    return json.dumps([spec["solver"], spec.get("threads", 1) or 1, Scene(**spec["scene"]).as_dict(),
+                       spec.get("preset", ""), profile, commit], sort_keys=True, default=str)
 
 
-def _failed_record(spec, status, message, profile, seconds) -> RunRecord:
+def _failed_record(spec, status, message, profile, seconds=None) -> RunRecord:
     scene = Scene(**spec["scene"])
     nan = float("nan")
     return RunRecord(solver=spec["solver"], precision=scene.precision, model=scene.model,
@@ -83,27 +61,47 @@ def _failed_record(spec, status, message, profile, seconds) -> RunRecord:
                      t_end=0.0, stages={s: 0.0 for s in ("input", "init", "snp", "pi", "su", "output")},
                      jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan, status=status, failed_step=None,
                      threads=spec.get("threads", 1), steps_requested=scene.n_steps, scene=scene.as_dict(),
-                     message=f"{message} (after {seconds:.0f} s)", profile_id=profile,
-                     commit=git_commit(), versions=package_versions())
+                     message=message if seconds is None else f"{message} (after {seconds:.0f} s)",
+                     profile_id=profile, commit=git_commit(), versions=package_versions(),
+                     preset=spec.get("preset", ""))
 
 
 def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: float,
           stream=sys.stderr) -> int:
-    """Run ``runs`` (skipping those already stored), one child process each. Returns runs made."""
+    """Run ``runs`` (skipping those already stored), one child process each. Returns runs made.
+
+    Before each run its time is predicted from this machine's finished runs
+    (``predict.py``); a run predicted past ``run_budget`` is stored as
+    ``skipped`` with the prediction instead of being run into the wall.
+    """
+    from pcabench.predict import predicted_seconds
+
     profile, commit = this_profile_id(), git_commit()
-    done = {_key({"solver": r["solver"], "threads": r.get("threads", 1), "scene": _scene_kwargs(r)}, r["profile_id"],
-                 r["commit"]) for r in store.read_rows(store_path)} if store_path.exists() else set()
+    rows = store.read_rows(store_path) if Path(store_path).exists() else []
+    done = {_key({"solver": r["solver"], "threads": r.get("threads", 1), "scene": _scene_kwargs(r),
+                  "preset": r.get("preset", "")}, r["profile_id"], r["commit"]) for r in rows}
+    mine = [r for r in rows if r.get("profile_id") == profile]
     t_start, made = time.perf_counter(), 0
     for i, spec in enumerate(runs, 1):
-        label = f"[{i}/{len(runs)}] {spec['solver']} " + " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                                                               for k, v in spec["scene"].items())
+        spec = resolve(spec)
+        label = f"[{i}/{len(runs)}] {spec['solver']}" + (f" x{spec['threads']}" if spec.get("threads", 1) > 1
+                                                          else "") + " " + " ".join(
+            f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in spec["scene"].items())
         if _key(spec, profile, commit) in done:
-            print(f"{label}: stored, skipped", file=stream, flush=True)
+            print(f"{label}: already stored", file=stream, flush=True)
             continue
-        left = sweep_budget - (time.perf_counter() - t_start)
+        elapsed = time.perf_counter() - t_start
+        left = sweep_budget - elapsed
         if left <= 0:
             print(f"{label}: sweep budget spent, stopping (rerun to resume)", file=stream, flush=True)
             break
+        scene = Scene(**spec["scene"])
+        seconds, why = predicted_seconds(spec, scene, mine)
+        if seconds is not None and seconds > run_budget:
+            row = store.append(_failed_record(spec, "skipped", f"{why} > run budget {run_budget:.0f} s",
+                                              profile), store_path)
+            print(f"{label}: skipped, {why}", file=stream, flush=True)
+            continue
         t0 = time.perf_counter()
         cmd = [sys.executable, "-m", "pcabench.study", "--child", json.dumps(spec), "--store", str(store_path)]
         try:
@@ -117,9 +115,15 @@ def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: f
                                         time.perf_counter() - t0), store_path)
         made += 1
         last = store.read_rows(store_path)[-1]
-        print(f"{label}: {last['status']}, step {1e3 * _step(last):.2f} ms, MSE {last.get('mse')}, "
-              f"{time.perf_counter() - t0:.1f} s", file=stream, flush=True)
+        mine.append(last)
+        eta = (time.perf_counter() - t_start) / made * (len(runs) - i)
+        print(f"{label}: {last['status']}, step {1e3 * _step(last):.2f} ms, MSE {_fmt_err(last.get('mse'))}, "
+              f"{time.perf_counter() - t0:.1f} s (sweep eta <= {eta / 60:.1f} min)", file=stream, flush=True)
     return made
+
+
+def _fmt_err(x):
+    return "-" if x is None else f"{x:.4g}"
 
 
 def _step(row):
@@ -137,27 +141,45 @@ def child(spec_json: str, store_path: str) -> int:
 
     spec = json.loads(spec_json)
     record = run(Scene(**spec["scene"]), spec["solver"], threads=spec.get("threads"), profile_id=this_profile_id())
+    record.preset = spec.get("preset", "")
     store.append(record, store_path)
     return 0
 
 
+def runs_from_args(args) -> tuple[str, list[dict]]:
+    """The preset named by the flags, or the matrix built from --solver/--dx/... options."""
+    from pcabench.presets import matrix, preset
+
+    if args.dx:
+        return "matrix", matrix(args.solver or ["linkedlist-cpu"], args.dx, args.precision or ["float64"],
+                                args.model or ["lagrangian"], args.integrator or ["verlet"], args.cfl or [0.2],
+                                args.h_factor or [2.13], steps=args.steps, t_end=args.t_end, strip=args.strip,
+                                threads=args.threads)
+    name = "paper" if args.paper else "stability" if args.stability else "quick"
+    return name, preset(name)
+
+
 def cmd_study(args) -> int:
     from pcabench import hardware_profiles
+    from pcabench.presets import RUN_BUDGET
     from pcabench.reports import write_reports
-
     from pcabench.solvers import SceneError
 
-    for flag, value in (("--run-budget", args.run_budget), ("--sweep-budget", args.sweep_budget)):
+    name, runs = runs_from_args(args)
+    for spec in runs:  # validate the whole matrix before the first run
+        Scene(**spec["scene"])
+    run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
+    for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
             raise SceneError(f"{flag} must be > 0 seconds (got {value})")
-    name = "paper" if args.paper else "quick"
-    runs = preset(name)
     profile = hardware_profiles.capture()
     hardware_profiles.save(profile)
     store_path = Path(args.results) / f"{profile['id']}.jsonl"
-    print(f"pcabench study --{name}: {len(runs)} runs on {profile['id']}, store {store_path}",
-          file=sys.stderr, flush=True)
-    sweep(runs, store_path, args.run_budget, args.sweep_budget)
+    print(f"pcabench study ({name}): {len(runs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
+          f"store {store_path}", file=sys.stderr, flush=True)
+    sweep(runs, store_path, run_budget, args.sweep_budget)
+    if args.no_report:
+        return 0
     paths = write_reports(Path(args.results), Path(args.reports))
     for p in paths:
         print(f"wrote {p}", file=sys.stderr)
@@ -173,14 +195,35 @@ def cmd_report(args) -> int:
 
 
 def add_study_commands(sub) -> None:
-    p = sub.add_parser("study", help="run a sweep (each run in its own process) and write the report")
+    from pcabench.cli import _number, _positive_int
+    from pcabench.solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS
+
+    p = sub.add_parser("study", help="run a sweep (each run in its own process) and write the report",
+                       description="Run a preset, or the product of the matrix options, one process per run.")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="a few minutes on a laptop CPU (default)")
     g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets")
+    g.add_argument("--stability", action="store_true",
+                   help="CFL x integrator x h/dx, run length and float32: the stability map")
+    m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
+    m.add_argument("--dx", nargs="+", type=_number("--dx"), help="lattice spacings, m")
+    m.add_argument("--solver", nargs="+", choices=SOLVERS)
+    m.add_argument("--precision", nargs="+", choices=PRECISIONS)
+    m.add_argument("--model", nargs="+", choices=MODELS)
+    m.add_argument("--integrator", nargs="+", choices=INTEGRATORS)
+    m.add_argument("--cfl", nargs="+", type=_number("--cfl"))
+    m.add_argument("--h-factor", nargs="+", type=_number("--h-factor"))
+    end = m.add_mutually_exclusive_group()
+    end.add_argument("--steps", type=_positive_int("--steps"))
+    end.add_argument("--t-end", type=_number("--t-end"))
+    m.add_argument("--strip", action="store_true", help="the thinnest y-periodic strip instead of 20 m")
+    m.add_argument("--threads", type=_positive_int("--threads"), default=1)
     p.add_argument("--results", default=str(RESULTS_DIR), help="folder of result stores (*.jsonl)")
     p.add_argument("--reports", default="reports", help="folder for the reports")
-    p.add_argument("--run-budget", type=float, default=900.0, help="seconds per run before it is a timeout")
+    p.add_argument("--run-budget", type=float, help="seconds per run before it is a timeout "
+                   "(default: quick 120, paper 900, stability 120, matrix 900)")
     p.add_argument("--sweep-budget", type=float, default=4 * 3600.0, help="seconds for the whole sweep")
+    p.add_argument("--no-report", action="store_true", help="store the runs, do not write the reports")
     p.set_defaults(func=cmd_study)
     p = sub.add_parser("report", help="regenerate the reports from the stored results")
     p.add_argument("--results", default=str(RESULTS_DIR))

@@ -1,4 +1,10 @@
-"""Build the Markdown report and figures of each measured profile from the store."""
+"""Write the Markdown reports: one per measured profile, the card comparison, and the index.
+
+    reports/<profile>/report.md   Tables 4-6, Figs. 8-11, 13, speed vs accuracy,
+                                  cost of simplifications, stability map, failed runs
+    reports/cards.md              Table 6 and Fig. 14 across systems, GPU cards side by side
+    reports/README.md             the index
+"""
 from __future__ import annotations
 
 from pathlib import Path
@@ -7,159 +13,221 @@ import numpy as np
 
 from pcabench import hardware_profiles, store
 
-PAPER = "paper-system-1"
+from . import figures as F
+from . import tables as T
+
+INACCURATE_ABOVE = 0.10  # relative RMS above which a bounded run is classed inaccurate (stability map)
 
 
-def _paper_tables():
-    pub = hardware_profiles.load(PAPER)["published"]
-    return pub["table4"], pub["table5"]
-
-
-def _md_table(header, rows) -> str:
+def md_table(header, rows) -> str:
     out = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     out += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
     return "\n".join(out)
 
 
-def _fmt(x, spec=".3g"):
-    return "-" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, spec)
+def fmt(x, spec=".3g") -> str:
+    if x is None or (isinstance(x, float) and not np.isfinite(x)):
+        return "-"
+    return format(x, spec)
 
 
-def fit_order(dx, err):
-    """Least-squares slope of log(err) against log(dx): the observed convergence order."""
-    dx, err = np.asarray(dx, float), np.asarray(err, float)
-    ok = np.isfinite(err) & (err > 0)
-    if ok.sum() < 2:
-        return float("nan")
-    return float(np.polyfit(np.log(dx[ok]), np.log(err[ok]), 1)[0])
+def pct(x) -> str:
+    return fmt(None if x is None else 100 * x, ".2f") + (" %" if x is not None and np.isfinite(x) else "")
 
 
-def stage_tables(df):
-    """Table 4 (ms per step and stage by N) and Table 5 (percentages), ours beside the paper's."""
-    t4, t5 = _paper_tables()
-    timing = df[(df.status == "ok") & (df.model == "lagrangian") & df.strip_height.isna()]
-    rows4, rows5 = [], []
-    for (solver, precision, threads, n), g in timing.groupby(["solver", "precision", "threads", "n_particles"]):
-        r = g.iloc[-1]
-        steps = max(int(r.steps), 1)
-        ms = {s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")}
-        per = {s: 1e3 * r[f"t_{s}"] / steps for s in ("snp", "pi", "su")}
-        total = sum(per.values())
-        paper4 = t4["rows"].get(str(int(n)))
-        paper5 = t5["rows"].get(str(int(n)))
-        rows4.append([f"{solver} {precision}" + (f" x{threads}" if threads > 1 else ""), f"{int(n):,}",
-                      _fmt(ms["input"], ".2f"), _fmt(ms["init"], ".2f"), _fmt(per["snp"], ".3f"),
-                      _fmt(per["pi"], ".3f"), _fmt(per["su"], ".3f"), _fmt(ms["output"], ".2f"),
-                      " / ".join(f"{v:g}" for v in paper4) if paper4 else "-"])
-        rows5.append([f"{solver} {precision}" + (f" x{threads}" if threads > 1 else ""), f"{int(n):,}",
-                      _fmt(100 * per["snp"] / total, ".1f"), _fmt(100 * per["pi"] / total, ".1f"),
-                      _fmt(100 * per["su"] / total, ".1f"),
-                      " / ".join(f"{v:g}" for v in paper5) if paper5 else "-"])
-    return rows4, rows5
+def _machine(pid: str) -> str:
+    prof = hardware_profiles.stored().get(pid)
+    if not prof:
+        return "profile not stored"
+    cpu = prof.get("cpu") or {}
+    gpu = prof.get("gpu") or {}
+    text = f"CPU {cpu.get('model', '?')} ({cpu.get('cores_usable', cpu.get('logical_cores', '?'))} cores usable)"
+    if gpu:
+        text += f"; GPU {gpu.get('name')} ({fmt(gpu.get('memory_bytes', 0) / 2**30, '.0f')} GiB, " \
+                f"CC {gpu.get('compute_capability')})"
+    return text
 
 
-def error_table(df):
-    acc = df[(df.status == "ok") & df.strip_height.notna()]
-    rows, orders = [], []
-    for (model, precision, t_final), g in acc.groupby(["model", "precision", acc.t_final.round(6)]):
-        g = g.sort_values("dx")
-        for _, r in g.iterrows():
-            rows.append([model, precision, _fmt(t_final, "g"), _fmt(r.dx, "g"), f"{int(r.n_particles):,}",
-                         _fmt(r.mse, ".4g"), _fmt(r.me, ".3g")])
-        order = fit_order(g.dx, g.mse)
-        orders.append((model, precision, t_final, order, g))
-    return rows, orders
+def _sections_timing(df) -> list[str]:
+    lines = []
+    rows4 = T.table4(df)
+    if rows4:
+        lines += ["## Table 4: stage times (the paper's scene: lagrangian, full domain)", "",
+                  "input, init and output in ms per run; SNP, PI and SU in ms per step. The paper's column is its "
+                  "published Table 4 (Tesla K20c, GPU, one step, ms: input / init / SNP / PI / SU / output).", "",
+                  md_table(["config", "N", "input", "init", "SNP", "PI", "SU", "output", "paper (K20c)"],
+                           [[r["config"], f"{r['N']:,}", fmt(r["input"], ".2f"), fmt(r["init"], ".2f"),
+                             fmt(r["snp"], ".3f"), fmt(r["pi"], ".3f"), fmt(r["su"], ".3f"), fmt(r["output"], ".2f"),
+                             " / ".join(f"{v:g}" for v in r["paper"]) if r["paper"] else "-"] for r in rows4]), "",
+                  "## Table 5 and Fig. 11: share of a step", "",
+                  "The paper's Table 5 is its GPU code; its Fig. 11 (serial CPU) gives about 43 % SNP and "
+                  "53 % PI.", "",
+                  md_table(["config", "N", "SNP %", "PI %", "SU %", "paper K20c SNP / PI / SU %"],
+                           [[r["config"], f"{r['N']:,}", fmt(r["snp"], ".1f"), fmt(r["pi"], ".1f"),
+                             fmt(r["su"], ".1f"), " / ".join(f"{v:g}" for v in r["paper"]) if r["paper"] else "-"]
+                            for r in T.table5(df)]), ""]
+    return lines
 
 
-def figures(df, out: Path, pid: str) -> list[Path]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    paths = []
-    t4, _ = _paper_tables()
-    # Fig. 10: runtime of one step against N
-    fig, ax = plt.subplots(figsize=(6, 4.2))
-    timing = df[(df.status == "ok") & df.strip_height.isna()]
-    for (solver, precision, model, threads), g in timing.groupby(["solver", "precision", "model", "threads"]):
-        g = g.sort_values("n_particles")
-        ax.loglog(g.n_particles, 1e3 * g.t_step, "o-",
-                  label=f"{solver} {precision} {model}" + (f" x{threads}" if threads > 1 else ""))
-    n_p = np.array([int(k) for k in t4["rows"]])
-    step_p = np.array([sum(v[2:5]) for v in t4["rows"].values()])
-    ax.loglog(n_p, step_p, "k^--", label="paper, Tesla K20c (Table 4, published)")
-    ax.set_xlabel("particles N")
-    ax.set_ylabel("one step SNP+PI+SU (ms)")
-    ax.set_title(f"Runtime per step against N ({pid})", fontsize=9)
-    ax.legend(fontsize=6)
-    ax.grid(True, which="both", alpha=0.3)
-    p = out / "fig10_runtime_vs_N.png"
-    fig.tight_layout()
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
-    paths.append(p)
-    # Fig. 8: error against dx at fixed physical time, with fitted order
-    acc = df[(df.status == "ok") & df.strip_height.notna()]
-    if not acc.empty:
-        fig, ax = plt.subplots(figsize=(6, 4.2))
-        for (model, precision, t_final), g in acc.groupby(["model", "precision", acc.t_final.round(6)]):
-            g = g.sort_values("dx")
-            order = fit_order(g.dx, g.mse)
-            ax.loglog(g.dx, g.mse, "o-", label=f"{model} {precision}, t={t_final:g} s (order {order:.2f})")
-        ax.set_xlabel("dx (m)")
-        ax.set_ylabel("relative RMS error of u (paper's MSE)")
-        ax.set_title(f"Error against dx ({pid})", fontsize=9)
-        ax.legend(fontsize=6)
-        ax.grid(True, which="both", alpha=0.3)
-        p = out / "fig8_error_vs_dx.png"
-        fig.tight_layout()
-        fig.savefig(p, dpi=110)
-        plt.close(fig)
-        paths.append(p)
-        # speed against accuracy: error against time to solution
-        fig, ax = plt.subplots(figsize=(6, 4.2))
-        for (solver, model, precision), g in acc.groupby(["solver", "model", "precision"]):
-            wall = g.t_snp + g.t_pi + g.t_su + g.t_init
-            ax.loglog(wall, g.mse, "o", label=f"{solver} {model} {precision}")
-        ax.set_xlabel("time to solution (s, init + steps)")
-        ax.set_ylabel("relative RMS error of u")
-        ax.set_title(f"Speed against accuracy ({pid})", fontsize=9)
-        ax.legend(fontsize=6)
-        ax.grid(True, which="both", alpha=0.3)
-        p = out / "speed_vs_accuracy.png"
-        fig.tight_layout()
-        fig.savefig(p, dpi=110)
-        plt.close(fig)
-        paths.append(p)
-    return paths
+def _section_table6(df_all, pid) -> list[str]:
+    rows = [r for r in T.table6(df_all) if pid in (r["gpu_profile"],)]
+    if not rows:
+        return []
+    return ["## Table 6: CPU against GPU, one step", "",
+            "CPU: linkedlist-cpu float64, one thread (as the paper's), and all cores where measured. "
+            "A CPU measured on another machine is named; see [cards.md](../cards.md) for every system.", "",
+            md_table(["N", "GPU precision", "GPU ms", "CPU (profile)", "CPU ms", "speedup", "speedup vs all cores"],
+                     [[f"{r['N']:,}", r["precision"], fmt(r["gpu_ms"], ".3f"), r["cpu_profile"],
+                       fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
+                       "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f} "
+                                                                   f"(x{r['cpu_threads']})"] for r in rows]), ""]
 
 
-def report_for(df, pid: str, out: Path) -> Path:
+def _section_fig9(df) -> list[str]:
+    rows = T.fig9(df)
+    if not any(r["allpair_ms"] or r["allpair_status"] == "skipped" for r in rows):
+        return []
+    text = T.published()["text"]
+    return ["## Fig. 9: all-pair against linked list (serial, float64, paper's scene)", "",
+            md_table(["N", "all-pair ms/step", "linked list ms/step", "eta = t_AP / t_LL", "all-pair status"],
+                     [[f"{r['N']:,}", fmt(r["allpair_ms"], ".2f"), fmt(r["linkedlist_ms"], ".2f"),
+                       fmt(r["eta"], ".1f"), r["allpair_status"] + (f": {r['allpair_note']}" if r["allpair_note"]
+                                                                   else "")] for r in rows]), "",
+            "Paper (published, whole runs, s): all-pair " + ", ".join(
+                f"{v:g} s at {int(n):,}" for n, v in text["fig9_allpair_s"].items()) + "; linked list " + ", ".join(
+                f"{v:g} s at {int(n):,}" for n, v in text["fig9_linkedlist_s"].items()) + ".", ""]
+
+
+def _lagrangian_note(s) -> str:
+    t = s["t_final"][0] if len(set(np.round(s["t_final"], 6))) == 1 else None
+    ref = T.ISOTHERMAL_VS_LINEAR.get(round(t, 6)) if t else None
+    where = (f"It stops falling at dx = {s['stops_falling']:g}" if s["stops_falling"] else
+             "It has not yet stopped falling over these dx")
+    return (f"{where} ({', '.join(pct(e) for e in s['mse'])} for dx = {', '.join(f'{d:g}' for d in s['dx'])}). "
+            "The lagrangian model solves the isothermal (nonlinear) equations at Ma = 0.05, not the linear "
+            "ones, so against the linear pulse its error tends to the difference between the two solutions"
+            + (f", {pct(ref)} at t = {t:g} s," if ref else "") + " however small dx gets; coarse lattices score "
+            "lower only because their numerical smoothing hides the nonlinear steepening. No order is fitted.")
+
+
+def _section_fig8(df) -> list[str]:
+    series = T.error_series(df)
+    if not series:
+        return []
+    lines = ["## Fig. 8: error against dx", "",
+             "Relative RMS error of u against the analytic pulse (the paper's MSE) and max error ME (m/s). "
+             "`t = 10 s` is a fixed physical time, the honest protocol for convergence; `100 steps` is the paper's, "
+             "a different physical time (20 dx s) for each dx.", ""]
+    rows = []
+    for s in series:
+        for dx, n, mse, me, t in zip(s["dx"], s["N"], s["mse"], s["me"], s["t_final"]):
+            rows.append([s["model"], s["precision"], s["protocol"], s["domain"], f"{dx:g}", f"{n:,}", f"{t:g}",
+                         fmt(mse, ".4g"), fmt(me, ".3g")])
+    lines += [md_table(["model", "precision", "protocol", "domain", "dx", "N", "t (s)", "MSE", "ME"], rows), ""]
+    for s in series:
+        head = f"- {s['model']} {s['precision']}, {s['protocol']}, {s['domain']}: "
+        if s["model"] == "lagrangian" and s["protocol"].startswith("t ="):
+            lines.append(head + _lagrangian_note(s))
+        else:
+            lines.append(head + f"fitted order {s['order']:.2f}" + (
+                " (apparent: each dx ends at a different time)" if s["protocol"].endswith("steps") else "") + ".")
+    bars = [b for b in T.accuracy_bars(df) if b["verdict"] != "not measured" or b["bar"].startswith("relative")]
+    if bars:
+        lines += ["", "### Accuracy bars (linear, Verlet, cutoff 3h, strip, t = 10 s, float64)", "",
+                  md_table(["bar", "measured", "verdict"], [[b["bar"], b["measured"], b["verdict"]] for b in bars]),
+                  ""]
+    return lines
+
+
+def _section_front(df) -> list[str]:
+    points, front = T.speed_front(df)
+    if not points:
+        return []
+    rows = [[fmt(r["t_final"], "g"), pct(r["target"]), r["config"] or "none measured",
+             r.get("model", "-"), r.get("domain", "-"), fmt(r.get("dx"), "g"), fmt(r.get("seconds"), ".3g"),
+             pct(r.get("mse"))] for r in T.fastest_to(front)]
+    return ["## Speed against accuracy (what the paper lacks)", "",
+            "Every run at a fixed physical time, error against time to solution (init + steps, no JIT). "
+            "The front holds the runs no other run beats on both; the table names the fastest run "
+            "reaching each error.", "",
+            md_table(["t (s)", "error target", "fastest config", "model", "domain", "dx", "time (s)", "error"], rows),
+            ""]
+
+
+def _section_simplifications(df) -> list[str]:
+    rows = T.simplifications(df)
+    if not rows:
+        return []
+    return ["## The cost of each simplification", "",
+            "Each row changes one thing and keeps the rest: what the change buys in time to solution and "
+            "what it costs (or gains) in error against the linear analytic pulse.", "",
+            md_table(["simplification", "runs", "dx", "N", "time (s)", "speedup", "error"],
+                     [[r["simplification"], r["runs"], f"{r['dx']:g}", f"{r['N'][0]:,} -> {r['N'][1]:,}",
+                       f"{fmt(r['seconds'][0])} -> {fmt(r['seconds'][1])}", fmt(r["speedup"], ".2f"),
+                       f"{pct(r['mse'][0])} -> {pct(r['mse'][1])}"] for r in rows]), ""]
+
+
+def _section_stability(df) -> list[str]:
+    points, limits = T.stability(df, INACCURATE_ABOVE)
+    lines = []
+    if limits:
+        lines += ["## Stability: where methods fail", "",
+                  f"`pcabench study --stability`: the linear model on a strip, each run classed stable, "
+                  f"inaccurate (bounded, relative RMS above {100 * INACCURATE_ABOVE:g} %) or unstable (stopped "
+                  "at the step where max|u| left its bound or went non-finite).", "",
+                  md_table(["method", "dx", "CFLs run", "stable up to CFL", "first failure"],
+                           [[lim["config"], f"{lim['dx']:g}", ", ".join(f"{c:g}" for c in lim["cfls"]),
+                             fmt(lim["stable_up_to"], "g") if lim["stable_up_to"] else "none",
+                             "-" if not lim["first_failure"] else
+                             f"CFL {lim['first_failure'][0]:g}: {lim['first_failure'][1]}"
+                             + (f" at step {int(lim['first_failure'][2])}" if lim["first_failure"][2] else "")
+                             + (f" ({pct(lim['first_failure'][3])})" if lim["first_failure"][1] == "inaccurate"
+                                else "")] for lim in limits]), ""]
+    f32 = [r for r in T.float32_vs_float64(df) if any(d <= 0.05 for d, _, _ in r["pairs"])]
+    if f32:
+        lines += ["### float32 against float64", ""]
+        for r in f32:
+            pairs = "; ".join(f"dx {d:g}: {e64:.3g} / {e32:.3g}" for d, e64, e32 in r["pairs"])
+            verdict = (f"float32 departs from float64 by more than {100 * r['tolerance']:g} % at dx = {r['stops_at']:g}"
+                       if r["stops_at"] else
+                       f"float32 tracks float64 within {100 * r['tolerance']:g} % down to dx = {r['pairs'][-1][0]:g}, "
+                       "the smallest measured: it has not stopped converging")
+            lines.append(f"- {r['model']}, {r['protocol']}, {r['domain']} (MSE float64 / float32: {pairs}): "
+                         f"{verdict}.")
+        lines.append("")
+    return lines
+
+
+def _section_failed(df) -> list[str]:
+    bad = T.latest(df[df.status != "ok"])
+    if bad.empty:
+        return []
+    rows = [[r.solver, r.precision, r.model, r.integrator, f"{r.dx:g}", f"{int(r.n_particles):,}", r.protocol,
+             fmt(r.cfl, "g"), r.status, "-" if r.failed_step is None or not np.isfinite(r.failed_step)
+             else int(r.failed_step), str(r.message).splitlines()[0][:120] if r.message else ""]
+            for _, r in bad.sort_values(["status", "solver", "dx"]).iterrows()]
+    return ["## Runs that did not finish", "",
+            md_table(["solver", "precision", "model", "integrator", "dx", "N", "protocol", "CFL", "status", "step",
+                      "message"], rows), ""]
+
+
+def report_for(df, df_all, pid: str, out: Path) -> Path:
     out.mkdir(parents=True, exist_ok=True)
-    figs = figures(df, out, pid)
-    rows4, rows5 = stage_tables(df)
-    erows, orders = error_table(df)
+    figs = [f(df, out, pid) for f in (F.fig8, F.fig9, F.fig10, F.fig11, F.fig13, F.speed_vs_accuracy)]
+    figs.append(F.stability_map(df, out, pid, INACCURATE_ABOVE))
+    if T.table6(df_all) and any(r["gpu_profile"] == pid for r in T.table6(df_all)):
+        figs.append(F.fig14(df_all[df_all.profile_id.isin({pid} | {r["cpu_profile"] for r in T.table6(df_all)})],
+                            out, pid))
+    figs = [p for p in figs if p is not None]
+    counts = df.status.value_counts().to_dict()
     commits = sorted(set(df.commit.astype(str)))
-    lines = [f"# pcabench report: {pid}", "",
-             f"Runs: {len(df)} ({(df.status == 'ok').sum()} ok); commits: {', '.join(c[:12] for c in commits)}. "
-             "Regenerate with `pcabench report`.", "",
-             "## Table 4: stage times (paper's scene: lagrangian, full domain)", "",
-             "input, init and output in ms per run; SNP, PI and SU in ms per step. The paper's column is its "
-             "published Table 4 (Tesla K20c, one step, ms: input / init / SNP / PI / SU / output).", "",
-             _md_table(["solver", "N", "input", "init", "SNP", "PI", "SU", "output", "paper (K20c)"], rows4), "",
-             "## Table 5: share of a step", "",
-             _md_table(["solver", "N", "SNP %", "PI %", "SU %", "paper SNP / PI / SU %"], rows5), "",
-             "## Fig. 8: error against dx at a fixed physical time (y-periodic strip)", "",
-             _md_table(["model", "precision", "t (s)", "dx", "N", "MSE (rel. RMS)", "ME (m/s)"], erows), ""]
-    for model, precision, t_final, order, g in orders:
-        note = ""
-        if model == "lagrangian":
-            note = (" The lagrangian model solves the isothermal (nonlinear) equations at Ma = 0.05; against "
-                    "the linear pulse its error stops falling near the 5.1 % (t = 5 s) / 9.8 % (t = 10 s) "
-                    "difference between the two, so this slope is not a convergence order.")
-        lines.append(f"- {model} {precision}, t = {t_final:g} s: fitted order {order:.2f}.{note}")
-    lines.append("")
+    lines = [f"# pcabench report: {pid}", "", f"Machine: {_machine(pid)}.", "",
+             f"Runs: {len(df)} ({', '.join(f'{v} {k}' for k, v in sorted(counts.items()))}); commits: "
+             f"{', '.join(c[:12] for c in commits)}. Regenerate with `pcabench report`.", ""]
+    for section in (_sections_timing(df), _section_table6(df_all, pid), _section_fig9(df), _section_fig8(df),
+                    _section_front(df), _section_simplifications(df), _section_stability(df), _section_failed(df)):
+        lines += section
+    lines += ["## Figures", ""]
     for p in figs:
         lines += [f"![{p.stem}]({p.name})", ""]
     path = out / "report.md"
@@ -167,16 +235,48 @@ def report_for(df, pid: str, out: Path) -> Path:
     return path
 
 
+def cards_page(df_all, reports_dir: Path) -> list[Path]:
+    """Table 6 and Fig. 14 across every system, and the GPU cards side by side."""
+    ours, pub, cards = T.table6(df_all), T.table6_published(), T.cards(df_all)
+    lines = ["# Systems and GPU cards side by side", "",
+             "Regenerated by `pcabench report` from every results store and stored profile.", "",
+             "## Table 6: CPU against GPU per step", "", "Measured:", ""]
+    lines += [md_table(["GPU profile", "N", "precision", "GPU ms", "CPU profile", "CPU ms (1 thread)", "speedup"],
+                       [[r["gpu_profile"], f"{r['N']:,}", r["precision"], fmt(r["gpu_ms"], ".3f"), r["cpu_profile"],
+                         fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f")] for r in ours])
+              if ours else "No profile holds both GPU and serial CPU runs of the paper's scene at the same N yet."]
+    lines += ["", "Published (the paper's Table 6, 100 steps; its runtime unit is printed as min, but Table 4 "
+                  "makes seconds the consistent reading):", "",
+              md_table(["system", "card", "N", "CPU runtime", "GPU runtime", "speedup per step"],
+                       [[r["system"], r["card"], f"{r['N']:,}", f"{r['cpu']:g}", f"{r['gpu']:g}", f"{r['speedup']:g}"]
+                        for r in pub]), ""]
+    lines += ["## GPU cards: one lagrangian step (SNP + PI + SU)", ""]
+    if cards:
+        lines += [md_table(["card", "precision", "N", "step ms", "SNP ms", "PI ms", "SU ms", "ps per particle-step"],
+                           [[r["card"], r["precision"], f"{r['N']:,}", fmt(r["step_ms"], ".3f"),
+                             fmt(r["snp_ms"], ".3f"), fmt(r["pi_ms"], ".3f"), fmt(r["su_ms"], ".3f"),
+                             fmt(r["ps_per_particle_step"], ".0f")] for r in cards]), ""]
+    else:
+        lines += ["No GPU runs stored yet: run `pcabench gpu-check` on a GPU machine and merge its results.", ""]
+    figs = [F.fig14(df_all, reports_dir, "all systems"), F.cards_figure(df_all, reports_dir)]
+    lines += [f"![{p.stem}]({p.name})\n" for p in figs]
+    path = reports_dir / "cards.md"
+    path.write_text("\n".join(lines) + "\n")
+    return [path, *figs]
+
+
 def write_reports(results_dir: Path, reports_dir: Path) -> list[Path]:
-    df = store.load(results_dir)
-    if df.empty:
+    df_all = store.load(results_dir)
+    if df_all.empty:
         raise SystemExit(f"no results in {results_dir}: run `pcabench study --quick` first")
-    df["threads"] = df["threads"].fillna(1).astype(int)
-    paths = []
-    for pid, g in df.groupby("profile_id"):
-        paths.append(report_for(g, str(pid), Path(reports_dir) / str(pid)))
-    index = ["# Reports", "", "One folder per hardware profile, regenerated by `pcabench report`.", ""]
-    index += [f"- [{p.parent.name}]({p.parent.name}/report.md)" for p in paths]
+    reports_dir = Path(reports_dir)
+    reports_dir.mkdir(parents=True, exist_ok=True)
+    paths = [report_for(g, df_all, str(pid), reports_dir / str(pid)) for pid, g in df_all.groupby("profile_id")]
+    paths += cards_page(df_all, reports_dir)
+    index = ["# Reports", "", "Regenerated by `pcabench report` from `results/*.jsonl`.", "",
+             "- [cards.md](cards.md): Table 6, Fig. 14 and the GPU cards side by side, every system"]
+    index += [f"- [{p.parent.name}]({p.parent.name}/report.md): {_machine(p.parent.name)}"
+              for p in paths if p.name == "report.md"]
     index += ["", "GPU check tables and Nsight Compute profiles: [gpu/](gpu/); notes: [gpu/NOTES.md](gpu/NOTES.md)."]
-    (Path(reports_dir) / "README.md").write_text("\n".join(index) + "\n")
-    return paths + [Path(reports_dir) / "README.md"]
+    (reports_dir / "README.md").write_text("\n".join(index) + "\n")
+    return paths + [reports_dir / "README.md"]

@@ -1,0 +1,121 @@
+"""Study matrices: the presets and the matrix built from command-line options.
+
+A run spec is a dict ``{"solver", "threads", "scene": Scene kwargs}``. Each
+preset lists the runs its tables and figures need, smallest first, so that a
+sweep can predict the cost of a large run from the smaller ones before it.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+
+# Seconds per run before it is recorded as a timeout, by preset (--run-budget overrides).
+RUN_BUDGET = {"quick": 120.0, "paper": 900.0, "stability": 120.0, "matrix": 900.0}
+
+# The stability preset's scene: the design's dx = 0.25 on a strip, the linear model
+# (exactly the linear wave equation, so growth is the integrator's, not the physics').
+STABILITY_DX = 0.25
+STABILITY_CFL = (0.1, 0.2, 0.5, 1.0, 2.0, 2.5, 3.0, 4.0, 4.5, 5.0, 5.5, 6.0, 7.0)
+STABILITY_H = (1.0, 1.3)  # h/dx beside the default 2.13
+# Above this relative RMS error a run that stayed bounded is classed inaccurate.
+INACCURATE_ABOVE = 0.10
+
+
+def strip_height(dx: float, cutoff_factor: float = 3.0, h_factor: float = 2.13) -> float:
+    """The thinnest y-periodic strip the cell list accepts at ``dx`` (whole rows), m."""
+    return math.ceil(3 * cutoff_factor * h_factor * (1 + 1e-9)) * dx
+
+
+def _spec(solver="linkedlist-cpu", threads=1, strip=False, **scene) -> dict:
+    if strip:
+        scene["strip_height"] = strip_height(scene["dx"], scene.get("cutoff_factor", 3.0),
+                                             scene.get("h_factor", 2.13))
+    return {"solver": solver, "threads": threads, "scene": scene}
+
+
+def quick() -> list[dict]:
+    """A few minutes on a laptop CPU: every table and figure at small N."""
+    runs = []
+    # Table 4/5, Figs. 10, 11, 13: the paper's scene (lagrangian, full domain)
+    runs += [_spec(dx=dx, steps=20) for dx in (1.0, 0.5, 0.25)]
+    # Fig. 9: all-pair against linked list (0.125 is predicted past the budget and skipped)
+    runs += [_spec("allpair-cpu", dx=dx, steps=20) for dx in (1.0, 0.5, 0.25, 0.125)]
+    # Fig. 8 at a fixed physical time and at the paper's 100 steps, on the strip
+    for model in ("linear", "lagrangian"):
+        for dx in (0.4, 0.2, 0.1) + ((0.05,) if model == "linear" else ()):
+            runs.append(_spec(dx=dx, t_end=10.0, model=model, strip=True))
+        for dx in (0.4, 0.2, 0.1):
+            runs.append(_spec(dx=dx, steps=100, model=model, strip=True))
+    # The cost of each simplification: fixed particles, float32, and the full domain
+    for dx in (0.2, 0.1):
+        runs.append(_spec(dx=dx, t_end=10.0, model="fixed", strip=True))
+        runs.append(_spec(dx=dx, t_end=10.0, model="linear", precision="float32", strip=True))
+    runs.append(_spec(dx=0.2, t_end=10.0, model="linear"))
+    runs.append(_spec(dx=0.2, t_end=10.0, model="lagrangian"))
+    return runs
+
+
+def paper() -> list[dict]:
+    """The paper's CPU matrix (Tables 4-6, Figs. 8-14), as far as the budgets allow."""
+    runs = []
+    for dx in (1.0, 0.5, 0.25, 0.2, 0.1, 0.05, 0.025):  # 1K .. 1.6M; Table 6 at 25K/100K/400K
+        runs.append(_spec(dx=dx, steps=100))
+        runs.append(_spec(dx=dx, steps=100, threads=0))  # 0: every core this machine has
+    # Fig. 9 (the paper's 10th step, 1K .. 256K)
+    for dx in (1.0, 0.5, 0.25, 0.125, 0.0625):
+        runs.append(_spec(dx=dx, steps=10))
+        runs.append(_spec("allpair-cpu", dx=dx, steps=10))
+    for model in ("linear", "fixed", "lagrangian"):
+        for precision in ("float64", "float32"):
+            for dx in (0.4, 0.2, 0.1, 0.05, 0.025):
+                runs.append(_spec(threads=0, dx=dx, t_end=10.0, model=model, precision=precision, strip=True))
+            for dx in (0.1, 0.05, 0.01, 0.004):
+                runs.append(_spec(threads=0, dx=dx, steps=100, model=model, precision=precision, strip=True))
+        for dx in (0.2, 0.1):
+            runs.append(_spec(threads=0, dx=dx, t_end=10.0, model=model))
+    return runs
+
+
+def stability() -> list[dict]:
+    """Where methods fail: CFL x integrator, CFL x h/dx, run length, float32 at small dx."""
+    runs = []
+    base = dict(dx=STABILITY_DX, model="linear", strip=True)
+    for integrator in ("verlet", "rk2", "kdk1", "euler"):
+        for cfl in STABILITY_CFL:
+            runs.append(_spec(t_end=10.0, integrator=integrator, cfl=cfl, **base))
+    for h_factor in STABILITY_H:
+        for cfl in STABILITY_CFL:
+            runs.append(_spec(t_end=10.0, cfl=cfl, h_factor=h_factor, **base))
+    for cfl in (0.2, 1.0, 4.0):
+        runs.append(_spec(t_end=10.0, cfl=cfl, precision="float32", **base))
+    # run length: to t = 30 s (the pulse is then 10 m short of the free right edge)
+    for integrator in ("verlet", "rk2", "kdk1", "euler"):
+        runs.append(_spec(t_end=30.0, integrator=integrator, cfl=0.2, **base))
+    runs.append(_spec(t_end=30.0, cfl=4.0, **base))
+    # float32 against float64 at the paper's protocol down to its smallest dx
+    for dx in (0.04, 0.01, 0.004):
+        for precision in ("float64", "float32"):
+            runs.append(_spec(threads=0, dx=dx, steps=100, model="lagrangian", precision=precision, strip=True))
+    return runs
+
+
+PRESETS = {"quick": quick, "paper": paper, "stability": stability}
+
+
+def preset(name: str) -> list[dict]:
+    """The run matrix of preset ``name``, each spec tagged with the preset's name."""
+    if name not in PRESETS:
+        raise ValueError(f"preset must be one of {', '.join(PRESETS)} (got {name!r})")
+    return [dict(spec, preset=name) for spec in PRESETS[name]()]
+
+
+def matrix(solvers, dxs, precisions=("float64",), models=("lagrangian",), integrators=("verlet",),
+           cfls=(0.2,), h_factors=(2.13,), steps=None, t_end=None, strip=False, threads=1) -> list[dict]:
+    """The product of the options, smallest N first, as run specs tagged ``matrix``."""
+    runs = []
+    for solver, dx, precision, model, integrator, cfl, h in itertools.product(
+            solvers, sorted(dxs, reverse=True), precisions, models, integrators, cfls, h_factors):
+        scene = dict(dx=dx, precision=precision, model=model, integrator=integrator, cfl=cfl, h_factor=h)
+        scene.update({"steps": steps} if steps else {"t_end": t_end} if t_end else {"steps": 100})
+        runs.append(dict(_spec(solver, threads=threads, strip=strip, **scene), preset="matrix"))
+    return runs

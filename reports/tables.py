@@ -1,0 +1,354 @@
+"""The numbers behind every table and figure, computed from the store's DataFrame.
+
+Pure functions: a DataFrame from ``store.load`` in, lists of dicts out (one
+per table row), so the values can be tested without drawing anything. Times
+are s in the store and ms per step in the tables; errors are the paper's
+relative RMS ("MSE") of u.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from pcabench import hardware_profiles
+
+STAGES = ("input", "init", "snp", "pi", "su", "output")
+STEP_STAGES = ("snp", "pi", "su")
+PAPER_SYSTEMS = ("paper-system-1", "paper-system-2", "paper-system-3")
+# The scene's numerics unless a study varies them (Verlet, dt = 0.2 dx, h = 2.13 dx, cutoff 3h).
+DEFAULT_NUMERICS = {"integrator": "verlet", "cfl": 0.2, "h_factor": 2.13, "cutoff_factor": 3.0}
+# The exact isothermal solution at Ma = 0.05 against the linear pulse (design 1b; solvers/isothermal1d.py).
+ISOTHERMAL_VS_LINEAR = {5.0: 0.051, 10.0: 0.098}
+
+
+def published(system: str = "paper-system-1") -> dict:
+    """The paper's published numbers for ``system`` (hardware_profiles/paper-system-*.json)."""
+    return hardware_profiles.load(system)["published"]
+
+
+def label(r) -> str:
+    """``solver precision`` plus ``xN`` for a multi-threaded run."""
+    return f"{r['solver']} {r['precision']}" + (f" x{int(r['threads'])}" if int(r["threads"]) > 1 else "")
+
+
+def latest(df: pd.DataFrame) -> pd.DataFrame:
+    """One row per configuration and machine, the newest: reruns and overlapping presets count once."""
+    if df.empty:
+        return df
+    return df.sort_values("timestamp").drop_duplicates(["profile_id", "solver", "threads", "scene_key"],
+                                                       keep="last")
+
+
+def default_numerics(df: pd.DataFrame) -> pd.DataFrame:
+    mask = np.ones(len(df), bool)
+    for key, value in DEFAULT_NUMERICS.items():
+        col = df[key]
+        mask &= (col == value) if isinstance(value, str) else np.isclose(col.astype(float), value)
+    return df[mask]
+
+
+def paper_scene(df: pd.DataFrame) -> pd.DataFrame:
+    """Finished runs of the paper's timing scene: lagrangian, full domain, default numerics."""
+    d = default_numerics(df[(df.status == "ok") & (df.model == "lagrangian") & (df.domain == "full")])
+    return latest(d)
+
+
+def per_step_ms(r) -> dict:
+    steps = max(int(r["steps"]), 1)
+    return {s: 1e3 * r[f"t_{s}"] / steps for s in STEP_STAGES}
+
+
+def _newest_per(df, keys):
+    return df.sort_values("timestamp").drop_duplicates(keys, keep="last")
+
+
+# ---------------------------------------------------------------- Tables 4, 5 and Figs. 11, 13
+def table4(df) -> list[dict]:
+    """Stage times by N: input, init, output in ms per run; SNP, PI, SU in ms per step."""
+    t4 = published()["table4"]["rows"]
+    rows = []
+    for _, r in _newest_per(paper_scene(df), ["solver", "precision", "threads", "n_particles"]) \
+            .sort_values(["solver", "precision", "threads", "n_particles"]).iterrows():
+        row = {"config": label(r), "N": int(r.n_particles)}
+        row.update({s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")})
+        row.update(per_step_ms(r))
+        row["paper"] = t4.get(str(int(r.n_particles)))
+        rows.append(row)
+    return rows
+
+
+def table5(df) -> list[dict]:
+    """Each step stage's share of a step, %, with the paper's (GPU, Table 5) beside it."""
+    t5 = published()["table5"]["rows"]
+    rows = []
+    for row in table4(df):
+        total = sum(row[s] for s in STEP_STAGES)
+        rows.append({"config": row["config"], "N": row["N"],
+                     **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": t5.get(str(row["N"]))})
+    return rows
+
+
+def one_step_shares(df) -> list[dict]:
+    """Fig. 13: each of the six stages' share of a one-step run, %: input + init + one step + output."""
+    rows = []
+    for row in table4(df):
+        total = sum(row[s] for s in STAGES)
+        rows.append({"config": row["config"], "N": row["N"], **{s: 100 * row[s] / total for s in STAGES}})
+    return rows
+
+
+# ---------------------------------------------------------------- Table 6 and Fig. 14
+def table6(df_all) -> list[dict]:
+    """CPU (serial linked list, float64) against GPU per step at the same N, for each GPU profile.
+
+    The CPU is taken from the same machine where it was measured there, else
+    from another measured machine, and the row says which.
+    """
+    runs = paper_scene(df_all)
+    gpu = runs[runs.solver == "linkedlist-gpu"]
+    cpu = runs[(runs.solver == "linkedlist-cpu") & (runs.precision == "float64")]
+    rows = []
+    for _, g in _newest_per(gpu, ["profile_id", "precision", "n_particles"]) \
+            .sort_values(["profile_id", "n_particles", "precision"]).iterrows():
+        same_n = cpu[cpu.n_particles == g.n_particles]
+        serial = same_n[same_n.threads == 1]
+        if serial.empty:
+            continue
+        here = serial[serial.profile_id == g.profile_id]
+        c = (here if not here.empty else serial).sort_values("timestamp").iloc[-1]
+        multi = same_n[(same_n.threads > 1) & (same_n.profile_id == c.profile_id)]
+        m = multi.sort_values("threads").iloc[-1] if not multi.empty else None
+        rows.append({"gpu_profile": g.profile_id, "cpu_profile": c.profile_id, "N": int(g.n_particles),
+                     "precision": g.precision, "cpu_ms": 1e3 * c.t_step, "gpu_ms": 1e3 * g.t_step,
+                     "speedup": c.t_step / g.t_step,
+                     "cpu_threads": None if m is None else int(m.threads),
+                     "speedup_all_cores": None if m is None else m.t_step / g.t_step})
+    return rows
+
+
+def table6_published() -> list[dict]:
+    rows = []
+    for system in PAPER_SYSTEMS:
+        prof = hardware_profiles.load(system)
+        for n, (cpu, gpu, speedup) in prof["published"]["table6"]["rows"].items():
+            rows.append({"system": system, "card": prof["gpu"]["name"], "N": int(n), "cpu": cpu, "gpu": gpu,
+                         "speedup": speedup})
+    return sorted(rows, key=lambda r: (r["system"], r["N"]))
+
+
+# ---------------------------------------------------------------- Fig. 9
+def fig9(df) -> list[dict]:
+    """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL."""
+    runs = paper_scene(df)
+    ll = _newest_per(runs[(runs.solver == "linkedlist-cpu") & (runs.threads == 1) & (runs.precision == "float64")],
+                     ["n_particles"]).set_index("n_particles")
+    ap_all = latest(default_numerics(df[(df.solver == "allpair-cpu") & (df.model == "lagrangian")
+                                        & (df.domain == "full")]))
+    rows = []
+    for n, g in ap_all.groupby("n_particles"):
+        ok = g[g.status == "ok"]
+        r = (ok if not ok.empty else g).sort_values("timestamp").iloc[-1]
+        row = {"N": int(n), "allpair_ms": 1e3 * r.t_step if r.status == "ok" else None,
+               "allpair_status": r.status, "allpair_note": "" if r.status == "ok" else str(r.message)[:160],
+               "linkedlist_ms": 1e3 * ll.loc[n, "t_step"] if n in ll.index else None}
+        row["eta"] = (row["allpair_ms"] / row["linkedlist_ms"]
+                      if row["allpair_ms"] and row["linkedlist_ms"] else None)
+        rows.append(row)
+    for n in ll.index:
+        if n not in {r["N"] for r in rows}:
+            rows.append({"N": int(n), "allpair_ms": None, "allpair_status": "not run", "allpair_note": "",
+                         "linkedlist_ms": 1e3 * ll.loc[n, "t_step"], "eta": None})
+    return sorted(rows, key=lambda r: r["N"])
+
+
+# ---------------------------------------------------------------- Fig. 8 and the accuracy bars
+def fit_order(dx, err) -> float:
+    """Least-squares slope of log(err) against log(dx): the observed convergence order."""
+    dx, err = np.asarray(dx, float), np.asarray(err, float)
+    ok = np.isfinite(err) & (err > 0)
+    if ok.sum() < 2:
+        return float("nan")
+    return float(np.polyfit(np.log(dx[ok]), np.log(err[ok]), 1)[0])
+
+
+def error_series(df) -> list[dict]:
+    """Fig. 8: error against dx for each (model, precision, protocol, domain), with the fitted order.
+
+    Solvers agree to round-off, so one error per dx is kept (the newest).
+    """
+    acc = default_numerics(latest(df[df.status == "ok"]))
+    out = []
+    for (model, precision, protocol, domain), g in acc.groupby(["model", "precision", "protocol", "domain"]):
+        g = _newest_per(g, ["dx"]).sort_values("dx", ascending=False)
+        if len(g) < 2:
+            continue
+        series = {"model": model, "precision": precision, "protocol": protocol, "domain": domain,
+                  "dx": g.dx.tolist(), "N": g.n_particles.astype(int).tolist(), "mse": g.mse.tolist(),
+                  "me": g.me.tolist(), "t_final": g.t_final.tolist(), "order": fit_order(g.dx, g.mse)}
+        series["stops_falling"] = stops_falling(series["dx"], series["mse"])
+        out.append(series)
+    return sorted(out, key=lambda s: (s["protocol"], s["domain"], s["model"], s["precision"]))
+
+
+def stops_falling(dx, err, gain=0.75):
+    """The dx below which refining no longer cuts the error by 25 % per halving, or None."""
+    for i in range(len(dx) - 1):
+        ratio = np.log(dx[i] / dx[i + 1]) / np.log(2)  # halvings between the two
+        if err[i + 1] > err[i] * gain ** ratio:
+            return dx[i]
+    return None
+
+
+def accuracy_bars(df) -> list[dict]:
+    """The issue's bars: linear, Verlet, cutoff 3h, strip, t = 10 s: order >= 1 and < 2 % at dx = 0.05."""
+    series = [s for s in error_series(df) if s["model"] == "linear" and s["protocol"] == "t = 10 s"
+              and s["domain"] == "strip" and s["precision"] == "float64"]
+    if not series:
+        return [{"bar": "linear, t = 10 s, strip: order >= 1 and error < 2 % at dx = 0.05",
+                 "measured": "not measured", "verdict": "not measured"}]
+    s = series[0]
+    at = dict(zip(np.round(s["dx"], 9), s["mse"]))
+    e05 = at.get(0.05)
+    return [
+        {"bar": f"fitted order >= 1 (dx = {', '.join(f'{d:g}' for d in s['dx'])})",
+         "measured": f"{s['order']:.2f}", "verdict": "met" if s["order"] >= 1 else "missed"},
+        {"bar": "relative RMS < 2 % at dx = 0.05", "measured": "not measured" if e05 is None else f"{100 * e05:.2f} %",
+         "verdict": "not measured" if e05 is None else "met" if e05 < 0.02 else "missed"},
+    ]
+
+
+# ---------------------------------------------------------------- speed against accuracy
+def speed_front(df) -> tuple[list[dict], list[dict]]:
+    """Error against time to solution at a fixed physical time: every point, and the Pareto front.
+
+    Time to solution is init + SNP + PI + SU (s), without JIT, input and output.
+    """
+    pts = default_numerics(latest(df[(df.status == "ok") & df.protocol.str.startswith("t =")]))
+    points = [{"config": label(r), "model": r.model, "domain": r.domain, "dx": r.dx, "N": int(r.n_particles),
+               "t_final": r.t_final, "seconds": r.t_solution, "mse": r.mse} for _, r in pts.iterrows()]
+    front = []
+    for t_final in sorted({p["t_final"] for p in points}):
+        best = np.inf
+        for p in sorted((p for p in points if p["t_final"] == t_final), key=lambda p: (p["seconds"], p["mse"])):
+            if p["mse"] < best:
+                best = p["mse"]
+                front.append(p)
+    return points, front
+
+
+def fastest_to(front, targets=(0.10, 0.05, 0.02, 0.01, 0.005)) -> list[dict]:
+    """For each error target, the fastest configuration on the front that reaches it."""
+    rows = []
+    for t_final in sorted({p["t_final"] for p in front}):
+        pts = sorted((p for p in front if p["t_final"] == t_final), key=lambda p: p["seconds"])
+        for target in targets:
+            hit = next((p for p in pts if p["mse"] <= target), None)
+            rows.append({"t_final": t_final, "target": target, **(hit or {"config": None})})
+    return rows
+
+
+# ---------------------------------------------------------------- cost of each simplification
+SIMPLIFICATIONS = (
+    # (what changes, column, baseline value, simplified value)
+    ("y-periodic strip instead of the 20 m domain", "domain", "full", "strip"),
+    ("fixed particles (one search) instead of lagrangian", "model", "lagrangian", "fixed"),
+    ("linear (frozen coefficients) instead of lagrangian", "model", "lagrangian", "linear"),
+    ("float32 instead of float64", "precision", "float64", "float32"),
+)
+
+
+def simplifications(df) -> list[dict]:
+    """What each simplification buys (time to solution) and costs (error), same runs otherwise."""
+    runs = default_numerics(latest(df[df.status == "ok"]))
+    rows = []
+    shared = ["solver", "threads", "model", "precision", "domain", "protocol", "dx"]
+    for what, col, base, simple in SIMPLIFICATIONS:
+        keys = [k for k in shared if k != col]
+        for key, g in runs.groupby(keys):
+            a, b = g[g[col] == base], g[g[col] == simple]
+            if a.empty or b.empty:
+                continue
+            a, b = a.sort_values("timestamp").iloc[-1], b.sort_values("timestamp").iloc[-1]
+            ctx = dict(zip(keys, key))
+            rows.append({"simplification": what,
+                         "runs": " ".join(str(ctx[k]) for k in ("solver", "model", "precision", "domain", "protocol")
+                                          if k in ctx) + (f" x{ctx['threads']}" if ctx.get("threads", 1) > 1 else ""),
+                         "dx": ctx["dx"], "N": (int(a.n_particles), int(b.n_particles)),
+                         "seconds": (a.t_solution, b.t_solution), "speedup": a.t_solution / b.t_solution,
+                         "mse": (a.mse, b.mse)})
+    return rows
+
+
+# ---------------------------------------------------------------- stability
+def classify(r, inaccurate_above: float) -> str:
+    """stable / inaccurate (bounded, error above the bar) / unstable, or the failed run's status."""
+    if r["status"] == "ok":
+        return "stable" if r["mse"] <= inaccurate_above else "inaccurate"
+    return r["status"]
+
+
+def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
+    """The stability map's points and, per configuration, the largest CFL up to which every run is stable."""
+    runs = latest(df[df.preset == "stability"])
+    runs = runs[runs.protocol.str.startswith("t =")]
+    points, limits = [], []
+    for (integ, h, precision, protocol, dx), g in runs.groupby(["integrator", "h_factor", "precision", "protocol",
+                                                               "dx"]):
+        g = g.sort_values("cfl")
+        name = f"{integ}, h = {h:g} dx, {precision}, {protocol}"
+        limit, first_bad = None, None
+        for _, r in g.iterrows():
+            cls = classify(r, inaccurate_above)
+            points.append({"config": name, "cfl": r.cfl, "class": cls, "mse": r.mse,
+                           "failed_step": r.failed_step, "steps": r.steps_requested})
+            if first_bad is None:
+                if cls == "stable":
+                    limit = r.cfl
+                else:
+                    first_bad = (r.cfl, cls, r.failed_step, r.mse)
+        limits.append({"config": name, "dx": dx, "cfls": g.cfl.tolist(), "stable_up_to": limit,
+                       "first_failure": first_bad})
+    return points, limits
+
+
+def float32_vs_float64(df, tolerance: float = 0.10) -> list[dict]:
+    """float32 against float64 for the same runs: the ratio of errors, and where float32 stops converging."""
+    runs = default_numerics(latest(df[df.status == "ok"]))
+    out = []
+    for (model, protocol, domain), g in runs.groupby(["model", "protocol", "domain"]):
+        a = _newest_per(g[g.precision == "float64"], ["dx"]).set_index("dx")
+        b = _newest_per(g[g.precision == "float32"], ["dx"]).set_index("dx")
+        both = sorted(set(a.index) & set(b.index), reverse=True)
+        if not both:
+            continue
+        pairs = [(d, a.loc[d, "mse"], b.loc[d, "mse"]) for d in both]
+        bad = next((d for d, e64, e32 in pairs if abs(e32 / e64 - 1) > tolerance), None)
+        out.append({"model": model, "protocol": protocol, "domain": domain, "pairs": pairs,
+                    "stops_at": bad, "tolerance": tolerance})
+    return out
+
+
+# ---------------------------------------------------------------- cards side by side
+def cards(df_all) -> list[dict]:
+    """GPU step time by N for each measured card and precision (paper scene), ms."""
+    runs = paper_scene(df_all)
+    gpu = _newest_per(runs[runs.solver == "linkedlist-gpu"], ["profile_id", "precision", "n_particles"])
+    rows = []
+    for _, r in gpu.sort_values(["n_particles", "profile_id", "precision"]).iterrows():
+        card = (hardware_profiles.stored().get(r.profile_id, {}).get("gpu") or {}).get("name", r.profile_id)
+        rows.append({"profile": r.profile_id, "card": card, "precision": r.precision, "N": int(r.n_particles),
+                     "step_ms": 1e3 * r.t_step, **{f"{s}_ms": v for s, v in per_step_ms(r).items()},
+                     "ps_per_particle_step": 1e12 * r.t_step / r.n_particles})
+    return rows
+
+
+def cards_published() -> list[dict]:
+    """The paper's cards: K20c one step from Table 4 (ms), all three from Table 6 / 100 steps (read as s)."""
+    rows = []
+    for n, v in published()["table4"]["rows"].items():
+        rows.append({"system": "paper-system-1", "card": "Tesla K20c", "N": int(n), "step_ms": sum(v[2:5]),
+                     "source": "Table 4"})
+    for r in table6_published():
+        rows.append({"system": r["system"], "card": r["card"], "N": r["N"], "step_ms": 1e3 * r["gpu"] / 100,
+                     "source": "Table 6 / 100 steps, read as s"})
+    return rows
