@@ -122,6 +122,11 @@ def cmd_profile(args) -> int:
     from pcabench import hardware_profiles
 
     profile = hardware_profiles.capture(with_gpu=not args.no_gpu)
+    if args.asv:
+        from pcabench.hardware_profiles import asv_machine
+
+        print(asv_machine.write(profile))
+        return 0
     if args.save:
         path = hardware_profiles.save(profile, args.out)
         print(f"wrote {path}", file=sys.stderr)
@@ -152,6 +157,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--save", action="store_true", help="store it under hardware_profiles/")
     p.add_argument("--out", help="folder to store it in (default: the package's hardware_profiles/)")
     p.add_argument("--no-gpu", action="store_true")
+    p.add_argument("--asv", action="store_true",
+                   help="write this machine's entry into ~/.asv-machine.json and print its name (for --machine)")
     p.set_defaults(func=cmd_profile)
 
     from pcabench.study import add_study_commands

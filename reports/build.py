@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 
 from pcabench import hardware_profiles, store
+from pcabench.presets import INACCURATE_ABOVE
 
 from . import figures as F
 from . import tables as T
 
-INACCURATE_ABOVE = 0.10  # relative RMS above which a bounded run is classed inaccurate (stability map)
 
 
 def md_table(header, rows) -> str:
@@ -180,7 +180,7 @@ def _section_stability(df) -> list[str]:
                              fmt(lim["stable_up_to"], "g") if lim["stable_up_to"] else "none",
                              "-" if not lim["first_failure"] else
                              f"CFL {lim['first_failure'][0]:g}: {lim['first_failure'][1]}"
-                             + (f" at step {int(lim['first_failure'][2])}" if lim["first_failure"][2] else "")
+                             + (f" at step {lim['first_failure'][2]}" if lim["first_failure"][2] else "")
                              + (f" ({pct(lim['first_failure'][3])})" if lim["first_failure"][1] == "inaccurate"
                                 else "")] for lim in limits]), ""]
     f32 = [r for r in T.float32_vs_float64(df) if any(d <= 0.05 for d, _, _ in r["pairs"])]

@@ -21,21 +21,22 @@ STAGE_COLOURS = {"input": "tab:gray", "init": "tab:brown", "snp": "tab:blue", "p
 
 
 @contextmanager
-def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, logx=False, logy=False):
+def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, logx=False, logy=False, size=None):
     """A figure with ``ncols`` axes, labelled, gridded, saved to ``path`` on exit."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, ncols, figsize=(6 * ncols, 4.2), squeeze=False)
+    fig, axes = plt.subplots(1, ncols, figsize=size or (6 * ncols, 4.2), squeeze=False)
     axes = list(axes[0])
+    for ax in axes:
+        ax.set_xscale("log") if logx else None
+        ax.set_yscale("log") if logy else None
     yield axes
     for ax in axes:
         ax.set_xlabel(xlabel) if not ax.get_xlabel() else None
         ax.set_ylabel(ylabel) if not ax.get_ylabel() else None
-        ax.set_xscale("log") if logx else None
-        ax.set_yscale("log") if logy else None
         ax.grid(True, which="both", alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=6)
@@ -206,8 +207,9 @@ def stability_map(df, out: Path, pid: str, inaccurate_above: float):
         return None
     configs = [lim["config"] for lim in limits]
     path = out / "stability_map.png"
-    with figure(path, f"Stability map: dt c0 / dx against method ({pid}); inaccurate = bounded but "
-                f"relative RMS > {100 * inaccurate_above:g} %", "CFL = dt c0 / dx", "", logx=True) as (ax,):
+    with figure(path, f"Stability map ({pid}): inaccurate = bounded but relative RMS > "
+                f"{100 * inaccurate_above:g} %; numbers: the step where an unstable run stopped",
+                "CFL = dt c0 / dx", "", logx=True, size=(9, 1.6 + 0.32 * len(configs))) as (ax,):
         for cls, (colour, marker) in CLASS_STYLE.items():
             pts = [p for p in points if p["class"] == cls]
             if pts:
@@ -217,8 +219,15 @@ def stability_map(df, out: Path, pid: str, inaccurate_above: float):
             if p["class"] == "unstable" and p["failed_step"]:
                 ax.annotate(f"{int(p['failed_step'])}", (p["cfl"], configs.index(p["config"])), fontsize=5,
                             xytext=(3, 3), textcoords="offset points")
+        from matplotlib.ticker import NullFormatter
+
+        cfls = sorted({p["cfl"] for p in points})
+        ax.set_xticks(cfls)
+        ax.set_xticklabels([f"{c:g}" for c in cfls], fontsize=7)
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_yticks(range(len(configs)))
-        ax.set_yticklabels(configs, fontsize=6)
+        ax.set_yticklabels(configs, fontsize=7)
+        ax.set_ylim(-0.6, len(configs) - 0.4)
     return path
 
 

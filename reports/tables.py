@@ -280,6 +280,10 @@ def simplifications(df) -> list[dict]:
 
 
 # ---------------------------------------------------------------- stability
+def _step_or_none(x):
+    return None if x is None or not np.isfinite(x) else int(x)
+
+
 def classify(r, inaccurate_above: float) -> str:
     """stable / inaccurate (bounded, error above the bar) / unstable, or the failed run's status."""
     if r["status"] == "ok":
@@ -299,13 +303,14 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
         limit, first_bad = None, None
         for _, r in g.iterrows():
             cls = classify(r, inaccurate_above)
+            step = _step_or_none(r.failed_step)
             points.append({"config": name, "cfl": r.cfl, "class": cls, "mse": r.mse,
-                           "failed_step": r.failed_step, "steps": r.steps_requested})
+                           "failed_step": step, "steps": r.steps_requested})
             if first_bad is None:
                 if cls == "stable":
                     limit = r.cfl
                 else:
-                    first_bad = (r.cfl, cls, r.failed_step, r.mse)
+                    first_bad = (r.cfl, cls, step, r.mse)
         limits.append({"config": name, "dx": dx, "cfls": g.cfl.tolist(), "stable_up_to": limit,
                        "first_failure": first_bad})
     return points, limits

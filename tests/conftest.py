@@ -4,13 +4,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.common import gpu_available
+from pcabench.presets import strip_height
 from pcabench.run import run
 from pcabench.solvers import Scene
 
 
 def strip_for(dx: float, cutoff_factor: float = 3.0, h_factor: float = 2.13) -> float:
     """The thinnest y-periodic strip the cell list accepts at ``dx``, m (whole rows)."""
-    return float(np.ceil(3 * cutoff_factor * h_factor * (1 + 1e-9)) * dx)
+    return strip_height(dx, cutoff_factor, h_factor)
 
 
 def run_fields(scene: Scene, solver: str, tmp_path, threads=None):
@@ -18,15 +20,6 @@ def run_fields(scene: Scene, solver: str, tmp_path, threads=None):
     record = run(scene, solver, threads=threads, fields_path=path)
     fields = dict(np.load(path)) if path.exists() else None
     return record, fields
-
-
-def gpu_available() -> bool:
-    try:
-        from pcabench.solvers.linkedlist_gpu import device_backend, simulated
-
-        return not simulated() and device_backend()[1] is not None
-    except Exception:  # noqa: BLE001 - no CuPy, no driver, no device
-        return False
 
 
 @pytest.fixture

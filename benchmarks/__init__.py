@@ -1,0 +1,1 @@
+"""The asv suite: speed and accuracy of the pcabench solvers across commits (see asv.conf.json)."""

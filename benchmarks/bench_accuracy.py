@@ -1,0 +1,62 @@
+"""Track accuracy and where the time goes: errors against the analytic pulse, stage shares of a step.
+
+asv counts a rise as a regression, which is the right direction for an error
+and for the share of a stage that should stay small.
+"""
+import time
+
+import numpy as np
+
+from .common import Prepared, large
+from pcabench.run import run
+from pcabench.solvers import Scene
+
+
+class TrackError:
+    """Relative RMS error of u at t = 10 s on a strip (Fig. 8's fixed-time protocol), Verlet, float64."""
+
+    params = [["linear", "lagrangian"], [0.4, 0.2] + ([0.1] if large() else [])]
+    param_names = ["model", "dx"]
+    unit = "relative RMS"
+    timeout = 300
+
+    def track_error_t10(self, model, dx):
+        # 20 rows: the thinnest strip the cell list accepts at h = 2.13 dx and a 3h cutoff
+        scene = Scene(dx=dx, t_end=10.0, model=model, strip_height=20 * dx)
+        record = run(scene, "linkedlist-cpu")
+        if record.status != "ok":
+            raise RuntimeError(f"{record.status}: {record.message}")
+        return record.mse
+
+
+class TrackErrorPaperProtocol:
+    """The paper's protocol: relative RMS after 100 steps, full domain, lagrangian."""
+
+    params = [["float64", "float32"], [1.0, 0.5]]
+    param_names = ["precision", "dx"]
+    unit = "relative RMS"
+
+    def track_error_100_steps(self, precision, dx):
+        return run(Scene(dx=dx, precision=precision, steps=100), "linkedlist-cpu").mse
+
+
+class TrackStageShare:
+    """Each stage's share of a linked-list step at 16K particles (Table 5 / Fig. 11), %."""
+
+    params = [["float64", "float32"], ["snp", "pi", "su"]]
+    param_names = ["precision", "stage"]
+    unit = "%"
+    repeats = 7
+
+    def setup(self, precision, stage):
+        self.p = Prepared("linkedlist-cpu", precision, 0.25)
+
+    def track_share(self, precision, stage):
+        seconds = {s: [] for s in ("snp", "pi", "su")}
+        for _ in range(self.repeats):
+            for s in seconds:
+                t0 = time.perf_counter()
+                self.p.stage(s)
+                seconds[s].append(time.perf_counter() - t0)
+        median = {s: float(np.median(v)) for s, v in seconds.items()}
+        return 100 * median[stage] / sum(median.values())

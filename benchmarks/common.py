@@ -1,0 +1,116 @@
+"""A solver prepared for benchmarking, shared by the asv suite and the pytest-benchmark suite.
+
+It lives beside the asv suite, not in the package, because asv benchmarks
+older commits with the suite of the working tree: this file uses only the
+solver interface (Scene, make_solver, step_program, run) that every commit has.
+
+``Prepared(solver, precision, dx)`` compiles (outside any timed region), places
+the particles and takes the first step, so that the timed calls are steady
+state: ``step()`` is one whole step, ``stage("pi")`` only that stage's
+operations of one step (the stages of a step add up to the step). Each call
+ends with ``synchronize()``, so a GPU's queued work is inside the timing.
+
+Nothing here touches CUDA at import: ``gpu_available()`` imports CuPy only
+when asked, and a GPU solver is built only when one exists.
+"""
+from __future__ import annotations
+
+import functools
+import os
+import subprocess
+import sys
+
+from pcabench.solvers import Scene, make_solver
+from pcabench.solvers.analytic import errors as analytic_errors
+from pcabench.solvers.integrators import step_program
+
+# Particle counts: seconds on a laptop CPU by default; PCABENCH_BENCH_LARGE=1 adds 100K and 400K.
+SMALL_DX = (1.0, 0.5, 0.25)  # 1K, 4K, 16K particles on the paper's domain
+LARGE_DX = (0.1, 0.05)
+GPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M; large adds 10M
+GPU_LARGE_DX = (0.01,)
+ALLPAIR_MAX_N = 16_000  # all-pair is O(N^2): 16K is about 1 s per step on a laptop core
+
+
+def large() -> bool:
+    return os.environ.get("PCABENCH_BENCH_LARGE", "") not in ("", "0")
+
+
+def cpu_dx() -> tuple:
+    return SMALL_DX + (LARGE_DX if large() else ())
+
+
+def gpu_dx() -> tuple:
+    return GPU_DX + (GPU_LARGE_DX if large() else ())
+
+
+@functools.lru_cache(maxsize=None)
+def gpu_available() -> bool:
+    """A real CUDA device with CuPy and numba-cuda (never the simulator)."""
+    if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
+        return False
+    try:
+        from pcabench.solvers.linkedlist_gpu import device_backend, simulated
+
+        return not simulated() and device_backend()[1] is not None
+    except Exception:  # noqa: BLE001 - no CuPy, no driver, no device
+        return False
+
+
+class Unsupported(Exception):
+    """This combination is not benchmarked here (no GPU; all-pair past ALLPAIR_MAX_N)."""
+
+
+class Prepared:
+    """One solver at steady state on the paper's scene (or ``scene`` overrides)."""
+
+    def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=None, **scene):
+        self.scene = Scene(dx=dx, precision=precision, **{"steps": 100, **scene})
+        if solver == "linkedlist-gpu" and not gpu_available():
+            raise Unsupported("no CUDA GPU here")
+        if solver == "allpair-cpu" and self.scene.n_particles > ALLPAIR_MAX_N:
+            raise Unsupported(f"all-pair past {ALLPAIR_MAX_N:,} particles")
+        self.name = solver
+        self.solver = make_solver(solver, threads=threads)
+        self.solver.input(self.scene)
+        self.jit_seconds = self.solver.warmup()
+        self.solver = make_solver(solver, threads=threads)
+        self.solver.input(self.scene)
+        self.solver.init()
+        self.program = step_program(self.scene.integrator, self.solver, first=False)
+        for _, op in step_program(self.scene.integrator, self.solver, first=True):
+            op()
+        self.solver.synchronize()
+
+    @property
+    def n_particles(self) -> int:
+        return self.scene.n_particles
+
+    def step(self) -> None:
+        """One whole step (SNP + PI + SU)."""
+        for _, op in self.program:
+            op()
+        self.solver.synchronize()
+
+    def stage(self, name: str) -> None:
+        """Only the ``name`` operations of one step (snp, pi or su)."""
+        for stage, op in self.program:
+            if stage == name:
+                op()
+        self.solver.synchronize()
+
+    def errors(self):
+        """Errors of u against the analytic pulse at the solver's current time."""
+        f = self.solver.output()
+        return analytic_errors(self.scene, f.x, f.u, f.t)
+
+
+def jit_seconds_in_fresh_process(solver: str, precision: str) -> float:
+    """Compilation time of ``solver`` as a new user meets it: a fresh interpreter, s."""
+    code = ("from pcabench.solvers import Scene, make_solver\n"
+            f"s = make_solver({solver!r}); s.input(Scene(dx=1.0, precision={precision!r}))\n"
+            "print(s.warmup())")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    if proc.returncode != 0:
+        raise RuntimeError(proc.stderr.strip()[-400:])
+    return float(proc.stdout.strip().splitlines()[-1])

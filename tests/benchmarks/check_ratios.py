@@ -1,0 +1,68 @@
+"""Check same-run ratios in a pytest-benchmark JSON file; exit 1 naming any that fails.
+
+    python tests/benchmarks/check_ratios.py reports/pytest-benchmark/run.json
+
+The ratios hold on any machine, however fast or noisy, because both sides
+were measured in the same run:
+- the linked list takes less time per step than all-pair at every size tested;
+- a step's SNP + PI + SU medians add up to the step's median (within 25 %).
+"""
+from __future__ import annotations
+
+import json
+import sys
+
+STEP_SUM_TOLERANCE = 0.25
+
+
+def medians(path) -> dict:
+    data = json.loads(open(path).read())
+    out = {}
+    for b in data["benchmarks"]:
+        e = b["extra_info"]
+        out[(e["solver"], e["precision"], e["n_particles"], e["stage"])] = b["stats"]["median"]
+    return out
+
+
+def check(med: dict) -> list[str]:
+    failures, checked = [], 0
+    for (solver, precision, n, stage), t in sorted(med.items()):
+        if stage != "step":
+            continue
+        parts = [med.get((solver, precision, n, s)) for s in ("snp", "pi", "su")]
+        if None not in parts:
+            checked += 1
+            ratio = sum(parts) / t
+            if abs(ratio - 1) > STEP_SUM_TOLERANCE:
+                failures.append(f"{solver} {precision} N={n}: SNP+PI+SU = {sum(parts):.3g} s is {ratio:.2f}x "
+                                f"the measured step {t:.3g} s (allowed 1 +- {STEP_SUM_TOLERANCE})")
+        if solver == "allpair-cpu" and ("linkedlist-cpu", precision, n, "step") in med:
+            checked += 1
+            ll = med[("linkedlist-cpu", precision, n, "step")]
+            if not ll < t:
+                failures.append(f"{precision} N={n}: linked list {ll:.3g} s per step is not faster than "
+                                f"all-pair {t:.3g} s")
+    if checked == 0:
+        failures.append("no benchmark pairs to compare: was the suite run with --benchmark-only?")
+    return failures
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) != 1:
+        print(__doc__.strip().splitlines()[2], file=sys.stderr)
+        return 2
+    try:
+        failures = check(medians(argv[0]))
+    except (OSError, ValueError, KeyError) as exc:
+        print(f"cannot read the pytest-benchmark JSON {argv[0]!r}: {exc}", file=sys.stderr)
+        return 2
+    for f in failures:
+        print(f"ratio check failed: {f}", file=sys.stderr)
+    if not failures:
+        print(f"ratio checks passed ({argv[0]})")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
