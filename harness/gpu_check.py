@@ -9,6 +9,9 @@
    model and precision (max relative difference of u and drho);
 4. times linkedlist-gpu across dx = 0.1 ... 0.004 for both precisions and the
    three models (the paper's full domain, 100 steps by default);
+5. times linkedlist-cpu on the same machine, one thread (the paper's CPU
+   code) and every core, at dx = 0.1 ... 0.025 for a few steps: Table 6's
+   CPU column, so that the speedup compares one machine's CPU and GPU;
 
 and writes DIR/profile.json, DIR/gpu_results.jsonl (run records),
 DIR/gpu_check.md (tables) and DIR/pytest_gpu.log.
@@ -26,6 +29,8 @@ from pathlib import Path
 import numpy as np
 
 PAPER_SIZES = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)
+CPU_SIZES = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
+CPU_STEPS = 5
 MODELS = ("lagrangian", "fixed", "linear")
 PRECISIONS = ("float32", "float64")
 
@@ -157,7 +162,26 @@ def timing_sweep(sizes, steps: int, store_path: Path, profile_id: str, models=MO
     return rows
 
 
-def markdown(profile, compare_rows, timing_rows, steps) -> str:
+def cpu_peer(sizes, steps: int, store_path: Path, profile_id: str) -> list[dict]:
+    """linkedlist-cpu, lagrangian float64, one thread and every core, on this GPU's host."""
+    from pcabench import store
+    from pcabench.run import run
+    from pcabench.solvers import Scene
+    from pcabench.study import all_cores
+
+    rows = []
+    for dx in sizes:
+        for threads in sorted({1, all_cores()}):
+            rec = run(Scene(dx=dx, steps=steps), "linkedlist-cpu", threads=threads, profile_id=profile_id)
+            store.append(rec, store_path)
+            rows.append({"dx": dx, "N": rec.n_particles, "threads": threads, "status": rec.status,
+                         "step_ms": 1e3 * rec.step_seconds})
+            print(f"cpu dx={dx} N={rec.n_particles} threads={threads}: {rec.status}, "
+                  f"{1e3 * rec.step_seconds:.1f} ms per step", flush=True)
+    return rows
+
+
+def markdown(profile, compare_rows, timing_rows, steps, cpu_rows=()) -> str:
     g = profile.get("gpu") or {}
     lines = [f"# GPU check: {g.get('name', '?')} ({profile['id']})", "",
              f"Measured ceilings: {json.dumps(profile.get('measured', {}))}", "",
@@ -177,6 +201,11 @@ def markdown(profile, compare_rows, timing_rows, steps) -> str:
             f"{r['ps_per_pair']:.2f} | {r['neighbours']:.1f} | {r['mse']:.3g} | {r['init_ms']:.1f} | "
             f"{r['output_ms']:.1f} |")
     lines += ["", "ps/pair counts both sweeps of a Verlet step (2 x N x mean neighbours pairs)."]
+    if cpu_rows:
+        lines += ["", "## linkedlist-cpu on this host (lagrangian, float64)", "",
+                  "| dx | N | threads | status | step (ms) |", "|---|---|---|---|---|"]
+        lines += [f"| {r['dx']} | {r['N']:,} | {r['threads']} | {r['status']} | {r['step_ms']:.1f} |"
+                  for r in cpu_rows]
     return "\n".join(lines) + "\n"
 
 
@@ -188,6 +217,7 @@ def main(argv=None) -> int:
     parser.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
     parser.add_argument("--skip-tests", action="store_true")
     parser.add_argument("--skip-compare", action="store_true")
+    parser.add_argument("--skip-cpu", action="store_true", help="no linkedlist-cpu timings on this host")
     parser.add_argument("--only-ceilings", action="store_true", help="profile and measured ceilings only")
     args = parser.parse_args(argv)
     return gpu_check(args)
@@ -216,7 +246,8 @@ def gpu_check(args) -> int:
     compare_rows = [] if args.skip_compare else compare_with_cpu()
     timing_rows = timing_sweep(args.sizes, args.steps, out / "gpu_results.jsonl", profile["id"],
                                models=args.models)
-    text = markdown(profile, compare_rows, timing_rows, args.steps)
+    cpu_rows = [] if args.skip_cpu else cpu_peer(CPU_SIZES, CPU_STEPS, out / "gpu_results.jsonl", profile["id"])
+    text = markdown(profile, compare_rows, timing_rows, args.steps, cpu_rows)
     (out / "gpu_check.md").write_text(text)
     print(text, flush=True)
     return rc

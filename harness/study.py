@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
@@ -104,8 +105,9 @@ def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: f
             continue
         t0 = time.perf_counter()
         cmd = [sys.executable, "-m", "pcabench.study", "--child", json.dumps(spec), "--store", str(store_path)]
+        env = dict(os.environ, PCABENCH_COMMIT=commit)  # every run of a sweep carries the sweep's commit
         try:
-            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=min(run_budget, left))
+            proc = subprocess.run(cmd, capture_output=True, text=True, timeout=min(run_budget, left), env=env)
             if proc.returncode != 0:
                 status = "out-of-memory" if proc.returncode in (-9, 137) else "error"
                 store.append(_failed_record(spec, status, proc.stderr.strip()[-400:], profile,

@@ -143,9 +143,11 @@ def _section_front(df) -> list[str]:
     points, front = T.speed_front(df)
     if not points:
         return []
-    rows = [[fmt(r["t_final"], "g"), pct(r["target"]), r["config"] or "none measured",
+    fastest = T.fastest_to(front)
+    reached = {r["t_final"] for r in fastest if r["config"]}
+    rows = [[fmt(r["t_final"], "g"), pct(r["target"]), r["config"] or "no run reached it",
              r.get("model", "-"), r.get("domain", "-"), fmt(r.get("dx"), "g"), fmt(r.get("seconds"), ".3g"),
-             pct(r.get("mse"))] for r in T.fastest_to(front)]
+             pct(r.get("mse"))] for r in fastest if r["t_final"] in reached]
     return ["## Speed against accuracy (what the paper lacks)", "",
             "Every run at a fixed physical time, error against time to solution (init + steps, no JIT). "
             "The front holds the runs no other run beats on both; the table names the fastest run "
@@ -175,14 +177,26 @@ def _section_stability(df) -> list[str]:
                   f"`pcabench study --stability`: the linear model on a strip, each run classed stable, "
                   f"inaccurate (bounded, relative RMS above {100 * INACCURATE_ABOVE:g} %) or unstable (stopped "
                   "at the step where max|u| left its bound or went non-finite).", "",
-                  md_table(["method", "dx", "CFLs run", "stable up to CFL", "first failure"],
+                  md_table(["method", "dx", "CFLs run", "bounded up to CFL", "stable and accurate up to CFL",
+                            "first failure"],
                            [[lim["config"], f"{lim['dx']:g}", ", ".join(f"{c:g}" for c in lim["cfls"]),
+                             fmt(lim["bounded_up_to"], "g") if lim["bounded_up_to"] else "none",
                              fmt(lim["stable_up_to"], "g") if lim["stable_up_to"] else "none",
                              "-" if not lim["first_failure"] else
                              f"CFL {lim['first_failure'][0]:g}: {lim['first_failure'][1]}"
                              + (f" at step {lim['first_failure'][2]}" if lim["first_failure"][2] else "")
                              + (f" ({pct(lim['first_failure'][3])})" if lim["first_failure"][1] == "inaccurate"
                                 else "")] for lim in limits]), ""]
+        for lim in limits:
+            if lim["h_factor"] == 2.13 and lim["precision"] == "float64" and len(lim["cfls"]) > 3:
+                unb = lim["first_unbounded"]
+                lines.append(f"- **{lim['integrator']}** ({lim['protocol']}): stays bounded up to CFL "
+                             f"{fmt(lim['bounded_up_to'], 'g') if lim['bounded_up_to'] else 'none of those run'}"
+                             + (f", blows up from CFL {unb[0]:g}" + (f" (step {unb[2]})" if unb[2] else "")
+                                if unb else ", and never blew up")
+                             + f"; within {100 * INACCURATE_ABOVE:g} % error up to CFL "
+                             f"{fmt(lim['stable_up_to'], 'g') if lim['stable_up_to'] else 'none'}.")
+        lines.append("")
     f32 = [r for r in T.float32_vs_float64(df) if any(d <= 0.05 for d, _, _ in r["pairs"])]
     if f32:
         lines += ["### float32 against float64", ""]
@@ -220,10 +234,10 @@ def report_for(df, df_all, pid: str, out: Path) -> Path:
                             out, pid))
     figs = [p for p in figs if p is not None]
     counts = df.status.value_counts().to_dict()
-    commits = sorted(set(df.commit.astype(str)))
+    commits = sorted({c[:12] + ("+dirty" if c.endswith("+dirty") else "") for c in df.commit.astype(str)})
     lines = [f"# pcabench report: {pid}", "", f"Machine: {_machine(pid)}.", "",
              f"Runs: {len(df)} ({', '.join(f'{v} {k}' for k, v in sorted(counts.items()))}); commits: "
-             f"{', '.join(c[:12] for c in commits)}. Regenerate with `pcabench report`.", ""]
+             f"{', '.join(commits)}. Regenerate with `pcabench report`.", ""]
     for section in (_sections_timing(df), _section_table6(df_all, pid), _section_fig9(df), _section_fig8(df),
                     _section_front(df), _section_simplifications(df), _section_stability(df), _section_failed(df)):
         lines += section

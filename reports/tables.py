@@ -177,6 +177,7 @@ def error_series(df) -> list[dict]:
     Solvers agree to round-off, so one error per dx is kept (the newest).
     """
     acc = default_numerics(latest(df[df.status == "ok"]))
+    acc = acc[(acc.protocol == "100 steps") | acc.protocol.str.startswith("t =")]  # the paper's, or fixed time
     out = []
     for (model, precision, protocol, domain), g in acc.groupby(["model", "precision", "protocol", "domain"]):
         g = _newest_per(g, ["dx"]).sort_values("dx", ascending=False)
@@ -300,7 +301,7 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
                                                                "dx"]):
         g = g.sort_values("cfl")
         name = f"{integ}, h = {h:g} dx, {precision}, {protocol}"
-        limit, first_bad = None, None
+        limit, bounded, first_bad, first_unbounded = None, None, None, None
         for _, r in g.iterrows():
             cls = classify(r, inaccurate_above)
             step = _step_or_none(r.failed_step)
@@ -311,8 +312,14 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
                     limit = r.cfl
                 else:
                     first_bad = (r.cfl, cls, step, r.mse)
-        limits.append({"config": name, "dx": dx, "cfls": g.cfl.tolist(), "stable_up_to": limit,
-                       "first_failure": first_bad})
+            if first_unbounded is None:
+                if cls in ("stable", "inaccurate"):
+                    bounded = r.cfl
+                else:
+                    first_unbounded = (r.cfl, cls, step)
+        limits.append({"config": name, "integrator": integ, "h_factor": h, "precision": precision,
+                       "protocol": protocol, "dx": dx, "cfls": g.cfl.tolist(), "stable_up_to": limit,
+                       "first_failure": first_bad, "bounded_up_to": bounded, "first_unbounded": first_unbounded})
     return points, limits
 
 

@@ -132,6 +132,7 @@ def test_tables_from_a_fixed_results_file(results):
     points, limits = T.stability(a, inaccurate_above=0.15)
     lim = {x["config"].split(",")[0]: x for x in limits}
     assert lim["verlet"]["stable_up_to"] == 4.0 and lim["verlet"]["first_failure"][:2] == (5.0, "inaccurate")
+    assert lim["verlet"]["bounded_up_to"] == 5.0 and lim["verlet"]["first_unbounded"] == (6.0, "unstable", 7)
     assert lim["euler"]["stable_up_to"] is None and lim["euler"]["first_failure"][1:3] == ("unstable", 30)
 
     f32 = {r["model"]: r for r in T.float32_vs_float64(a)}
@@ -159,7 +160,7 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
         assert image.shape[0] > 100 and image.shape[1] > 100 and image.std() > 0, name
     a = (out / "machine-a" / "report.md").read_text()
     for words in ("Table 4", "Table 5", "Table 6", "Fig. 9", "Fig. 8", "fitted order 2.00", "stops falling at dx = 0.2",
-                  "Speed against accuracy", "cost of each simplification", "stable up to CFL", "skipped"):
+                  "Speed against accuracy", "cost of each simplification", "accurate up to CFL", "bounded up to CFL", "skipped"):
         assert words in a, words
     cards = (out / "cards.md").read_text()
     assert "machine-b" in cards and "Tesla K20c" in cards and "Quadro M4000" in cards
