@@ -5,10 +5,10 @@ inside the measurement. ``track_step_ms`` times the same step with CUDA
 events instead of the host clock. Nothing touches CUDA at import: the check
 runs in ``setup``.
 """
-from .common import Prepared, gpu_available, gpu_dx, jit_seconds_in_fresh_process
+from .common import Prepared, StageBenchmarks, gpu_available, gpu_dx, jit_seconds_in_fresh_process
 
 
-class TimeGPUStep:
+class TimeGPUStep(StageBenchmarks):
     params = [["float32", "float64"], list(gpu_dx())]
     param_names = ["precision", "dx"]
     timeout = 300
@@ -17,18 +17,6 @@ class TimeGPUStep:
         if not gpu_available():
             raise NotImplementedError("no CUDA GPU on this machine")
         self.p = Prepared("linkedlist-gpu", precision, dx)
-
-    def time_step(self, *_):
-        self.p.step()
-
-    def time_snp(self, *_):
-        self.p.stage("snp")
-
-    def time_pi(self, *_):
-        self.p.stage("pi")
-
-    def time_su(self, *_):
-        self.p.stage("su")
 
     def track_step_ms(self, *_):
         cupy = self.p.solver.cupy

@@ -4,10 +4,10 @@ Compilation and the first step happen in ``setup``, outside the timed region
 (``bench_jit.py`` times compilation on its own). All-pair stops at 16K
 particles; ``PCABENCH_BENCH_LARGE=1`` adds 100K and 400K for the linked list.
 """
-from .common import Prepared, Unsupported, cpu_dx
+from .common import Prepared, StageBenchmarks, Unsupported, cpu_dx
 
 
-class TimeStep:
+class TimeStep(StageBenchmarks):
     params = [["allpair-cpu", "linkedlist-cpu"], ["float64", "float32"], list(cpu_dx())]
     param_names = ["solver", "precision", "dx"]
     timeout = 300
@@ -18,18 +18,6 @@ class TimeStep:
             self.p = Prepared(solver, precision, dx)
         except Unsupported as exc:
             raise NotImplementedError(str(exc))
-
-    def time_step(self, *_):
-        self.p.step()
-
-    def time_snp(self, *_):
-        self.p.stage("snp")
-
-    def time_pi(self, *_):
-        self.p.stage("pi")
-
-    def time_su(self, *_):
-        self.p.stage("su")
 
 
 class TimeStepThreads:

@@ -15,6 +15,7 @@ when asked, and a GPU solver is built only when one exists.
 """
 from __future__ import annotations
 
+import abc
 import functools
 import os
 import subprocess
@@ -103,6 +104,29 @@ class Prepared:
         """Errors of u against the analytic pulse at the solver's current time."""
         f = self.solver.output()
         return analytic_errors(self.scene, f.x, f.u, f.t)
+
+
+class StageBenchmarks(abc.ABC):
+    """asv time_ benchmarks of one step and of each stage of ``self.p``, the Prepared that ``setup`` makes.
+
+    Abstract, so that asv does not collect it where it is defined or imported.
+    """
+
+    @abc.abstractmethod
+    def setup(self, *params):
+        """Make ``self.p``; raise NotImplementedError to skip these parameters."""
+
+    def time_step(self, *_):
+        self.p.step()
+
+    def time_snp(self, *_):
+        self.p.stage("snp")
+
+    def time_pi(self, *_):
+        self.p.stage("pi")
+
+    def time_su(self, *_):
+        self.p.stage("su")
 
 
 def jit_seconds_in_fresh_process(solver: str, precision: str) -> float:

@@ -126,37 +126,36 @@ def _stacked(ax, labels, shares, stages):
     ax.set_ylim(0, 100)
 
 
+def _shares(path, title, ylabel, rows, published, stages):
+    """Stacked bars: our rows (config, N), then the paper's ``(label, shares)`` pairs."""
+    labels = [f"{r['config']}\nN={r['N']:,}" for r in rows] + [label for label, _ in published]
+    shares = [dict(r) for r in rows] + [sh for _, sh in published]
+    with figure(path, title, "", ylabel) as (ax,):
+        _stacked(ax, labels, shares, stages)
+    return path
+
+
 def fig11(df, out: Path, pid: str):
     rows = T.table5(df)
     if not rows:
         return None
     text = T.published()["text"]["fig11_cpu_step_shares_pct"]
-    labels = [f"{r['config']}\nN={r['N']:,}" for r in rows]
-    shares = [dict(r) for r in rows]
-    labels.append("paper CPU\n(Fig. 11 text)")
-    shares.append({"snp": text["snp"], "pi": text["pi"], "su": 100 - text["snp"] - text["pi"]})
-    for n, v in T.published()["table5"]["rows"].items():
-        labels.append(f"paper K20c\nN={int(n):,}")
-        shares.append(dict(zip(T.STEP_STAGES, v)))
-    path = out / "fig11_step_shares.png"
-    with figure(path, f"Figs. 11 / Table 5: share of a step ({pid})", "", "% of one step (SNP+PI+SU)") as (ax,):
-        _stacked(ax, labels, shares, T.STEP_STAGES)
-    return path
+    paper = [("paper CPU\n(Fig. 11 text)", {"snp": text["snp"], "pi": text["pi"],
+                                             "su": 100 - text["snp"] - text["pi"]})]
+    paper += [(f"paper K20c\nN={int(n):,}", dict(zip(T.STEP_STAGES, v)))
+              for n, v in T.published()["table5"]["rows"].items()]
+    return _shares(out / "fig11_step_shares.png", f"Figs. 11 / Table 5: share of a step ({pid})",
+                   "% of one step (SNP+PI+SU)", rows, paper, T.STEP_STAGES)
 
 
 def fig13(df, out: Path, pid: str):
     rows = T.one_step_shares(df)
     if not rows:
         return None
-    labels = [f"{r['config']}\nN={r['N']:,}" for r in rows]
-    shares = [dict(r) for r in rows]
-    for n, v in T.published()["table4"]["rows"].items():
-        labels.append(f"paper K20c\nN={int(n):,}")
-        shares.append({s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)})
-    path = out / "fig13_task_shares.png"
-    with figure(path, f"Fig. 13: share of a one-step run by task ({pid})", "", "% of a one-step run") as (ax,):
-        _stacked(ax, labels, shares, T.STAGES)
-    return path
+    paper = [(f"paper K20c\nN={int(n):,}", {s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)})
+             for n, v in T.published()["table4"]["rows"].items()]
+    return _shares(out / "fig13_task_shares.png", f"Fig. 13: share of a one-step run by task ({pid})",
+                   "% of a one-step run", rows, paper, T.STAGES)
 
 
 def fig14(df_all, out: Path, title: str):
