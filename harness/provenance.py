@@ -37,6 +37,16 @@ def git_commit() -> str:
 
 
 @functools.lru_cache(maxsize=None)
+def host_id() -> str:
+    """A short hash of this computer's network name: tells two machines of one hardware profile apart
+    (a sweep resumes only the runs this host made) without publishing the name."""
+    import hashlib
+    import platform
+
+    return hashlib.sha1(platform.node().encode()).hexdigest()[:10]
+
+
+@functools.lru_cache(maxsize=None)
 def package_versions() -> dict:
     out = {"python": platform.python_version()}
     for name in PACKAGES:

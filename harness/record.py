@@ -34,6 +34,7 @@ class RunRecord:
     commit: str = ""
     versions: dict = field(default_factory=dict)
     preset: str = ""  # the study preset that asked for the run (quick, paper, stability, matrix), if any
+    host: str = ""  # provenance.host_id(): which computer of this hardware profile made the run
     timestamp: str = field(default_factory=lambda: _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
 
     CONTRACT = ("solver", "precision", "model", "integrator", "dx", "n_particles", "steps", "t_end",

@@ -13,7 +13,7 @@ from pcabench.solvers.analytic import errors as analytic_errors
 from pcabench.solvers.integrators import step_program
 
 from .clock import clock_for
-from .provenance import git_commit, package_versions
+from .provenance import git_commit, host_id, package_versions
 from .record import RunRecord
 
 
@@ -34,7 +34,7 @@ def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int | None =
         t_end=0.0, stages=stages, jit_seconds=0.0, mse=math.nan, me=math.nan,
         mean_neighbours=math.nan, status="error", failed_step=None, threads=threads or 1,
         steps_requested=scene.n_steps, scene=scene.as_dict(), profile_id=profile_id or "",
-        commit=git_commit(), versions=package_versions())
+        commit=git_commit(), versions=package_versions(), host=host_id())
     step = 0
     try:
         clock = None

@@ -3,7 +3,7 @@
 Each finished run is appended and flushed to disk at once, so an interrupted
 sweep loses no finished run. Stores taken on different machines merge by
 concatenation: a run is identified by its ``run_id`` (profile, commit,
-solver, scene and timestamp), and duplicates are dropped on load.
+solver, scene, timestamp and host), and duplicates are dropped on load.
 """
 from __future__ import annotations
 
@@ -15,8 +15,9 @@ from pathlib import Path
 
 
 def run_id(row: dict) -> str:
-    key = json.dumps([row.get("profile_id"), row.get("commit"), row.get("solver"), row.get("threads"),
-                      row.get("scene"), row.get("timestamp")], sort_keys=True, default=str)
+    key = [row.get("profile_id"), row.get("commit"), row.get("solver"), row.get("threads"),
+           row.get("scene"), row.get("timestamp")] + ([row["host"]] if row.get("host") else [])
+    key = json.dumps(key, sort_keys=True, default=str)
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 

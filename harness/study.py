@@ -9,7 +9,8 @@ Each run is a child process with a time budget: a crash, hang or
 out-of-memory in one run is recorded (status error / timeout /
 out-of-memory) and the sweep goes on. Every finished run is appended to the
 store at once; a rerun skips the runs the store already holds for this
-machine, commit and preset, so an interrupted sweep resumes where it stopped.
+machine (hardware profile and host), commit and preset, so an interrupted
+sweep resumes where it stopped.
 Runs predicted to take longer than the run budget are stored as ``skipped``.
 """
 from __future__ import annotations
@@ -24,7 +25,7 @@ from pathlib import Path
 
 from pcabench import store
 from pcabench.hardware_profiles import profile_id as this_profile_id
-from pcabench.provenance import git_commit, package_versions
+from pcabench.provenance import git_commit, host_id, package_versions
 from pcabench.record import RunRecord
 from pcabench.solvers import Scene
 
@@ -48,10 +49,10 @@ def resolve(spec: dict) -> dict:
     return spec
 
 
-def _key(spec: dict, profile: str, commit: str) -> str:
-    """What identifies a run for resuming: solver, threads, scene, preset, machine and commit."""
+def _key(spec: dict, profile: str, commit: str, host: str) -> str:
+    """What identifies a run for resuming: solver, threads, scene, preset, machine, commit and host."""
     return json.dumps([spec["solver"], spec.get("threads", 1) or 1, Scene(**spec["scene"]).as_dict(),
-                       spec.get("preset", ""), profile, commit], sort_keys=True, default=str)
+                       spec.get("preset", ""), profile, commit, host], sort_keys=True, default=str)
 
 
 def _failed_record(spec, status, message, profile, seconds=None) -> RunRecord:
@@ -64,7 +65,7 @@ def _failed_record(spec, status, message, profile, seconds=None) -> RunRecord:
                      threads=spec.get("threads", 1), steps_requested=scene.n_steps, scene=scene.as_dict(),
                      message=message if seconds is None else f"{message} (after {seconds:.0f} s)",
                      profile_id=profile, commit=git_commit(), versions=package_versions(),
-                     preset=spec.get("preset", ""))
+                     preset=spec.get("preset", ""), host=host_id())
 
 
 def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: float,
@@ -77,10 +78,11 @@ def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: f
     """
     from pcabench.predict import predicted_seconds
 
-    profile, commit = this_profile_id(), git_commit()
+    profile, commit, host = this_profile_id(), git_commit(), host_id()
     rows = store.read_rows(store_path) if Path(store_path).exists() else []
     done = {_key({"solver": r["solver"], "threads": r.get("threads", 1), "scene": _scene_kwargs(r),
-                  "preset": r.get("preset", "")}, r["profile_id"], r["commit"]) for r in rows}
+                  "preset": r.get("preset", "")}, r["profile_id"], r["commit"], r.get("host", ""))
+            for r in rows}
     mine = [r for r in rows if r.get("profile_id") == profile]
     t_start, made = time.perf_counter(), 0
     for i, spec in enumerate(runs, 1):
@@ -88,7 +90,7 @@ def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: f
         label = f"[{i}/{len(runs)}] {spec['solver']}" + (f" x{spec['threads']}" if spec.get("threads", 1) > 1
                                                           else "") + " " + " ".join(
             f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in spec["scene"].items())
-        if _key(spec, profile, commit) in done:
+        if _key(spec, profile, commit, host) in done:
             print(f"{label}: already stored", file=stream, flush=True)
             continue
         elapsed = time.perf_counter() - t_start
@@ -99,8 +101,8 @@ def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: f
         scene = Scene(**spec["scene"])
         seconds, why = predicted_seconds(spec, scene, mine)
         if seconds is not None and seconds > run_budget:
-            row = store.append(_failed_record(spec, "skipped", f"{why} > run budget {run_budget:.0f} s",
-                                              profile), store_path)
+            store.append(_failed_record(spec, "skipped", f"{why} > run budget {run_budget:.0f} s", profile),
+                         store_path)
             print(f"{label}: skipped, {why}", file=stream, flush=True)
             continue
         t0 = time.perf_counter()

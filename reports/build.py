@@ -128,6 +128,13 @@ def _section_fig8(df) -> list[str]:
         head = f"- {s['model']} {s['precision']}, {s['protocol']}, {s['domain']}: "
         if s["model"] == "lagrangian" and s["protocol"].startswith("t ="):
             lines.append(head + _lagrangian_note(s))
+        elif s["stops_falling"] and s["protocol"].startswith("t ="):
+            lines.append(head + f"its error stops falling at dx = {s['stops_falling']:g} "
+                         f"({', '.join(pct(e) for e in s['mse'])} for dx = {', '.join(f'{d:g}' for d in s['dx'])})"
+                         + ("; the fixed model keeps the nonlinear rho div(u) term of the paper's equations but "
+                            "drops the advection terms (u . grad), so it solves neither the linear nor the "
+                            "isothermal equations and its error against the linear pulse stays large"
+                            if s["model"] == "fixed" else "") + ". No order is fitted.")
         else:
             lines.append(head + f"fitted order {s['order']:.2f}" + (
                 " (apparent: each dx ends at a different time)" if s["protocol"].endswith("steps") else "") + ".")
@@ -150,8 +157,10 @@ def _section_front(df) -> list[str]:
              pct(r.get("mse"))] for r in fastest if r["t_final"] in reached]
     return ["## Speed against accuracy (what the paper lacks)", "",
             "Every run at a fixed physical time, error against time to solution (init + steps, no JIT). "
-            "The front holds the runs no other run beats on both; the table names the fastest run "
-            "reaching each error.", "",
+            "The front holds the `linear` runs no other linear run beats on both: their error is "
+            "discretisation error. (A lagrangian or fixed run's error against the linear pulse also holds "
+            "the difference between its equations and the linear ones; they are plotted, not ranked.) "
+            "The table names the fastest run reaching each error.", "",
             md_table(["t (s)", "error target", "fastest config", "model", "domain", "dx", "time (s)", "error"], rows),
             ""]
 

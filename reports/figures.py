@@ -56,8 +56,9 @@ def fig8(df, out: Path, pid: str):
                 ncols=len(protocols), logx=True, logy=True) as axes:
         for ax, protocol in zip(axes, protocols):
             for s in (s for s in series if s["protocol"] == protocol):
-                ax.plot(s["dx"], s["mse"], "o-", label=f"{s['model']} {s['precision']} {s['domain']} "
-                                                      f"(order {s['order']:.2f})")
+                how = (f"stops falling at dx = {s['stops_falling']:g}" if s["stops_falling"]
+                       else f"order {s['order']:.2f}")
+                ax.plot(s["dx"], s["mse"], "o-", label=f"{s['model']} {s['precision']} {s['domain']} ({how})")
             if protocol == "100 steps":
                 ax.plot([0.004], [T.published()["text"]["fig8_mse_100_steps_dx_0.004"]], "k^",
                         label="paper, dx = 0.004 (published)")
@@ -143,7 +144,7 @@ def fig11(df, out: Path, pid: str):
     paper = [("paper CPU\n(Fig. 11 text)", {"snp": text["snp"], "pi": text["pi"],
                                              "su": 100 - text["snp"] - text["pi"]})]
     paper += [(f"paper K20c\nN={int(n):,}", dict(zip(T.STEP_STAGES, v)))
-              for n, v in T.published()["table5"]["rows"].items()]
+              for n, v in sorted(T.published()["table5"]["rows"].items(), key=lambda kv: int(kv[0]))]
     return _shares(out / "fig11_step_shares.png", f"Figs. 11 / Table 5: share of a step ({pid})",
                    "% of one step (SNP+PI+SU)", rows, paper, T.STEP_STAGES)
 
@@ -153,7 +154,7 @@ def fig13(df, out: Path, pid: str):
     if not rows:
         return None
     paper = [(f"paper K20c\nN={int(n):,}", {s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)})
-             for n, v in T.published()["table4"]["rows"].items()]
+             for n, v in sorted(T.published()["table4"]["rows"].items(), key=lambda kv: int(kv[0]))]
     return _shares(out / "fig13_task_shares.png", f"Fig. 13: share of a one-step run by task ({pid})",
                    "% of a one-step run", rows, paper, T.STAGES)
 
@@ -196,7 +197,7 @@ def speed_vs_accuracy(df, out: Path, pid: str):
                     label=f"{config} {model} {domain}, t = {t_final:g} s")
         for (t_final,), pts in _groups(front, ("t_final",)):
             ax.step([p["seconds"] for p in pts], [p["mse"] for p in pts], "k-", where="post", lw=1,
-                    label=f"front (fastest to each error), t = {t_final:g} s")
+                    label=f"front of the linear runs (fastest to each error), t = {t_final:g} s")
     return path
 
 

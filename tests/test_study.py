@@ -51,6 +51,19 @@ def test_killed_sweep_resumes_to_the_same_store(tmp_path):
     assert len(outcome(path)) == 4
 
 
+@pytest.mark.parametrize("args,words", [
+    (["--dx", "0"], ["dx", "> 0"]),
+    (["--dx", "1", "--cfl", "-1"], ["cfl", "> 0"]),
+    (["--quick", "--run-budget", "0"], ["--run-budget", "> 0"]),
+])
+def test_bad_study_input_exits_2_before_any_run(tmp_path, args, words):
+    proc = study(tmp_path, *args)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in err, err
+    assert all(w in err for w in words), err
+    assert not list(tmp_path.glob("*.jsonl"))
+
+
 # ---------------------------------------------------------------- a small fixed results file
 def row(profile="machine-a", solver="linkedlist-cpu", threads=1, step_ms=(1.0, 4.0, 0.1), steps=10, mse=0.01,
         status="ok", failed_step=None, preset="", stamp=0, message="", **scene):
