@@ -208,7 +208,7 @@ def _section_stability(df) -> list[str]:
         lines.append("")
     f32 = [r for r in T.float32_vs_float64(df) if any(d <= 0.05 for d, _, _ in r["pairs"])]
     if f32:
-        lines += ["### float32 against float64", ""]
+        lines += ["## float32 against float64", ""]
         for r in f32:
             pairs = "; ".join(f"dx {d:g}: {e64:.3g} / {e32:.3g}" for d, e64, e32 in r["pairs"])
             verdict = (f"float32 departs from float64 by more than {100 * r['tolerance']:g} % at dx = {r['stops_at']:g}"
