@@ -242,6 +242,8 @@ def report_for(df, df_all, pid: str, out: Path) -> Path:
         figs.append(F.fig14(df_all[df_all.profile_id.isin({pid} | {r["cpu_profile"] for r in T.table6(df_all)})],
                             out, pid))
     figs = [p for p in figs if p is not None]
+    for stale in set(out.glob("*.png")) - set(figs):  # a figure whose data is gone is not left behind
+        stale.unlink()
     counts = df.status.value_counts().to_dict()
     commits = sorted({c[:12] + ("+dirty" if c.endswith("+dirty") else "") for c in df.commit.astype(str)})
     lines = [f"# pcabench report: {pid}", "", f"Machine: {_machine(pid)}.", "",
