@@ -12,12 +12,17 @@ PACKAGES = ("pcabench", "numpy", "numba", "numba-cuda", "cupy-cuda12x", "cupy-cu
             "matplotlib")
 
 
+# The paths whose changes change a run's numbers (git pathspecs from the repository root).
+CODE = (":(top)solvers", ":(top)harness", ":(top)hardware_profiles/*.py", ":(top)pyproject.toml")
+
+
 @functools.lru_cache(maxsize=None)
 def git_commit() -> str:
     """The commit of the source tree (with '+dirty' if its code has local changes), or 'unknown'.
 
-    Results, reports and stored profiles are outputs, not code: a sweep that
-    appends to a tracked results file does not make its own later runs dirty.
+    Only the code that makes a run counts (``CODE``): results, reports, stored
+    profiles and documents are not, so a sweep that appends to a tracked
+    results file, or an edited README, does not make later runs dirty.
     """
     if os.environ.get("PCABENCH_COMMIT"):
         return os.environ["PCABENCH_COMMIT"]  # a copy without git history (e.g. a GPU machine)
@@ -28,9 +33,8 @@ def git_commit() -> str:
         sha = proc.stdout.strip()
         if proc.returncode != 0 or len(sha) != 40:
             return "unknown"
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", ":/",
-                                ":(exclude,top)reports", ":(exclude,top)hardware_profiles/*.json"], cwd=here,
-                               capture_output=True, text=True, timeout=10).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", *CODE],
+                               cwd=here, capture_output=True, text=True, timeout=10).stdout.strip()
         return sha + ("+dirty" if dirty else "")
     except (OSError, subprocess.SubprocessError):
         return "unknown"

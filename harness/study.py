@@ -115,6 +115,10 @@ def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: f
                 store.append(_failed_record(spec, status, proc.stderr.strip()[-400:], profile,
                                             time.perf_counter() - t0), store_path)
         except subprocess.TimeoutExpired:
+            if left < run_budget:  # the sweep's budget ran out, not the run's: nothing to record
+                print(f"{label}: sweep budget spent during the run, not stored (rerun to resume)",
+                      file=stream, flush=True)
+                break
             store.append(_failed_record(spec, "timeout", f"past the run budget of {run_budget:.0f} s", profile,
                                         time.perf_counter() - t0), store_path)
         made += 1

@@ -194,3 +194,12 @@ def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):
     last = store.read_rows(path)[-1]
     assert last["status"] == "skipped" and last["n_particles"] == 64000
     assert "predicted" in last["message"] and "N^2.00" in last["message"]
+
+
+def test_a_run_cut_by_the_sweep_budget_is_not_stored(tmp_path):
+    from pcabench.study import sweep
+
+    path = tmp_path / "s.jsonl"
+    spec = {"solver": "linkedlist-cpu", "threads": 1, "scene": {"dx": 0.5, "steps": 50}}
+    sweep([spec], path, run_budget=600.0, sweep_budget=0.5)  # the child cannot even compile in 0.5 s
+    assert not path.exists() or store.read_rows(path) == []  # a rerun must run it, not find a false timeout
