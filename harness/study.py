@@ -27,7 +27,7 @@ from pcabench import store
 from pcabench.hardware_profiles import profile_id as this_profile_id
 from pcabench.provenance import git_commit, host_id, package_versions
 from pcabench.record import RunRecord
-from pcabench.solvers import Scene
+from pcabench.solvers import Scene, make_solver
 
 RESULTS_DIR = Path("reports/results")
 
@@ -174,8 +174,12 @@ def cmd_study(args) -> int:
     from pcabench.solvers import SceneError
 
     name, runs = runs_from_args(args)
-    for spec in runs:  # validate the whole matrix before the first run
-        Scene(**spec["scene"])
+    solvers = {}
+    for spec in map(resolve, runs):  # validate the whole matrix before the first run
+        key = (spec["solver"], spec.get("threads", 1))
+        if key not in solvers:  # SceneError (bad threads) or SolverUnavailable (no GPU): exit before running
+            solvers[key] = make_solver(*key)
+        solvers[key].check_scene(Scene(**spec["scene"]))
     run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:

@@ -55,6 +55,8 @@ def test_killed_sweep_resumes_to_the_same_store(tmp_path):
     (["--dx", "0"], ["dx", "> 0"]),
     (["--dx", "1", "--cfl", "-1"], ["cfl", "> 0"]),
     (["--quick", "--run-budget", "0"], ["--run-budget", "> 0"]),
+    (["--dx", "1", "--threads", "9999"], ["threads", "between 1 and"]),
+    (["--dx", "1", "--solver", "allpair-cpu", "--threads", "2"], ["allpair-cpu is serial"]),
 ])
 def test_bad_study_input_exits_2_before_any_run(tmp_path, args, words):
     proc = study(tmp_path, *args)
