@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 
+from pcabench.record import step_seconds
+
 ORDER = {"allpair-cpu": 2.0}  # the default is 1.0: the cell list is linear in N
 START_UP = 5.0  # s: a child process, imports and JIT on a tiny scene (measured 3-7 s on a laptop CPU)
 
@@ -30,8 +32,7 @@ def step_model(spec: dict, scene, rows: list[dict]):
     pts = {}
     for row in rows:
         if _same_config(row, spec, scene):
-            st = row["stages"]
-            pts.setdefault(int(row["n_particles"]), []).append((st["snp"] + st["pi"] + st["su"]) / row["steps"])
+            pts.setdefault(int(row["n_particles"]), []).append(step_seconds(row["stages"], row["steps"]))
     pts = {n: float(np.median(v)) for n, v in pts.items() if n > 0 and min(v) > 0}
     if not pts:
         return None

@@ -4,7 +4,14 @@ from __future__ import annotations
 import datetime as _dt
 from dataclasses import asdict, dataclass, field
 
+from pcabench.solvers import STAGES
+
 STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
+
+
+def step_seconds(stages: dict, steps: int) -> float:
+    """Mean wall time of one step (SNP + PI + SU) from total stage times, s."""
+    return (stages["snp"] + stages["pi"] + stages["su"]) / max(steps or 0, 1)
 
 
 @dataclass
@@ -40,14 +47,27 @@ class RunRecord:
     CONTRACT = ("solver", "precision", "model", "integrator", "dx", "n_particles", "steps", "t_end",
                 "stages", "jit_seconds", "mse", "me", "mean_neighbours", "status", "failed_step")
 
+    @classmethod
+    def before_run(cls, scene, solver: str, threads, status: str = "error", message: str = "",
+                   profile_id: str = "", preset: str = "") -> "RunRecord":
+        """The record of ``scene`` on ``solver`` before any step: no times, no errors, provenance filled."""
+        from .provenance import git_commit, host_id, package_versions
+
+        nan = float("nan")
+        return cls(solver=solver, precision=scene.precision, model=scene.model, integrator=scene.integrator,
+                   dx=scene.dx, n_particles=scene.n_particles, steps=0, t_end=0.0,
+                   stages={s: 0.0 for s in STAGES}, jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan,
+                   status=status, failed_step=None, threads=threads or 1, steps_requested=scene.n_steps,
+                   scene=scene.as_dict(), message=message, profile_id=profile_id, commit=git_commit(),
+                   versions=package_versions(), preset=preset, host=host_id())
+
     def as_dict(self) -> dict:
         return asdict(self)
 
     @property
     def step_seconds(self) -> float:
         """Mean wall time of one step (SNP + PI + SU), s."""
-        s = self.stages
-        return (s["snp"] + s["pi"] + s["su"]) / max(self.steps, 1)
+        return step_seconds(self.stages, self.steps)
 
     def stage_table(self) -> str:
         """The paper's stage table for this run: total s and ms per step."""

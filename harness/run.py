@@ -13,7 +13,6 @@ from pcabench.solvers.analytic import errors as analytic_errors
 from pcabench.solvers.integrators import step_program
 
 from .clock import clock_for
-from .provenance import git_commit, host_id, package_versions
 from .record import RunRecord
 
 
@@ -27,14 +26,7 @@ def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int | None =
         fields_path=None, progress=None, profile_id: str | None = None) -> RunRecord:
     """Run ``scene`` with ``solver_name``; return its record. Never raises for a failed run."""
     solver = make_solver(solver_name, threads=threads)
-    stages = {s: 0.0 for s in ("input", "init", "snp", "pi", "su", "output")}
-    record = RunRecord(
-        solver=solver_name, precision=scene.precision, model=scene.model,
-        integrator=scene.integrator, dx=scene.dx, n_particles=scene.n_particles, steps=0,
-        t_end=0.0, stages=stages, jit_seconds=0.0, mse=math.nan, me=math.nan,
-        mean_neighbours=math.nan, status="error", failed_step=None, threads=threads or 1,
-        steps_requested=scene.n_steps, scene=scene.as_dict(), profile_id=profile_id or "",
-        commit=git_commit(), versions=package_versions(), host=host_id())
+    record = RunRecord.before_run(scene, solver_name, threads, profile_id=profile_id or "")
     step = 0
     try:
         clock = None

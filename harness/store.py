@@ -15,9 +15,8 @@ from pathlib import Path
 
 
 def run_id(row: dict) -> str:
-    key = [row.get("profile_id"), row.get("commit"), row.get("solver"), row.get("threads"),
-           row.get("scene"), row.get("timestamp")] + ([row["host"]] if row.get("host") else [])
-    key = json.dumps(key, sort_keys=True, default=str)
+    key = json.dumps([row.get("profile_id"), row.get("commit"), row.get("solver"), row.get("threads"),
+                      row.get("scene"), row.get("timestamp"), row.get("host")], sort_keys=True, default=str)
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 

@@ -25,8 +25,8 @@ from pathlib import Path
 
 from pcabench import store
 from pcabench.hardware_profiles import profile_id as this_profile_id
-from pcabench.provenance import git_commit, host_id, package_versions
-from pcabench.record import RunRecord
+from pcabench.provenance import git_commit, host_id
+from pcabench.record import RunRecord, step_seconds
 from pcabench.solvers import Scene, make_solver
 
 RESULTS_DIR = Path("reports/results")
@@ -56,16 +56,9 @@ def _key(spec: dict, profile: str, commit: str, host: str) -> str:
 
 
 def _failed_record(spec, status, message, profile, seconds=None) -> RunRecord:
-    scene = Scene(**spec["scene"])
-    nan = float("nan")
-    return RunRecord(solver=spec["solver"], precision=scene.precision, model=scene.model,
-                     integrator=scene.integrator, dx=scene.dx, n_particles=scene.n_particles, steps=0,
-                     t_end=0.0, stages={s: 0.0 for s in ("input", "init", "snp", "pi", "su", "output")},
-                     jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan, status=status, failed_step=None,
-                     threads=spec.get("threads", 1), steps_requested=scene.n_steps, scene=scene.as_dict(),
-                     message=message if seconds is None else f"{message} (after {seconds:.0f} s)",
-                     profile_id=profile, commit=git_commit(), versions=package_versions(),
-                     preset=spec.get("preset", ""), host=host_id())
+    return RunRecord.before_run(Scene(**spec["scene"]), spec["solver"], spec.get("threads", 1), status=status,
+                                message=message if seconds is None else f"{message} (after {seconds:.0f} s)",
+                                profile_id=profile, preset=spec.get("preset", ""))
 
 
 def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: float,
@@ -125,18 +118,14 @@ def sweep(runs: list[dict], store_path: Path, run_budget: float, sweep_budget: f
         last = store.read_rows(store_path)[-1]
         mine.append(last)
         eta = (time.perf_counter() - t_start) / made * (len(runs) - i)
-        print(f"{label}: {last['status']}, step {1e3 * _step(last):.2f} ms, MSE {_fmt_err(last.get('mse'))}, "
+        step_ms = 1e3 * step_seconds(last["stages"], last["steps"])
+        print(f"{label}: {last['status']}, step {step_ms:.2f} ms, MSE {_fmt_err(last.get('mse'))}, "
               f"{time.perf_counter() - t0:.1f} s (sweep eta <= {eta / 60:.1f} min)", file=stream, flush=True)
     return made
 
 
 def _fmt_err(x):
     return "-" if x is None else f"{x:.4g}"
-
-
-def _step(row):
-    st = row.get("stages") or {}
-    return (st.get("snp", 0) + st.get("pi", 0) + st.get("su", 0)) / max(row.get("steps") or 1, 1)
 
 
 def _scene_kwargs(row: dict) -> dict:

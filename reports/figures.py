@@ -30,13 +30,17 @@ def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, log
 
     fig, axes = plt.subplots(1, ncols, figsize=size or (6 * ncols, 4.2), squeeze=False)
     axes = list(axes[0])
-    for ax in axes:
-        ax.set_xscale("log") if logx else None
-        ax.set_yscale("log") if logy else None
+    for ax in axes:  # scales first: a figure may set its own ticks inside the block
+        if logx:
+            ax.set_xscale("log")
+        if logy:
+            ax.set_yscale("log")
     yield axes
     for ax in axes:
-        ax.set_xlabel(xlabel) if not ax.get_xlabel() else None
-        ax.set_ylabel(ylabel) if not ax.get_ylabel() else None
+        if not ax.get_xlabel():
+            ax.set_xlabel(xlabel)
+        if not ax.get_ylabel():
+            ax.set_ylabel(ylabel)
         ax.grid(True, which="both", alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=6)

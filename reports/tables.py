@@ -11,8 +11,8 @@ import numpy as np
 import pandas as pd
 
 from pcabench import hardware_profiles
+from pcabench.solvers import STAGES
 
-STAGES = ("input", "init", "snp", "pi", "su", "output")
 STEP_STAGES = ("snp", "pi", "su")
 PAPER_SYSTEMS = ("paper-system-1", "paper-system-2", "paper-system-3")
 # The scene's numerics unless a study varies them (Verlet, dt = 0.2 dx, h = 2.13 dx, cutoff 3h).
@@ -33,10 +33,7 @@ def label(r) -> str:
 
 def latest(df: pd.DataFrame) -> pd.DataFrame:
     """One row per configuration and machine, the newest: reruns and overlapping presets count once."""
-    if df.empty:
-        return df
-    return df.sort_values("timestamp").drop_duplicates(["profile_id", "solver", "threads", "scene_key"],
-                                                       keep="last")
+    return df if df.empty else _newest_per(df, ["profile_id", "solver", "threads", "scene_key"])
 
 
 def default_numerics(df: pd.DataFrame) -> pd.DataFrame:
