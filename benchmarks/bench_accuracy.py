@@ -9,7 +9,7 @@ import numpy as np
 
 from .common import Prepared, large
 from pcabench.run import run
-from pcabench.solvers import Scene
+from solvers import Scene
 
 
 class TrackError:

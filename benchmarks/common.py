@@ -21,9 +21,9 @@ import os
 import subprocess
 import sys
 
-from pcabench.solvers import Scene, make_solver
-from pcabench.solvers.analytic import errors as analytic_errors
-from pcabench.solvers.integrators import step_program
+from solvers import Scene, make_solver
+from solvers.analytic import errors as analytic_errors
+from solvers.integrators import step_program
 
 # Particle counts: seconds on a laptop CPU by default; PCABENCH_BENCH_LARGE=1 adds 100K and 400K.
 SMALL_DX = (1.0, 0.5, 0.25)  # 1K, 4K, 16K particles on the paper's domain
@@ -51,7 +51,7 @@ def gpu_available() -> bool:
     if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
         return False
     try:
-        from pcabench.solvers.linkedlist_gpu import device_backend, simulated
+        from solvers.linkedlist_gpu import device_backend, simulated
 
         return not simulated() and device_backend()[1] is not None
     except Exception:  # noqa: BLE001 - no CuPy, no driver, no device
@@ -131,7 +131,7 @@ class StageBenchmarks(abc.ABC):
 
 def jit_seconds_in_fresh_process(solver: str, precision: str) -> float:
     """Compilation time of ``solver`` as a new user meets it: a fresh interpreter, s."""
-    code = ("from pcabench.solvers import Scene, make_solver\n"
+    code = ("from solvers import Scene, make_solver\n"
             f"s = make_solver({solver!r}); s.input(Scene(dx=1.0, precision={precision!r}))\n"
             "print(s.warmup())")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)

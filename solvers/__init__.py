@@ -6,7 +6,7 @@ that the package works with no CUDA library installed.
 from __future__ import annotations
 
 from .interface import STAGES, Fields, Solver, SolverUnavailable
-from .scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
+from .scene import INTEGRATORS, MODELS, NUMERICS, PRECISIONS, Scene, SceneError
 
 SOLVERS = ("allpair-cpu", "linkedlist-cpu", "linkedlist-gpu")
 
@@ -31,4 +31,4 @@ def make_solver(name: str, threads: int | None = None) -> Solver:
 
 
 __all__ = ["Scene", "SceneError", "Solver", "SolverUnavailable", "Fields", "STAGES", "SOLVERS",
-           "MODELS", "INTEGRATORS", "PRECISIONS", "make_solver"]
+           "MODELS", "INTEGRATORS", "PRECISIONS", "NUMERICS", "make_solver"]

@@ -26,6 +26,14 @@ FLOAT_ARRAYS_PER_PARTICLE = 26
 INT_ARRAYS_PER_PARTICLE = 4  # cell id, permutation, sort scratch (int32/int64)
 
 
+# The y-periodic height must hold the kernel support (2 cutoffs) and the cell
+# list's 3-row stencil without seeing a neighbour twice: this many cutoffs.
+STRIP_CUTOFFS = 3.0
+
+# Scene parameters that choose the numerical method rather than the physics.
+NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor")
+
+
 class SceneError(ValueError):
     """A scene parameter is outside its allowed range."""
 
@@ -123,9 +131,7 @@ class Scene:
         if self.strip_height is not None:
             finite("strip_height")
             need(self.strip_height > 0, f"strip_height must be > 0 m (got {self.strip_height})")
-        # The y-periodic height must hold the kernel support (2 cutoffs) and the
-        # cell list's 3-row stencil without seeing a neighbour twice: 3 cutoffs.
-        least = 3.0 * self.cutoff
+        least = STRIP_CUTOFFS * self.cutoff
         need(self.height >= least * (1 - 1e-9),
              f"{'strip_height' if self.strip_height is not None else 'y_max - y_min'} must be at least "
              f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
@@ -216,6 +222,24 @@ class Scene:
     @property
     def height_span(self) -> float:
         return self.strip_height if self.strip_height is not None else self.y_max - self.y_min
+
+    # ------------------------------------------------------------ defaults and rules
+    @classmethod
+    def default(cls, name: str):
+        """The default value of the scene parameter ``name`` (the one place defaults live)."""
+        return cls.__dataclass_fields__[name].default
+
+    @classmethod
+    def thinnest_strip(cls, dx: float, cutoff_factor: float | None = None,
+                       h_factor: float | None = None) -> float:
+        """The thinnest y-periodic strip height the rules accept at ``dx``, in whole rows, m."""
+        cutoff_factor = cls.default("cutoff_factor") if cutoff_factor is None else cutoff_factor
+        h_factor = cls.default("h_factor") if h_factor is None else h_factor
+        return math.ceil(STRIP_CUTOFFS * cutoff_factor * h_factor * (1 + 1e-9)) * dx
+
+    def uses_default_numerics(self) -> bool:
+        """True when integrator, CFL, h/dx and cutoff are the defaults (the paper's method)."""
+        return all(getattr(self, name) == self.default(name) for name in NUMERICS)
 
     # ------------------------------------------------------------ helpers
     def replace(self, **changes) -> "Scene":

@@ -7,7 +7,7 @@ import pytest
 from benchmarks.common import gpu_available
 from pcabench.presets import strip_height
 from pcabench.run import run
-from pcabench.solvers import Scene
+from solvers import Scene
 
 
 def strip_for(dx: float, cutoff_factor: float = 3.0, h_factor: float = 2.13) -> float:

@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from pcabench.solvers import Scene, SceneError
+from solvers import Scene, SceneError
 
 
 def pcabench(*args, timeout=600):

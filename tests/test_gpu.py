@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from pcabench.solvers import Scene, SceneError, SolverUnavailable, make_solver
+from solvers import Scene, SceneError, SolverUnavailable, make_solver
 
 from .conftest import run_fields
 
@@ -23,7 +23,7 @@ SIM_SCRIPT = r"""
 import json, sys, tempfile, numpy as np
 from pathlib import Path
 from pcabench.run import run
-from pcabench.solvers import Scene
+from solvers import Scene
 precision, model, steps = sys.argv[1], sys.argv[2], int(sys.argv[3])
 scene = Scene(dx=1.0, x_min=-8.0, x_max=8.0, steps=steps, model=model, precision=precision)
 out = {}
@@ -65,7 +65,7 @@ def test_simulated_gpu_kernels_match_cpu(precision, model, steps, tol):
 
 
 def test_gpu_solver_without_gpu_says_so(monkeypatch):
-    from pcabench.solvers import linkedlist_gpu
+    from solvers import linkedlist_gpu
 
     if not linkedlist_gpu.simulated():
         try:

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from pcabench.run import run
-from pcabench.solvers import Scene
-from pcabench.solvers.isothermal1d import isothermal_pulse
-from pcabench.solvers.kernel import make_exp_neg_table
+from solvers import Scene
+from solvers.isothermal1d import isothermal_pulse
+from solvers.kernel import make_exp_neg_table
 
 from .conftest import run_fields, strip_for
 
@@ -113,7 +113,7 @@ def test_lagrangian_converges_to_isothermal_not_linear(tmp_path):
 
 
 def test_isothermal_reference_differs_from_linear_pulse_by_5_percent():
-    from pcabench.solvers.analytic import pulse_velocity
+    from solvers.analytic import pulse_velocity
 
     scene = Scene(dx=0.5)
     x, u = isothermal_pulse(scene, 5.0)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pcabench import store
 from pcabench.run import run
-from pcabench.solvers import Scene
+from solvers import Scene
 
 
 def test_append_read_merge_and_torn_line(tmp_path):

@@ -14,7 +14,7 @@ from pcabench import store
 from pcabench.record import RunRecord
 from pcabench.reports import tables as T
 from pcabench.reports import write_reports
-from pcabench.solvers import Scene
+from solvers import Scene
 
 SWEEP = ["--dx", "1", "0.5", "--solver", "linkedlist-cpu", "allpair-cpu", "--steps", "3", "--no-report"]
 
@@ -183,7 +183,7 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
 
 
 def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):
-    from pcabench.hardware_profiles import profile_id
+    from pcabench.profiles import profile_id
     from pcabench.study import sweep
 
     path = tmp_path / "s.jsonl"

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 
 def pytest_benchmark_update_machine_info(config, machine_info):
-    from pcabench.hardware_profiles import capture
+    from pcabench.profiles import capture
 
     machine_info["pcabench_profile"] = capture()
 

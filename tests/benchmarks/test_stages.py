@@ -14,7 +14,7 @@ from __future__ import annotations
 import pytest
 
 from benchmarks.common import Prepared, Unsupported
-from pcabench.hardware_profiles import profile_id
+from pcabench.profiles import profile_id
 
 SOLVERS = ("allpair-cpu", "linkedlist-cpu", "linkedlist-gpu")
 SIZES = (1.0, 0.5)  # 1,000 and 4,000 particles

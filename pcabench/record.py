@@ -4,7 +4,7 @@ from __future__ import annotations
 import datetime as _dt
 from dataclasses import asdict, dataclass, field
 
-from pcabench.solvers import STAGES
+from solvers import STAGES
 
 STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
 

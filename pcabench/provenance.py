@@ -13,7 +13,7 @@ PACKAGES = ("pcabench", "numpy", "numba", "numba-cuda", "cupy-cuda12x", "cupy-cu
 
 
 # The paths whose changes change a run's numbers (git pathspecs from the repository root).
-CODE = (":(top)solvers", ":(top)harness", ":(top)hardware_profiles/*.py", ":(top)pyproject.toml")
+CODE = (":(top)solvers", ":(top)pcabench", ":(top)pyproject.toml")
 
 
 @functools.lru_cache(maxsize=None)

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcabench import hardware_profiles, store
+from pcabench import profiles, store
 from pcabench.presets import INACCURATE_ABOVE
 
 from . import figures as F
@@ -36,7 +36,7 @@ def pct(x) -> str:
 
 
 def _machine(pid: str) -> str:
-    prof = hardware_profiles.stored().get(pid)
+    prof = profiles.stored().get(pid)
     if not prof:
         return "profile not stored"
     cpu = prof.get("cpu") or {}

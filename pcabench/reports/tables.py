@@ -10,8 +10,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from pcabench import hardware_profiles
-from pcabench.solvers import STAGES
+from pcabench import profiles
+from solvers import STAGES
 
 STEP_STAGES = ("snp", "pi", "su")
 PAPER_SYSTEMS = ("paper-system-1", "paper-system-2", "paper-system-3")
@@ -23,7 +23,7 @@ ISOTHERMAL_VS_LINEAR = {5.0: 0.051, 10.0: 0.098}
 
 def published(system: str = "paper-system-1") -> dict:
     """The paper's published numbers for ``system`` (hardware_profiles/paper-system-*.json)."""
-    return hardware_profiles.load(system)["published"]
+    return profiles.load(system)["published"]
 
 
 def label(r) -> str:
@@ -126,7 +126,7 @@ def table6(df_all) -> list[dict]:
 def table6_published() -> list[dict]:
     rows = []
     for system in PAPER_SYSTEMS:
-        prof = hardware_profiles.load(system)
+        prof = profiles.load(system)
         for n, (cpu, gpu, speedup) in prof["published"]["table6"]["rows"].items():
             rows.append({"system": system, "card": prof["gpu"]["name"], "N": int(n), "cpu": cpu, "gpu": gpu,
                          "speedup": speedup})
@@ -350,7 +350,7 @@ def cards(df_all) -> list[dict]:
     gpu = _newest_per(runs[runs.solver == "linkedlist-gpu"], ["profile_id", "precision", "n_particles"])
     rows = []
     for _, r in gpu.sort_values(["n_particles", "profile_id", "precision"]).iterrows():
-        card = (hardware_profiles.stored().get(r.profile_id, {}).get("gpu") or {}).get("name", r.profile_id)
+        card = (profiles.stored().get(r.profile_id, {}).get("gpu") or {}).get("name", r.profile_id)
         rows.append({"profile": r.profile_id, "card": card, "precision": r.precision, "N": int(r.n_particles),
                      "step_ms": 1e3 * r.t_step, **{f"{s}_ms": v for s, v in per_step_ms(r).items()},
                      "ps_per_particle_step": 1e12 * r.t_step / r.n_particles})

@@ -24,10 +24,10 @@ import time
 from pathlib import Path
 
 from pcabench import store
-from pcabench.hardware_profiles import profile_id as this_profile_id
+from pcabench.profiles import profile_id as this_profile_id
 from pcabench.provenance import git_commit, host_id
 from pcabench.record import RunRecord, step_seconds
-from pcabench.solvers import Scene, make_solver
+from solvers import Scene, make_solver
 
 RESULTS_DIR = Path("reports/results")
 
@@ -157,10 +157,10 @@ def runs_from_args(args) -> tuple[str, list[dict]]:
 
 
 def cmd_study(args) -> int:
-    from pcabench import hardware_profiles
+    from pcabench import profiles
     from pcabench.presets import RUN_BUDGET
     from pcabench.reports import write_reports
-    from pcabench.solvers import SceneError
+    from solvers import SceneError
 
     name, runs = runs_from_args(args)
     solvers = {}
@@ -173,8 +173,8 @@ def cmd_study(args) -> int:
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
             raise SceneError(f"{flag} must be > 0 seconds (got {value})")
-    profile = hardware_profiles.capture()
-    hardware_profiles.save(profile)
+    profile = profiles.capture()
+    profiles.save(profile)
     store_path = Path(args.results) / f"{profile['id']}.jsonl"
     print(f"pcabench study ({name}): {len(runs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
           f"store {store_path}", file=sys.stderr, flush=True)
@@ -197,7 +197,7 @@ def cmd_report(args) -> int:
 
 def add_study_commands(sub) -> None:
     from pcabench.cli import _number, _positive_int
-    from pcabench.solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS
+    from solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS
 
     p = sub.add_parser("study", help="run a sweep (each run in its own process) and write the report",
                        description="Run a preset, or the product of the matrix options, one process per run.")

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import math
 
-from pcabench.solvers import Scene, SceneError, make_solver
-from pcabench.solvers.analytic import errors as analytic_errors
-from pcabench.solvers.integrators import step_program
+from solvers import Scene, SceneError, make_solver
+from solvers.analytic import errors as analytic_errors
+from solvers.integrators import step_program
 
 from .clock import clock_for
 from .record import RunRecord

@@ -1,6 +1,6 @@
 """pcabench: benchmarking harness and study suite for SPH acoustics.
 
-Data flow: scene -> solver (pcabench.solvers) -> stage clock (pcabench.clock)
+Data flow: scene -> solver (the package ``solvers``) -> stage clock (pcabench.clock)
 -> run record (pcabench.record) -> results store (pcabench.store)
 -> reports (pcabench.reports).
 """

@@ -17,7 +17,7 @@ import math
 import sys
 import time
 
-from pcabench.solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
+from solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
 
 
 class Progress:
@@ -91,7 +91,7 @@ def scene_from_args(args) -> Scene:
 
 def cmd_run(args) -> int:
     from pcabench.run import run
-    from pcabench.hardware_profiles import profile_id
+    from pcabench.profiles import profile_id
 
     scene = scene_from_args(args)
     if not args.json:
@@ -119,16 +119,16 @@ def cmd_run(args) -> int:
 
 
 def cmd_profile(args) -> int:
-    from pcabench import hardware_profiles
+    from pcabench import profiles
 
-    profile = hardware_profiles.capture(with_gpu=not args.no_gpu)
+    profile = profiles.capture(with_gpu=not args.no_gpu)
     if args.asv:
-        from pcabench.hardware_profiles import asv_machine
+        from pcabench import asv_machine
 
         print(asv_machine.write(profile))
         return 0
     if args.save:
-        path = hardware_profiles.save(profile, args.out)
+        path = profiles.save(profile, args.out)
         print(f"wrote {path}", file=sys.stderr)
     print(json.dumps(profile, indent=2))
     return 0

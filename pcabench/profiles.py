@@ -1,4 +1,10 @@
-"""Capture this machine's hardware profile: CPU, memory, GPU where one exists.
+"""Hardware profiles: capture this machine's (CPU, memory, GPU where one exists), read stored ones.
+
+Stored profiles are data, one JSON file per machine, ``<id>.json``: the
+checkout's ``hardware_profiles/`` (the paper's three systems, marked
+``"source": "published"``, carry its published timings) and the user's own
+(``paths.user_profiles()``), where ``save`` writes. Captured profiles are
+``"source": "measured"``.
 
 GPU details come from CuPy's runtime API when CuPy and a device are present
 (name, memory, compute capability, SM count, clocks, driver and runtime
@@ -8,9 +14,13 @@ marked as datasheet values, not measurements.
 from __future__ import annotations
 
 import functools
+import json
 import os
 import platform
 import re
+from pathlib import Path
+
+from . import paths
 
 # Datasheet peaks for cards we know (FP32/FP64 TFLOP/s without tensor cores, TB/s).
 DATASHEET = {
@@ -118,3 +128,33 @@ def capture(with_gpu: bool = True) -> dict:
         "gpu": gpu,
     }
     return profile
+
+
+def _folders() -> list[Path]:
+    """Where stored profiles are read from, in order (a later folder's profile wins)."""
+    return [p for p in (paths.reference_profiles(), paths.user_profiles()) if p is not None and p.is_dir()]
+
+
+def stored() -> dict:
+    """Every stored profile by id."""
+    out = {}
+    for folder in _folders():
+        out.update({p.stem: json.loads(p.read_text()) for p in sorted(folder.glob("*.json"))})
+    return out
+
+
+def load(pid: str) -> dict:
+    """The stored profile ``pid``; KeyError naming the stored ones if there is none."""
+    profiles = stored()
+    if pid not in profiles:
+        raise KeyError(f"no hardware profile {pid!r}; stored: {', '.join(sorted(profiles)) or 'none'}")
+    return profiles[pid]
+
+
+def save(profile: dict, directory: Path | None = None) -> Path:
+    """Write ``profile`` as ``<id>.json`` into ``directory`` (default: the user's profiles folder)."""
+    directory = Path(directory) if directory else paths.user_profiles()
+    directory.mkdir(parents=True, exist_ok=True)
+    path = directory / f"{profile['id']}.json"
+    path.write_text(json.dumps(profile, indent=2, sort_keys=True) + "\n")
+    return path

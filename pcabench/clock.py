@@ -11,7 +11,7 @@ from __future__ import annotations
 import time
 from collections import defaultdict
 
-from pcabench.solvers.interface import STAGES
+from solvers.interface import STAGES
 
 
 class HostClock:

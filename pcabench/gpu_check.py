@@ -37,7 +37,7 @@ PRECISIONS = ("float32", "float64")
 
 def measure_ceilings(cupy) -> dict:
     """Device-to-device copy bandwidth (bytes read + written) and FP32/FP64 FMA rates."""
-    from pcabench.solvers.linkedlist_gpu import device_backend
+    from solvers.linkedlist_gpu import device_backend
 
     cuda, _ = device_backend()
     out = {}
@@ -101,7 +101,7 @@ def measure_ceilings(cupy) -> dict:
 def compare_with_cpu(dx: float = 0.5, steps: int = 20) -> list[dict]:
     """Max relative difference GPU vs CPU of the final u and drho, every model and precision."""
     from pcabench.run import run
-    from pcabench.solvers import Scene
+    from solvers import Scene
 
     rows = []
     for precision in PRECISIONS:
@@ -127,7 +127,7 @@ def compare_with_cpu(dx: float = 0.5, steps: int = 20) -> list[dict]:
 def timing_sweep(sizes, steps: int, store_path: Path, profile_id: str, models=MODELS) -> list[dict]:
     from pcabench import store
     from pcabench.run import run
-    from pcabench.solvers import Scene
+    from solvers import Scene
 
     rows = []
     for dx in sizes:
@@ -166,7 +166,7 @@ def cpu_peer(sizes, steps: int, store_path: Path, profile_id: str) -> list[dict]
     """linkedlist-cpu, lagrangian float64, one thread and every core, on this GPU's host."""
     from pcabench import store
     from pcabench.run import run
-    from pcabench.solvers import Scene
+    from solvers import Scene
     from pcabench.study import all_cores
 
     rows = []
@@ -224,13 +224,13 @@ def main(argv=None) -> int:
 
 
 def gpu_check(args) -> int:
-    from pcabench import hardware_profiles
-    from pcabench.solvers.linkedlist_gpu import device_backend
+    from pcabench import profiles
+    from solvers.linkedlist_gpu import device_backend
 
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     _cuda, cupy = device_backend()  # raises SolverUnavailable with a clear message
-    profile = hardware_profiles.capture()
+    profile = profiles.capture()
     if cupy is not None:
         profile["measured"] = measure_ceilings(cupy)
     (out / "profile.json").write_text(json.dumps(profile, indent=2) + "\n")
