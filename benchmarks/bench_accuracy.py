@@ -7,9 +7,9 @@ import time
 
 import numpy as np
 
-from .common import Prepared, large
 from pcabench.run import run
-from solvers import Scene
+
+from .common import Prepared, Scene, large, thinnest_strip
 
 
 class TrackError:
@@ -21,8 +21,7 @@ class TrackError:
     timeout = 300
 
     def track_error_t10(self, model, dx):
-        # 20 rows: the thinnest strip the cell list accepts at h = 2.13 dx and a 3h cutoff
-        scene = Scene(dx=dx, t_end=10.0, model=model, strip_height=20 * dx)
+        scene = Scene(dx=dx, t_end=10.0, model=model, strip_height=thinnest_strip(dx))
         record = run(scene, "linkedlist-cpu")
         if record.status != "ok":
             raise RuntimeError(f"{record.status}: {record.message}")

@@ -2,7 +2,9 @@
 
 It lives beside the asv suite, not in the package, because asv benchmarks
 older commits with the suite of the working tree: this file uses only the
-solver interface (Scene, make_solver, step_program, run) that every commit has.
+solver interface (Scene, make_solver, step_program) that every commit has.
+The solvers are the top-level package ``solvers``; commits before the layout
+change had them at ``pcabench.solvers``, so :data:`solvers` is whichever exists.
 
 ``Prepared(solver, precision, dx)`` compiles (outside any timed region), places
 the particles and takes the first step, so that the timed calls are steady
@@ -21,9 +23,25 @@ import os
 import subprocess
 import sys
 
-from solvers import Scene, make_solver
-from solvers.analytic import errors as analytic_errors
-from solvers.integrators import step_program
+from importlib import import_module
+
+try:
+    import solvers
+except ImportError:  # commits before the layout change
+    from pcabench import solvers
+
+Scene, make_solver = solvers.Scene, solvers.make_solver
+analytic_errors = import_module(f"{solvers.__name__}.analytic").errors
+step_program = import_module(f"{solvers.__name__}.integrators").step_program
+
+def thinnest_strip(dx: float) -> float:
+    """The thinnest y-periodic strip Scene accepts at ``dx``, m (older commits: the harness's presets)."""
+    if hasattr(Scene, "thinnest_strip"):
+        return Scene.thinnest_strip(dx)
+    from pcabench.presets import strip_height  # commits before Scene owned the strip rule
+
+    return strip_height(dx)
+
 
 # Particle counts: seconds on a laptop CPU by default; PCABENCH_BENCH_LARGE=1 adds 100K and 400K.
 SMALL_DX = (1.0, 0.5, 0.25)  # 1K, 4K, 16K particles on the paper's domain
@@ -51,7 +69,8 @@ def gpu_available() -> bool:
     if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
         return False
     try:
-        from solvers.linkedlist_gpu import device_backend, simulated
+        gpu = import_module(f"{solvers.__name__}.linkedlist_gpu")
+        device_backend, simulated = gpu.device_backend, gpu.simulated
 
         return not simulated() and device_backend()[1] is not None
     except Exception:  # noqa: BLE001 - no CuPy, no driver, no device
@@ -65,7 +84,7 @@ class Unsupported(Exception):
 class Prepared:
     """One solver at steady state on the paper's scene (or ``scene`` overrides)."""
 
-    def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=None, **scene):
+    def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=1, **scene):
         self.scene = Scene(dx=dx, precision=precision, **{"steps": 100, **scene})
         if solver == "linkedlist-gpu" and not gpu_available():
             raise Unsupported("no CUDA GPU here")
@@ -131,7 +150,7 @@ class StageBenchmarks(abc.ABC):
 
 def jit_seconds_in_fresh_process(solver: str, precision: str) -> float:
     """Compilation time of ``solver`` as a new user meets it: a fresh interpreter, s."""
-    code = ("from solvers import Scene, make_solver\n"
+    code = (f"from {solvers.__name__} import Scene, make_solver\n"
             f"s = make_solver({solver!r}); s.input(Scene(dx=1.0, precision={precision!r}))\n"
             "print(s.warmup())")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)

@@ -1,13 +1,14 @@
-"""The ``pcabench`` command line.
+"""The ``pcabench`` command line: the only module that knows about argparse.
 
     pcabench run --solver linkedlist-cpu --dx 0.1 --t-end 10
-    pcabench profile
-    pcabench study --quick | --paper | --stability
-    pcabench report
+    pcabench study --quick | --paper | --stability | --dx 1 0.5 ...
+    pcabench report [--reference]
+    pcabench profile [--save | --asv]
+    pcabench gpu-check --out DIR
 
 Bad input ends with one line naming the parameter and its allowed range, and
 exit code 2; a run that fails (unstable, out of memory) is reported with its
-status and exit code 1.
+status and exit code 1; a solver that cannot run here (no GPU) exits 3.
 """
 from __future__ import annotations
 
@@ -16,8 +17,33 @@ import json
 import math
 import sys
 import time
+from pathlib import Path
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
+
+from . import __version__, paths
+from .spec import SERIAL, OptionError, RunSpec, parse_threads
+
+SOLVER_HELP = """solvers:
+  allpair-cpu     every pair tested (the paper's all-pair search), serial
+  linkedlist-cpu  uniform cell list (the paper's cellBegin arrays), serial or --threads N|all
+  linkedlist-gpu  the cell list on a CUDA GPU, CuPy + numba-cuda (pip install -e ".[gpu]")
+models:
+  lagrangian  the paper's: particles move, rho = rho0 + drho (isothermal Euler at Ma 0.05)
+  fixed       particles stay on the lattice, rho = rho0 + drho
+  linear      particles stay, coefficients frozen at rho0: exactly the linear wave equation
+integrators:
+  verlet  Stormer-Verlet, second order, no amplitude drift (default)
+  kdk1    one-sweep kick-drift-kick: first order, amplitude grows
+  euler   forward Euler: grows at any dt
+  rk2     explicit midpoint"""
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line naming the option, and exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 class Progress:
@@ -35,8 +61,7 @@ class Progress:
         if now - self.last < self.every and done < total:
             return
         self.last = now
-        rate = (now - self.t0) / max(done, 1)
-        eta = rate * (total - done)
+        eta = (now - self.t0) / max(done, 1) * (total - done)
         self.stream.write(f"\r{self.label}: step {done}/{total} ({100 * done / total:5.1f} %), "
                           f"eta {eta:6.1f} s ")
         if done == total:
@@ -44,61 +69,80 @@ class Progress:
         self.stream.flush()
 
 
-def _positive_int(name):
+# ---------------------------------------------------------------- option types
+def positive_int(name):
     def parse(text):
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1 (got {text!r})")
+            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1 (got {text!r})") from None
         if value < 1:
             raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1 (got {value})")
         return value
     return parse
 
 
-def _number(name):
+def number(name):
     def parse(text):
         try:
             value = float(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})")
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
         if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
         return value
     return parse
 
 
-def add_scene_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--precision", default="float64", choices=PRECISIONS)
-    p.add_argument("--dx", type=_number("--dx"), required=True, help="lattice spacing, m (paper: 1 .. 0.004)")
+def threads_option(text):
+    try:
+        return parse_threads(text)
+    except OptionError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
+    """The scene's options, with Scene's defaults; ``many``: each takes a list (a study's matrix)."""
+    n = {"nargs": "+"} if many else {}
+    d = Scene.default
+    p.add_argument("--dx", type=number("--dx"), required=not many, **n,
+                   help="lattice spacing, m (paper: 1 .. 0.004; 0.1 is 100K particles)")
+    p.add_argument("--precision", choices=PRECISIONS, **n, help=f"default {d('precision')}")
     end = p.add_mutually_exclusive_group()
-    end.add_argument("--steps", type=_positive_int("--steps"), help="number of steps (default 100, the paper's)")
-    end.add_argument("--t-end", type=_number("--t-end"), help="physical end time, s")
-    p.add_argument("--model", default="lagrangian", choices=MODELS)
-    p.add_argument("--integrator", default="verlet", choices=INTEGRATORS)
-    p.add_argument("--strip-height", type=_number("--strip-height"),
-                   help="replace the 20 m height by a y-periodic strip of this height, m")
-    p.add_argument("--cutoff", type=_number("--cutoff"), default=3.0, help="kernel cutoff in units of h (default 3)")
-    p.add_argument("--h-factor", type=_number("--h-factor"), default=2.13, help="h / dx (default 2.13)")
-    p.add_argument("--cfl", type=_number("--cfl"), default=0.2, help="dt * c0 / dx (default 0.2)")
+    end.add_argument("--steps", type=positive_int("--steps"), **n, help="number of steps (default 100, the paper's)")
+    end.add_argument("--t-end", type=number("--t-end"), **n, help="physical end time, s")
+    p.add_argument("--model", choices=MODELS, **n, help=f"default {d('model')}")
+    p.add_argument("--integrator", choices=INTEGRATORS, **n, help=f"default {d('integrator')}")
+    p.add_argument("--cutoff", type=number("--cutoff"), **n,
+                   help=f"kernel cutoff in units of h (default {d('cutoff_factor'):g})")
+    p.add_argument("--h-factor", type=number("--h-factor"), **n, help=f"h / dx (default {d('h_factor'):g})")
+    p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
+    p.add_argument("--threads", type=threads_option, **n,
+                   help="CPU threads for linkedlist-cpu: N or 'all' (default 1: serial, like the paper's CPU code)")
+
+
+SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
+                 "h_factor": "h_factor", "cfl": "cfl"}
 
 
 def scene_from_args(args) -> Scene:
-    return Scene(dx=args.dx, precision=args.precision, model=args.model, integrator=args.integrator,
-                 steps=args.steps, t_end=args.t_end, strip_height=args.strip_height,
-                 cutoff_factor=args.cutoff, h_factor=args.h_factor, cfl=args.cfl)
+    given = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt) is not None}
+    return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height, **given)
 
 
+# ---------------------------------------------------------------- commands
 def cmd_run(args) -> int:
-    from pcabench.run import run
-    from pcabench.profiles import profile_id
+    from .profiles import profile_id
+    from .run import run
+    from .spec import resolve_threads
 
     scene = scene_from_args(args)
+    threads = resolve_threads(args.threads or SERIAL, args.solver)
     if not args.json:
         print(f"pcabench run: {args.solver}, {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
-    record = run(scene, args.solver, threads=args.threads, fields_path=args.fields,
-                 progress=progress, profile_id=profile_id())
+    record = run(scene, args.solver, threads=threads, fields_path=args.fields, progress=progress,
+                 profile_id=profile_id())
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
@@ -118,67 +162,178 @@ def cmd_run(args) -> int:
     return 0 if record.status == "ok" else 1
 
 
+def study_specs(args) -> tuple[str, list[RunSpec]]:
+    """The preset named by the flags, or the matrix built from the scene options."""
+    from .presets import matrix, preset
+
+    if args.dx:
+        lists = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt)}
+        return "matrix", matrix(args.solver or ["linkedlist-cpu"], args.dx, threads=args.threads or [SERIAL],
+                                steps=args.steps or [None], t_ends=args.t_end or [None], strip=args.strip,
+                                **lists)
+    if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads")) or args.strip:
+        raise OptionError("--dx is needed to build a matrix from the scene options (or use a preset alone)")
+    name = "paper" if args.paper else "stability" if args.stability else "quick"
+    return name, preset(name)
+
+
+def check_specs(specs: list[RunSpec]) -> list[RunSpec]:
+    """Every spec resolved and checked by its solver before the first run (exits 2 or 3, not mid-sweep)."""
+    from solvers import make_solver
+
+    resolved, solvers = [], {}
+    for spec in specs:
+        spec = spec.resolved()
+        key = (spec.solver, spec.threads)
+        if key not in solvers:
+            solvers[key] = make_solver(*key)
+        solvers[key].check_scene(spec.scene)
+        resolved.append(spec)
+    return resolved
+
+
+def cmd_study(args) -> int:
+    from . import profiles
+    from .presets import RUN_BUDGET
+    from .reports import write_reports
+    from .sweep import sweep
+
+    name, specs = study_specs(args)
+    check_specs(specs)
+    run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
+    for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
+        if not value > 0:
+            raise OptionError(f"{flag} must be > 0 seconds (got {value})")
+    profile = profiles.capture()
+    profiles.save(profile)
+    store_path = Path(args.results) / f"{profile['id']}.jsonl"
+    print(f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
+          f"store {store_path}", file=sys.stderr, flush=True)
+    sweep(specs, store_path, run_budget, args.sweep_budget)
+    if args.no_report:
+        return 0
+    for p in write_reports(Path(args.results), Path(args.reports)):
+        print(f"wrote {p}", file=sys.stderr)
+    return 0
+
+
+def cmd_report(args) -> int:
+    from .reports import write_reports
+
+    results, reports = args.results, args.out
+    if args.reference:
+        if paths.checkout() is None:
+            raise OptionError("--reference needs a source checkout (its reports/ folder)")
+        results, reports = results or paths.reference_results(), reports or paths.reference_reports()
+    results, reports = results or paths.user_results(), reports or paths.user_reports()
+    for p in write_reports(Path(results), Path(reports)):
+        print(f"wrote {p}", file=sys.stderr)
+    return 0
+
+
 def cmd_profile(args) -> int:
-    from pcabench import profiles
+    from . import profiles
 
     profile = profiles.capture(with_gpu=not args.no_gpu)
     if args.asv:
-        from pcabench import asv_machine
+        from . import asv_machine
 
         print(asv_machine.write(profile))
         return 0
     if args.save:
-        path = profiles.save(profile, args.out)
-        print(f"wrote {path}", file=sys.stderr)
+        print(f"wrote {profiles.save(profile, args.out)}", file=sys.stderr)
     print(json.dumps(profile, indent=2))
     return 0
 
 
 def cmd_gpu_check(args) -> int:
-    from pcabench.gpu_check import main as gpu_main
+    from .gpu_check import gpu_check
 
-    return gpu_main(args.rest)
+    return gpu_check(Path(args.out), Path(args.results), Path(args.reports), sizes=args.sizes, steps=args.steps,
+                     models=args.models, run_tests=not args.skip_tests, compare=not args.skip_compare,
+                     cpu_peer=not args.skip_cpu, only_ceilings=args.only_ceilings, run_budget=args.run_budget)
 
 
+# ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="pcabench", description=__doc__.split("\n")[0])
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser = Parser(prog="pcabench", description=__doc__.split("\n")[0])
+    parser.add_argument("--version", action="version", version=f"pcabench {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    results_help = f"folder of results stores, *.jsonl (default: {paths.user_results()})"
+    reports_help = f"folder for the reports (default: {paths.user_reports()})"
 
-    p = sub.add_parser("run", help="run one scene on one solver and print the stage table")
+    p = sub.add_parser("run", help="run one scene on one solver and print the stage table",
+                       epilog=SOLVER_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--solver", required=True, choices=SOLVERS)
-    add_scene_options(p)
-    p.add_argument("--threads", type=_positive_int("--threads"), help="threads for linkedlist-cpu (default: serial)")
+    add_scene_options(p, many=False)
+    p.add_argument("--strip-height", type=number("--strip-height"),
+                   help="replace the 20 m height by a y-periodic strip of this height, m")
     p.add_argument("--fields", help="write the final fields (x, y, u, v, drho, t) to this .npz")
     p.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.set_defaults(func=cmd_run)
 
+    p = sub.add_parser("study", help="run a sweep (each run in its own process) and write the report",
+                       description="Run a preset, or the product of the matrix options, one process per run.",
+                       epilog=SOLVER_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--quick", action="store_true", help="a few minutes on a laptop CPU (default)")
+    g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets")
+    g.add_argument("--stability", action="store_true",
+                   help="CFL x integrator x h/dx, run length and float32: the stability map")
+    m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
+    m.add_argument("--solver", nargs="+", choices=SOLVERS)
+    add_scene_options(m, many=True)
+    m.add_argument("--strip", action="store_true", help="the thinnest y-periodic strip instead of 20 m")
+    p.add_argument("--results", default=str(paths.user_results()), help=results_help)
+    p.add_argument("--reports", default=str(paths.user_reports()), help=reports_help)
+    p.add_argument("--run-budget", type=number("--run-budget"), help="seconds per run before it is a timeout "
+                   "(default: quick 120, paper 900, stability 120, matrix 900)")
+    p.add_argument("--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0,
+                   help="seconds for the whole sweep")
+    p.add_argument("--no-report", action="store_true", help="store the runs, do not write the reports")
+    p.set_defaults(func=cmd_study)
+
+    p = sub.add_parser("report", help="regenerate the reports from the stored results")
+    p.add_argument("--reference", action="store_true",
+                   help="the committed reference: reports/results -> reports/ of the checkout")
+    p.add_argument("--results", help=results_help)
+    p.add_argument("--out", help=reports_help)
+    p.set_defaults(func=cmd_report)
+
     p = sub.add_parser("profile", help="capture this machine's hardware profile")
-    p.add_argument("--save", action="store_true", help="store it under hardware_profiles/")
-    p.add_argument("--out", help="folder to store it in (default: the package's hardware_profiles/)")
+    p.add_argument("--save", action="store_true", help="store it among the user's profiles")
+    p.add_argument("--out", help=f"folder to store it in (default: {paths.user_profiles()})")
     p.add_argument("--no-gpu", action="store_true")
     p.add_argument("--asv", action="store_true",
                    help="write this machine's entry into ~/.asv-machine.json and print its name (for --machine)")
     p.set_defaults(func=cmd_profile)
 
-    from pcabench.study import add_study_commands
+    from .gpu_check import CPU_DX, GPU_DX, MODELS
 
-    add_study_commands(sub)
-    p = sub.add_parser("gpu-check", add_help=False,
-                       help="on a GPU machine: GPU tests, CPU comparison, timing sweep, profile")
+    p = sub.add_parser("gpu-check", help="on a GPU machine: GPU tests, CPU comparison, timing sweep, profile")
+    p.add_argument("--out", default="gpu_check_out", help="folder for the check's own files (tables, logs)")
+    p.add_argument("--results", default=str(paths.user_results()), help=results_help)
+    p.add_argument("--reports", default=str(paths.user_reports()), help=reports_help)
+    p.add_argument("--sizes", type=number("--sizes"), nargs="+", default=list(GPU_DX), help="dx of the GPU sweep")
+    p.add_argument("--steps", type=positive_int("--steps"), default=100)
+    p.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
+    p.add_argument("--run-budget", type=number("--run-budget"), default=900.0, help="seconds per run")
+    p.add_argument("--skip-tests", action="store_true")
+    p.add_argument("--skip-compare", action="store_true")
+    p.add_argument("--skip-cpu", action="store_true",
+                   help=f"no linkedlist-cpu timings on this host (dx {', '.join(map(str, CPU_DX))})")
+    p.add_argument("--only-ceilings", action="store_true", help="profile and measured ceilings only")
     p.set_defaults(func=cmd_gpu_check)
     return parser
 
 
 def main(argv=None) -> int:
     parser = build_parser()
-    args, rest = parser.parse_known_args(argv)
-    if args.command != "gpu-check" and rest:
-        parser.error(f"unrecognized arguments: {' '.join(rest)}")
-    args.rest = rest
+    args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except SceneError as exc:
+    except (SceneError, OptionError) as exc:
         parser.exit(2, f"pcabench: error: {exc}\n")
     except SolverUnavailable as exc:
         parser.exit(3, f"pcabench: {exc}\n")

@@ -13,32 +13,33 @@
    code) and every core, at dx = 0.1 ... 0.025 for a few steps: Table 6's
    CPU column, so that the speedup compares one machine's CPU and GPU;
 
-and writes DIR/profile.json, DIR/gpu_results.jsonl (run records),
-DIR/gpu_check.md (tables) and DIR/pytest_gpu.log.
+The sweeps of 4 and 5 are ordinary sweeps (``sweep.py``): their runs go to
+the results store like a study's, under preset ``gpu``, and the reports are
+regenerated. DIR gets profile.json, gpu_check.md (tables) and pytest_gpu.log.
 """
 from __future__ import annotations
 
-import argparse
 import json
-import math
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
-PAPER_SIZES = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)
-CPU_SIZES = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
+from solvers import MODELS, PRECISIONS, Scene
+from solvers.linkedlist_gpu import device_backend
+
+from .record import STEP_STAGES, step_seconds
+from .run import run
+from .spec import ALL_CORES, SERIAL, RunSpec
+
+GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles
+CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
 CPU_STEPS = 5
-MODELS = ("lagrangian", "fixed", "linear")
-PRECISIONS = ("float32", "float64")
 
 
 def measure_ceilings(cupy) -> dict:
     """Device-to-device copy bandwidth (bytes read + written) and FP32/FP64 FMA rates."""
-    from solvers.linkedlist_gpu import device_backend
-
     cuda, _ = device_backend()
     out = {}
     n = 512 * 2**20 // 4  # 512 MiB per buffer
@@ -100,9 +101,6 @@ def measure_ceilings(cupy) -> dict:
 
 def compare_with_cpu(dx: float = 0.5, steps: int = 20) -> list[dict]:
     """Max relative difference GPU vs CPU of the final u and drho, every model and precision."""
-    from pcabench.run import run
-    from solvers import Scene
-
     rows = []
     for precision in PRECISIONS:
         for model in MODELS:
@@ -124,65 +122,37 @@ def compare_with_cpu(dx: float = 0.5, steps: int = 20) -> list[dict]:
     return rows
 
 
-def timing_sweep(sizes, steps: int, store_path: Path, profile_id: str, models=MODELS) -> list[dict]:
-    from pcabench import store
-    from pcabench.run import run
-    from solvers import Scene
-
-    rows = []
-    for dx in sizes:
-        for precision in PRECISIONS:
-            for model in models:
-                scene = Scene(dx=dx, steps=steps, model=model, precision=precision,
-                              memory_limit_bytes=2**40)  # the GPU solver checks its own memory
-                t0 = time.perf_counter()
-                rec = run(scene, "linkedlist-gpu", profile_id=profile_id)
-                row = store.append(rec, store_path)
-                step = rec.step_seconds
-                pairs = 2 * rec.n_particles * (rec.mean_neighbours if math.isfinite(rec.mean_neighbours) else 0)
-                st = rec.stages
-                loop = st["snp"] + st["pi"] + st["su"]
-                row_out = {
-                    "dx": dx, "N": rec.n_particles, "precision": precision, "model": model,
-                    "status": rec.status, "step_ms": 1e3 * step,
-                    "snp_pct": 100 * st["snp"] / loop if loop else float("nan"),
-                    "pi_pct": 100 * st["pi"] / loop if loop else float("nan"),
-                    "su_pct": 100 * st["su"] / loop if loop else float("nan"),
-                    "ns_per_particle_step": 1e9 * step / rec.n_particles,
-                    "ps_per_pair": 1e12 * step / pairs if pairs else float("nan"),
-                    "neighbours": rec.mean_neighbours, "mse": rec.mse,
-                    "init_ms": 1e3 * st["init"], "output_ms": 1e3 * st["output"],
-                    "jit_s": rec.jit_seconds, "wall_s": time.perf_counter() - t0,
-                }
-                rows.append(row_out)
-                print(" ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}"
-                               for k, v in row_out.items()), flush=True)
-                if rec.status != "ok":
-                    print(f"   {rec.message.splitlines()[0] if rec.message else ''}", flush=True)
-    return rows
+def gpu_specs(sizes, steps: int, models=MODELS) -> list[RunSpec]:
+    """The GPU timing sweep: linkedlist-gpu on the paper's full domain, every size, precision and model."""
+    return [RunSpec("linkedlist-gpu", Scene(dx=dx, steps=steps, model=model, precision=precision,
+                                            memory_limit_bytes=2**40), preset="gpu")  # the GPU checks its own memory
+            for dx in sizes for precision in PRECISIONS for model in models]
 
 
-def cpu_peer(sizes, steps: int, store_path: Path, profile_id: str) -> list[dict]:
-    """linkedlist-cpu, lagrangian float64, one thread and every core, on this GPU's host."""
-    from pcabench import store
-    from pcabench.run import run
-    from solvers import Scene
-    from pcabench.study import all_cores
-
-    rows = []
-    for dx in sizes:
-        for threads in sorted({1, all_cores()}):
-            rec = run(Scene(dx=dx, steps=steps), "linkedlist-cpu", threads=threads, profile_id=profile_id)
-            store.append(rec, store_path)
-            rows.append({"dx": dx, "N": rec.n_particles, "threads": threads, "status": rec.status,
-                         "step_ms": 1e3 * rec.step_seconds})
-            print(f"cpu dx={dx} N={rec.n_particles} threads={threads}: {rec.status}, "
-                  f"{1e3 * rec.step_seconds:.1f} ms per step", flush=True)
-    return rows
+def cpu_peer_specs() -> list[RunSpec]:
+    """linkedlist-cpu, lagrangian float64, one thread and every core, on this GPU's host: Table 6's CPU column."""
+    return [RunSpec("linkedlist-cpu", Scene(dx=dx, steps=CPU_STEPS), threads, preset="gpu")
+            for dx in CPU_DX for threads in (SERIAL, ALL_CORES)]
 
 
-def markdown(profile, compare_rows, timing_rows, steps, cpu_rows=()) -> str:
+def timing_row(row: dict) -> dict:
+    """One stored GPU run as the check's table row: step time, stage shares, ns per particle-step, ps per pair."""
+    st, steps, n = row["stages"], max(row["steps"] or 0, 1), row["n_particles"]
+    step = step_seconds(st, steps)
+    loop = step * steps
+    pairs = 2 * n * (row.get("mean_neighbours") or 0)  # both sweeps of a Verlet step
+    share = {s: 100 * st[s] / loop if loop else float("nan") for s in STEP_STAGES}
+    return {"dx": row["dx"], "N": n, "precision": row["precision"], "model": row["model"], "status": row["status"],
+            "step_ms": 1e3 * step, **{f"{s}_pct": share[s] for s in STEP_STAGES},
+            "ns_per_particle_step": 1e9 * step / n, "ps_per_pair": 1e12 * step / pairs if pairs else float("nan"),
+            "neighbours": row.get("mean_neighbours") or float("nan"),
+            "mse": row.get("mse") if row.get("mse") is not None else float("nan"),
+            "init_ms": 1e3 * st["init"], "output_ms": 1e3 * st["output"]}
+
+
+def markdown(profile, compare_rows, gpu_rows, steps, cpu_rows=()) -> str:
     g = profile.get("gpu") or {}
+    timing_rows = [timing_row(r) for r in gpu_rows]
     lines = [f"# GPU check: {g.get('name', '?')} ({profile['id']})", "",
              f"Measured ceilings: {json.dumps(profile.get('measured', {}))}", "",
              "## GPU vs linkedlist-cpu (max relative difference after the steps shown)", "",
@@ -204,54 +174,46 @@ def markdown(profile, compare_rows, timing_rows, steps, cpu_rows=()) -> str:
     if cpu_rows:
         lines += ["", "## linkedlist-cpu on this host (lagrangian, float64)", "",
                   "| dx | N | threads | status | step (ms) |", "|---|---|---|---|---|"]
-        lines += [f"| {r['dx']} | {r['N']:,} | {r['threads']} | {r['status']} | {r['step_ms']:.1f} |"
-                  for r in cpu_rows]
+        lines += [f"| {r['dx']} | {r['n_particles']:,} | {r['threads']} | {r['status']} | "
+                  f"{1e3 * step_seconds(r['stages'], r['steps']):.1f} |" for r in cpu_rows]
     return "\n".join(lines) + "\n"
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="pcabench gpu-check", description=__doc__.split("\n")[0])
-    parser.add_argument("--out", default="gpu_check_out", help="folder for the results")
-    parser.add_argument("--sizes", type=float, nargs="+", default=list(PAPER_SIZES))
-    parser.add_argument("--steps", type=int, default=100)
-    parser.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
-    parser.add_argument("--skip-tests", action="store_true")
-    parser.add_argument("--skip-compare", action="store_true")
-    parser.add_argument("--skip-cpu", action="store_true", help="no linkedlist-cpu timings on this host")
-    parser.add_argument("--only-ceilings", action="store_true", help="profile and measured ceilings only")
-    args = parser.parse_args(argv)
-    return gpu_check(args)
+def gpu_check(out: Path, results: Path, reports: Path, sizes=GPU_DX, steps: int = 100, models=MODELS,
+              run_tests: bool = True, compare: bool = True, cpu_peer: bool = True, only_ceilings: bool = False,
+              run_budget: float = 900.0) -> int:
+    """Profile and ceilings, GPU tests, GPU-vs-CPU comparison, then the GPU (and CPU-peer) sweep and reports.
 
+    The sweep is an ordinary sweep (one child process per run, the same store,
+    resume and report code as ``pcabench study``); its runs carry preset ``gpu``.
+    """
+    from . import profiles
+    from .reports import write_reports
+    from .sweep import sweep
 
-def gpu_check(args) -> int:
-    from pcabench import profiles
-    from solvers.linkedlist_gpu import device_backend
-
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     _cuda, cupy = device_backend()  # raises SolverUnavailable with a clear message
     profile = profiles.capture()
     if cupy is not None:
         profile["measured"] = measure_ceilings(cupy)
+    profiles.save(profile)
     (out / "profile.json").write_text(json.dumps(profile, indent=2) + "\n")
     print(json.dumps(profile, indent=1), flush=True)
-    if args.only_ceilings:
+    if only_ceilings:
         return 0
     rc = 0
-    if not args.skip_tests:
+    if run_tests:
         with open(out / "pytest_gpu.log", "w") as log:
             rc = subprocess.run([sys.executable, "-m", "pytest", "-m", "gpu", "-q", "tests"],
                                 stdout=log, stderr=subprocess.STDOUT).returncode
         print(f"pytest -m gpu: exit {rc} (log in {out / 'pytest_gpu.log'})", flush=True)
-    compare_rows = [] if args.skip_compare else compare_with_cpu()
-    timing_rows = timing_sweep(args.sizes, args.steps, out / "gpu_results.jsonl", profile["id"],
-                               models=args.models)
-    cpu_rows = [] if args.skip_cpu else cpu_peer(CPU_SIZES, CPU_STEPS, out / "gpu_results.jsonl", profile["id"])
-    text = markdown(profile, compare_rows, timing_rows, args.steps, cpu_rows)
+    compare_rows = compare_with_cpu() if compare else []
+    store_path = results / f"{profile['id']}.jsonl"
+    gpu_rows = sweep(gpu_specs(sizes, steps, models), store_path, run_budget, sweep_budget=24 * 3600.0)
+    cpu_rows = sweep(cpu_peer_specs(), store_path, run_budget, sweep_budget=24 * 3600.0) if cpu_peer else []
+    text = markdown(profile, compare_rows, gpu_rows, steps, cpu_rows)
     (out / "gpu_check.md").write_text(text)
     print(text, flush=True)
+    for p in write_reports(results, reports):
+        print(f"wrote {p}", file=sys.stderr)
     return rc
-
-
-if __name__ == "__main__":
-    sys.exit(main())

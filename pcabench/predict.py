@@ -13,25 +13,25 @@ import math
 
 import numpy as np
 
-from pcabench.record import step_seconds
+from .record import step_seconds
 
 ORDER = {"allpair-cpu": 2.0}  # the default is 1.0: the cell list is linear in N
 START_UP = 5.0  # s: a child process, imports and JIT on a tiny scene (measured 3-7 s on a laptop CPU)
 
 
-def _same_config(row: dict, spec: dict, scene) -> bool:
-    rs = row.get("scene") or {}
-    return (row.get("status") == "ok" and row.get("solver") == spec["solver"]
-            and int(row.get("threads") or 1) == int(spec.get("threads") or 1)
+def _same_config(row: dict, spec) -> bool:
+    rs, scene = row.get("scene") or {}, spec.scene
+    return (row.get("status") == "ok" and row.get("solver") == spec.solver
+            and int(row.get("threads") or 1) == int(spec.threads)
             and rs.get("precision") == scene.precision and rs.get("model") == scene.model
             and (row.get("steps") or 0) > 0)
 
 
-def step_model(spec: dict, scene, rows: list[dict]):
+def step_model(spec, rows: list[dict]):
     """``(a, b, sizes)`` of the fitted step time ``a * N**b`` (s), or None without data."""
     pts = {}
     for row in rows:
-        if _same_config(row, spec, scene):
+        if _same_config(row, spec):
             pts.setdefault(int(row["n_particles"]), []).append(step_seconds(row["stages"], row["steps"]))
     pts = {n: float(np.median(v)) for n, v in pts.items() if n > 0 and min(v) > 0}
     if not pts:
@@ -40,16 +40,17 @@ def step_model(spec: dict, scene, rows: list[dict]):
     t = np.array([pts[k] for k in sorted(pts)])
     if len(n) >= 2:
         b = float(np.polyfit(np.log(n[-3:]), np.log(t[-3:]), 1)[0])  # the three largest sizes
-        b = max(b, ORDER.get(spec["solver"], 1.0) * 0.5)  # never extrapolate flatter than half the order
+        b = max(b, ORDER.get(spec.solver, 1.0) * 0.5)  # never extrapolate flatter than half the order
     else:
-        b = ORDER.get(spec["solver"], 1.0)
+        b = ORDER.get(spec.solver, 1.0)
     a = float(t[-1] / n[-1] ** b)
     return a, b, [int(k) for k in n]
 
 
-def predicted_seconds(spec: dict, scene, rows: list[dict]):
-    """``(seconds, why)`` for ``spec`` from ``rows`` of this machine, or ``(None, "")`` without data."""
-    model = step_model(spec, scene, rows)
+def predicted_seconds(spec, rows: list[dict]):
+    """``(seconds, why)`` for the RunSpec ``spec`` from ``rows`` of this machine, or ``(None, "")`` without data."""
+    scene = spec.scene
+    model = step_model(spec, rows)
     if model is None:
         return None, ""
     a, b, sizes = model

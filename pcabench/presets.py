@@ -1,13 +1,17 @@
 """Study matrices: the presets and the matrix built from command-line options.
 
-A run spec is a dict ``{"solver", "threads", "scene": Scene kwargs}``. Each
-preset lists the runs its tables and figures need, smallest first, so that a
-sweep can predict the cost of a large run from the smaller ones before it.
+Each preset lists the runs (:class:`~pcabench.spec.RunSpec`) its tables and
+figures need, smallest first, so that a sweep can predict the cost of a large
+run from the smaller ones before it. Scene defaults (h/dx, CFL, cutoff, integrator, the strip
+rule) come from :class:`solvers.Scene`, never from here.
 """
 from __future__ import annotations
 
 import itertools
-import math
+
+from solvers import Scene
+
+from .spec import ALL_CORES, SERIAL, RunSpec
 
 # Seconds per run before it is recorded as a timeout, by preset (--run-budget overrides).
 RUN_BUDGET = {"quick": 120.0, "paper": 900.0, "stability": 120.0, "matrix": 900.0}
@@ -22,19 +26,15 @@ STABILITY_H = (1.0, 1.3)  # h/dx beside the default 2.13
 INACCURATE_ABOVE = 0.20
 
 
-def strip_height(dx: float, cutoff_factor: float = 3.0, h_factor: float = 2.13) -> float:
-    """The thinnest y-periodic strip the cell list accepts at ``dx`` (whole rows), m."""
-    return math.ceil(3 * cutoff_factor * h_factor * (1 + 1e-9)) * dx
-
-
-def _spec(solver="linkedlist-cpu", threads=1, strip=False, **scene) -> dict:
+def _spec(solver="linkedlist-cpu", threads=SERIAL, strip=False, **scene) -> RunSpec:
+    """One run; ``strip`` puts it on the thinnest y-periodic strip Scene accepts."""
     if strip:
-        scene["strip_height"] = strip_height(scene["dx"], scene.get("cutoff_factor", 3.0),
-                                             scene.get("h_factor", 2.13))
-    return {"solver": solver, "threads": threads, "scene": scene}
+        scene["strip_height"] = Scene.thinnest_strip(scene["dx"], scene.get("cutoff_factor"),
+                                                     scene.get("h_factor"))
+    return RunSpec(solver, Scene(**scene), threads)
 
 
-def quick() -> list[dict]:
+def quick() -> list[RunSpec]:
     """A few minutes on a laptop CPU: every table and figure at small N."""
     runs = []
     # Table 4/5, Figs. 10, 11, 13: the paper's scene (lagrangian, full domain)
@@ -56,12 +56,12 @@ def quick() -> list[dict]:
     return runs
 
 
-def paper() -> list[dict]:
+def paper() -> list[RunSpec]:
     """The paper's CPU matrix (Tables 4-6, Figs. 8-14), as far as the budgets allow."""
     runs = []
     for dx in (1.0, 0.5, 0.25, 0.2, 0.1, 0.05, 0.025):  # 1K .. 1.6M; Table 6 at 25K/100K/400K
         runs.append(_spec(dx=dx, steps=100))
-        runs.append(_spec(dx=dx, steps=100, threads=0))  # 0: every core this machine has
+        runs.append(_spec(dx=dx, steps=100, threads=ALL_CORES))
     # Fig. 9 (the paper's 10th step, 1K .. 256K)
     for dx in (1.0, 0.5, 0.25, 0.125, 0.0625):
         runs.append(_spec(dx=dx, steps=10))
@@ -69,15 +69,15 @@ def paper() -> list[dict]:
     for model in ("linear", "fixed", "lagrangian"):
         for precision in ("float64", "float32"):
             for dx in (0.4, 0.2, 0.1, 0.05, 0.025):
-                runs.append(_spec(threads=0, dx=dx, t_end=10.0, model=model, precision=precision, strip=True))
+                runs.append(_spec(threads=ALL_CORES, dx=dx, t_end=10.0, model=model, precision=precision, strip=True))
             for dx in (0.1, 0.05, 0.01, 0.004):
-                runs.append(_spec(threads=0, dx=dx, steps=100, model=model, precision=precision, strip=True))
+                runs.append(_spec(threads=ALL_CORES, dx=dx, steps=100, model=model, precision=precision, strip=True))
         for dx in (0.2, 0.1):
-            runs.append(_spec(threads=0, dx=dx, t_end=10.0, model=model))
+            runs.append(_spec(threads=ALL_CORES, dx=dx, t_end=10.0, model=model))
     return runs
 
 
-def stability() -> list[dict]:
+def stability() -> list[RunSpec]:
     """Where methods fail: CFL x integrator, CFL x h/dx, run length, float32 at small dx."""
     runs = []
     base = dict(dx=STABILITY_DX, model="linear", strip=True)
@@ -96,27 +96,35 @@ def stability() -> list[dict]:
     # float32 against float64 at the paper's protocol down to its smallest dx
     for dx in (0.04, 0.01, 0.004):
         for precision in ("float64", "float32"):
-            runs.append(_spec(threads=0, dx=dx, steps=100, model="lagrangian", precision=precision, strip=True))
+            runs.append(_spec(threads=ALL_CORES, dx=dx, steps=100, model="lagrangian", precision=precision, strip=True))
     return runs
 
 
 PRESETS = {"quick": quick, "paper": paper, "stability": stability}
 
 
-def preset(name: str) -> list[dict]:
-    """The run matrix of preset ``name``, each spec tagged with the preset's name."""
+def preset(name: str) -> list[RunSpec]:
+    """The run matrix of preset ``name``, each spec carrying the preset's name."""
     if name not in PRESETS:
         raise ValueError(f"preset must be one of {', '.join(PRESETS)} (got {name!r})")
-    return [dict(spec, preset=name) for spec in PRESETS[name]()]
+    return [RunSpec(s.solver, s.scene, s.threads, name) for s in PRESETS[name]()]
 
 
-def matrix(solvers, dxs, precisions=("float64",), models=("lagrangian",), integrators=("verlet",),
-           cfls=(0.2,), h_factors=(2.13,), steps=None, t_end=None, strip=False, threads=1) -> list[dict]:
-    """The product of the options, smallest N first, as run specs tagged ``matrix``."""
+def matrix(solvers=("linkedlist-cpu",), dxs=(), threads=(SERIAL,), steps=(None,), t_ends=(None,),
+           strip=False, **scene_lists) -> list[RunSpec]:
+    """The product of the option lists, smallest N first, as run specs of preset ``matrix``.
+
+    ``scene_lists`` maps Scene parameters (precision, model, integrator, cfl,
+    h_factor, cutoff_factor) to lists; a parameter not given keeps Scene's
+    default. ``steps`` and ``t_ends`` are lists too (give one of them; neither
+    means the paper's 100 steps).
+    """
+    names = sorted(scene_lists)
+    ends = [{"steps": n} for n in steps if n] + [{"t_end": t} for t in t_ends if t] or [{}]
     runs = []
-    for solver, dx, precision, model, integrator, cfl, h in itertools.product(
-            solvers, sorted(dxs, reverse=True), precisions, models, integrators, cfls, h_factors):
-        scene = dict(dx=dx, precision=precision, model=model, integrator=integrator, cfl=cfl, h_factor=h)
-        scene.update({"steps": steps} if steps else {"t_end": t_end} if t_end else {"steps": 100})
-        runs.append(dict(_spec(solver, threads=threads, strip=strip, **scene), preset="matrix"))
+    for solver, dx, nthreads, end, *values in itertools.product(
+            solvers, sorted(dxs, reverse=True), threads, ends, *(scene_lists[k] for k in names)):
+        scene = dict(zip(names, values), dx=dx, **end)
+        spec = _spec(solver, threads=nthreads, strip=strip, **scene)
+        runs.append(RunSpec(spec.solver, spec.scene, spec.threads, "matrix"))
     return runs

@@ -7,11 +7,12 @@ from dataclasses import asdict, dataclass, field
 from solvers import STAGES
 
 STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
+STEP_STAGES = ("snp", "pi", "su")  # the stages of a time step; input, init and output happen once per run
 
 
 def step_seconds(stages: dict, steps: int) -> float:
     """Mean wall time of one step (SNP + PI + SU) from total stage times, s."""
-    return (stages["snp"] + stages["pi"] + stages["su"]) / max(steps or 0, 1)
+    return sum(stages[s] for s in STEP_STAGES) / max(steps or 0, 1)
 
 
 @dataclass
@@ -48,7 +49,7 @@ class RunRecord:
                 "stages", "jit_seconds", "mse", "me", "mean_neighbours", "status", "failed_step")
 
     @classmethod
-    def before_run(cls, scene, solver: str, threads, status: str = "error", message: str = "",
+    def before_run(cls, scene, solver: str, threads: int = 1, status: str = "error", message: str = "",
                    profile_id: str = "", preset: str = "") -> "RunRecord":
         """The record of ``scene`` on ``solver`` before any step: no times, no errors, provenance filled."""
         from .provenance import git_commit, host_id, package_versions
@@ -57,7 +58,7 @@ class RunRecord:
         return cls(solver=solver, precision=scene.precision, model=scene.model, integrator=scene.integrator,
                    dx=scene.dx, n_particles=scene.n_particles, steps=0, t_end=0.0,
                    stages={s: 0.0 for s in STAGES}, jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan,
-                   status=status, failed_step=None, threads=threads or 1, steps_requested=scene.n_steps,
+                   status=status, failed_step=None, threads=int(threads), steps_requested=scene.n_steps,
                    scene=scene.as_dict(), message=message, profile_id=profile_id, commit=git_commit(),
                    versions=package_versions(), preset=preset, host=host_id())
 
@@ -72,11 +73,11 @@ class RunRecord:
     def stage_table(self) -> str:
         """The paper's stage table for this run: total s and ms per step."""
         lines = [f"{'stage':<8}{'total (s)':>12}{'per step (ms)':>16}{'share of step':>15}"]
-        step_total = sum(self.stages[s] for s in ("snp", "pi", "su")) or float("nan")
-        for s in ("input", "init", "snp", "pi", "su", "output"):
-            per = 1e3 * self.stages[s] / max(self.steps, 1) if s in ("snp", "pi", "su") else float("nan")
-            share = f"{100 * self.stages[s] / step_total:13.1f} %" if s in ("snp", "pi", "su") else ""
-            per_txt = f"{per:16.3f}" if s in ("snp", "pi", "su") else f"{'':16}"
+        step_total = sum(self.stages[s] for s in STEP_STAGES) or float("nan")
+        for s in STAGES:
+            per = 1e3 * self.stages[s] / max(self.steps, 1) if s in STEP_STAGES else float("nan")
+            share = f"{100 * self.stages[s] / step_total:13.1f} %" if s in STEP_STAGES else ""
+            per_txt = f"{per:16.3f}" if s in STEP_STAGES else f"{'':16}"
             lines.append(f"{s:<8}{self.stages[s]:12.4f}{per_txt}{share:>15}")
         lines.append(f"{'jit':<8}{self.jit_seconds:12.4f}   (compilation, outside the timed stages)")
         return "\n".join(lines)

@@ -22,7 +22,7 @@ def _is_oom(exc: BaseException) -> bool:
         or "cudaerrormemoryallocation" in text
 
 
-def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int | None = None,
+def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int = 1,
         fields_path=None, progress=None, profile_id: str | None = None) -> RunRecord:
     """Run ``scene`` with ``solver_name``; return its record. Never raises for a failed run."""
     solver = make_solver(solver_name, threads=threads)

@@ -13,6 +13,8 @@ import math
 import os
 from pathlib import Path
 
+from .record import STEP_STAGES
+
 
 def run_id(row: dict) -> str:
     key = json.dumps([row.get("profile_id"), row.get("commit"), row.get("solver"), row.get("threads"),
@@ -28,11 +30,16 @@ def _clean(value):
     return value
 
 
+def to_row(record) -> dict:
+    """The stored form of a run record (a RunRecord or dict): JSON-safe (NaN as null), with its run_id."""
+    row = _clean(record.as_dict() if hasattr(record, "as_dict") else dict(record))
+    row.setdefault("run_id", run_id(row))
+    return row
+
+
 def append(record, path) -> dict:
     """Append one run record (a RunRecord or dict) to the store at ``path``; returns the row."""
-    row = record.as_dict() if hasattr(record, "as_dict") else dict(record)
-    row = _clean(row)
-    row.setdefault("run_id", run_id(row))
+    row = to_row(record)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     line = json.dumps(row, sort_keys=True) + "\n"
@@ -89,6 +96,7 @@ def load(paths):
         flat.append(r)
     df = pd.DataFrame(flat)
     if not df.empty:
-        df["t_step"] = (df["t_snp"] + df["t_pi"] + df["t_su"]) / df["steps"].clip(lower=1)
-        df["t_solution"] = df["t_init"] + df["t_snp"] + df["t_pi"] + df["t_su"]  # s, without JIT and I/O
+        step_total = sum(df[f"t_{s}"] for s in STEP_STAGES)
+        df["t_step"] = step_total / df["steps"].clip(lower=1)
+        df["t_solution"] = df["t_init"] + step_total  # s, without JIT and I/O
     return df

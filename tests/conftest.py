@@ -5,17 +5,13 @@ import numpy as np
 import pytest
 
 from benchmarks.common import gpu_available
-from pcabench.presets import strip_height
 from pcabench.run import run
 from solvers import Scene
 
-
-def strip_for(dx: float, cutoff_factor: float = 3.0, h_factor: float = 2.13) -> float:
-    """The thinnest y-periodic strip the cell list accepts at ``dx``, m (whole rows)."""
-    return strip_height(dx, cutoff_factor, h_factor)
+strip_for = Scene.thinnest_strip  # the thinnest y-periodic strip the cell list accepts at dx, m
 
 
-def run_fields(scene: Scene, solver: str, tmp_path, threads=None):
+def run_fields(scene: Scene, solver: str, tmp_path, threads=1):
     path = tmp_path / f"{solver}-{threads}-{scene.precision}-{scene.model}.npz"
     record = run(scene, solver, threads=threads, fields_path=path)
     fields = dict(np.load(path)) if path.exists() else None

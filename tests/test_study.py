@@ -93,7 +93,7 @@ def fixture_rows():
     rows.append(row(solver="allpair-cpu", status="skipped", dx=0.25, message="predicted 999 s > run budget"))
     # Fig. 8: linear errors exactly second order; lagrangian stops falling at dx = 0.2
     for dx in (0.4, 0.2, 0.1, 0.05):
-        h = 20 * dx
+        h = Scene.thinnest_strip(dx)
         rows.append(row(model="linear", mse=0.016 * (dx / 0.1) ** 2, dx=dx, t_end=10.0, strip_height=h))
         rows.append(row(model="linear", precision="float32", mse=0.016 * (dx / 0.1) ** 2 * (3 if dx == 0.05 else 1),
                         dx=dx, t_end=10.0, strip_height=h, step_ms=(0.5, 2.0, 0.05)))
@@ -184,12 +184,13 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
 
 def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):
     from pcabench.profiles import profile_id
-    from pcabench.study import sweep
+    from pcabench.spec import RunSpec
+    from pcabench.sweep import sweep
 
     path = tmp_path / "s.jsonl"
     for dx, ms in ((1.0, 10.0), (0.5, 160.0)):  # all-pair: 16x per 4x particles
         store.append(row(profile=profile_id(), solver="allpair-cpu", step_ms=(ms, 0, 0), dx=dx, steps=10), path)
-    spec = {"solver": "allpair-cpu", "threads": 1, "scene": {"dx": 0.125, "steps": 10}}
+    spec = RunSpec("allpair-cpu", Scene(dx=0.125, steps=10))
     t0 = time.perf_counter()
     sweep([spec], path, run_budget=60.0, sweep_budget=600.0)
     assert time.perf_counter() - t0 < 10  # no child process ran the 64K all-pair
@@ -199,9 +200,10 @@ def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):
 
 
 def test_a_run_cut_by_the_sweep_budget_is_not_stored(tmp_path):
-    from pcabench.study import sweep
+    from pcabench.spec import RunSpec
+    from pcabench.sweep import sweep
 
     path = tmp_path / "s.jsonl"
-    spec = {"solver": "linkedlist-cpu", "threads": 1, "scene": {"dx": 0.5, "steps": 50}}
+    spec = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=50))
     sweep([spec], path, run_budget=600.0, sweep_budget=0.5)  # the child cannot even compile in 0.5 s
     assert not path.exists() or store.read_rows(path) == []  # a rerun must run it, not find a false timeout

@@ -13,6 +13,7 @@ import numpy as np
 
 from pcabench import profiles, store
 from pcabench.presets import INACCURATE_ABOVE
+from solvers import Scene
 
 from . import figures as F
 from . import tables as T
@@ -197,7 +198,7 @@ def _section_stability(df) -> list[str]:
                              + (f" ({pct(lim['first_failure'][3])})" if lim["first_failure"][1] == "inaccurate"
                                 else "")] for lim in limits]), ""]
         for lim in limits:
-            if lim["h_factor"] == 2.13 and lim["precision"] == "float64" and len(lim["cfls"]) > 3:
+            if lim["h_factor"] == Scene.default("h_factor") and lim["precision"] == "float64" and len(lim["cfls"]) > 3:
                 unb = lim["first_unbounded"]
                 lines.append(f"- **{lim['integrator']}** ({lim['protocol']}): stays bounded up to CFL "
                              f"{fmt(lim['bounded_up_to'], 'g') if lim['bounded_up_to'] else 'none of those run'}"

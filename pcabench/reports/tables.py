@@ -11,12 +11,12 @@ import numpy as np
 import pandas as pd
 
 from pcabench import profiles
-from solvers import STAGES
+from pcabench.record import STEP_STAGES
+from solvers import NUMERICS, STAGES, Scene
 
-STEP_STAGES = ("snp", "pi", "su")
 PAPER_SYSTEMS = ("paper-system-1", "paper-system-2", "paper-system-3")
-# The scene's numerics unless a study varies them (Verlet, dt = 0.2 dx, h = 2.13 dx, cutoff 3h).
-DEFAULT_NUMERICS = {"integrator": "verlet", "cfl": 0.2, "h_factor": 2.13, "cutoff_factor": 3.0}
+# The scene's numerics unless a study varies them (Scene's defaults: Verlet, CFL, h/dx, cutoff).
+DEFAULT_NUMERICS = {name: Scene.default(name) for name in NUMERICS}
 # The exact isothermal solution at Ma = 0.05 against the linear pulse (design 1b; solvers/isothermal1d.py).
 ISOTHERMAL_VS_LINEAR = {5.0: 0.051, 10.0: 0.098}
 

@@ -1,0 +1,29 @@
+"""A sweep's child process: run one spec and print its record as one JSON line on stdout.
+
+    python -m pcabench.child '<RunSpec JSON>'
+
+The child never writes the store: the sweep (its parent) is the only writer,
+so a progress line always reports the record this child made.
+"""
+from __future__ import annotations
+
+import json
+import sys
+
+from .profiles import profile_id
+from .run import run
+from .spec import RunSpec
+from .store import to_row
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    spec = RunSpec.from_json(argv[0]).resolved()
+    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id())
+    record.preset = spec.preset
+    print(json.dumps(to_row(record), sort_keys=True), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,142 @@
+"""The run specification: what one run is (solver, threads, scene, preset), and when two runs are the same.
+
+A :class:`RunSpec` is a typed value. It travels to a sweep's child process as
+JSON (:meth:`RunSpec.to_json` / :meth:`RunSpec.from_json`), and
+:func:`identity` is the one definition of "the same run" used by the store,
+the resume logic and the reports.
+
+The thread policy lives here and nowhere else: ``threads`` is an integer >= 1
+(1 is serial, the paper's CPU code) or ``"all"`` (every core this process may
+use, for ``linkedlist-cpu``), resolved to an integer by :func:`resolve_threads`.
+"""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass
+
+from solvers import SOLVERS, Scene
+
+SERIAL = 1
+ALL_CORES = "all"
+THREADED = ("linkedlist-cpu",)  # solvers that run on more than one CPU thread
+
+
+class OptionError(ValueError):
+    """A harness option (not a scene parameter) is outside its allowed range."""
+
+
+def usable_cores() -> int:
+    """Threads ``"all"`` means: the cores this process may run on, within numba's thread limit."""
+    import numba
+
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return max(1, min(usable, numba.config.NUMBA_NUM_THREADS))
+
+
+def parse_threads(text) -> int | str:
+    """``--threads`` as given: an integer >= 1 or ``all``. OptionError names the option."""
+    if isinstance(text, str) and text.strip().lower() == ALL_CORES:
+        return ALL_CORES
+    try:
+        value = int(text)
+    except (TypeError, ValueError):
+        raise OptionError(f"--threads must be an integer >= 1 or 'all' (got {text!r})") from None
+    if value < 1:
+        raise OptionError(f"--threads must be an integer >= 1 or 'all' (got {value})")
+    return value
+
+
+def resolve_threads(threads, solver: str) -> int:
+    """The thread count for ``solver``: ``"all"`` becomes every usable core (1 for serial solvers).
+
+    An explicit count above 1 for a serial solver, or above the cores numba may
+    use, is an OptionError naming ``--threads``.
+    """
+    threads = parse_threads(threads)
+    if threads == ALL_CORES:
+        return usable_cores() if solver in THREADED else SERIAL
+    if threads > 1 and solver not in THREADED:
+        why = "as in the paper" if solver == "allpair-cpu" else "one GPU thread per particle"
+        raise OptionError(f"--threads: {solver} is serial, {why} (got {threads})")
+    import numba
+
+    if threads > numba.config.NUMBA_NUM_THREADS:
+        raise OptionError(f"--threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} "
+                          f"on this machine (got {threads})")
+    return threads
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a sweep: a solver on a scene, with ``threads`` CPU threads.
+
+    ``threads`` may be ``"all"`` until :meth:`resolved` turns it into a count.
+    ``preset`` names the study that asked for the run (quick, paper, stability,
+    matrix, gpu).
+    """
+
+    solver: str
+    scene: Scene
+    threads: int | str = SERIAL
+    preset: str = ""
+
+    def __post_init__(self):
+        if self.solver not in SOLVERS:
+            raise OptionError(f"--solver must be one of {', '.join(SOLVERS)} (got {self.solver!r})")
+        parse_threads(self.threads)
+
+    def resolved(self) -> "RunSpec":
+        """This spec with ``threads`` as a count on this machine."""
+        return RunSpec(self.solver, self.scene, resolve_threads(self.threads, self.solver), self.preset)
+
+    @property
+    def label(self) -> str:
+        """A short human label: solver, threads, N and the scene's non-default parameters."""
+        s = self.scene
+        threads = f" x{self.threads}" if self.threads not in (SERIAL, str(SERIAL)) else ""
+        changed = {k: v for k, v in scene_parameters(s).items() if v != Scene.default(k) and k != "dx"}
+        extra = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in changed.items())
+        return f"{self.solver}{threads} dx={s.dx:g} N={s.n_particles:,}" + (f" {extra}" if extra else "")
+
+    def to_json(self) -> str:
+        return json.dumps({"solver": self.solver, "threads": self.threads, "scene": scene_parameters(self.scene),
+                           "preset": self.preset}, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> "RunSpec":
+        d = json.loads(text)
+        return cls(d["solver"], Scene(**d["scene"]), d.get("threads", SERIAL), d.get("preset", ""))
+
+
+def scene_parameters(scene: Scene) -> dict:
+    """The scene's own parameters (no derived quantities, no machine limit), as stored."""
+    fields = Scene.__dataclass_fields__
+    return {k: getattr(scene, k) for k in fields if fields[k].compare}
+
+
+def scene_from_row(row: dict) -> Scene:
+    """The Scene of a stored row (derived keys dropped)."""
+    fields = Scene.__dataclass_fields__
+    return Scene(**{k: v for k, v in (row.get("scene") or {}).items() if k in fields and fields[k].compare})
+
+
+def identity(solver: str, threads: int, scene: Scene | dict, preset: str, profile: str, commit: str,
+             host: str) -> str:
+    """The key of a run for resuming and de-duplication: the same key is the same run.
+
+    ``scene`` may be a Scene or a stored row's scene dict (its derived keys are ignored).
+    """
+    if isinstance(scene, dict):
+        fields = Scene.__dataclass_fields__
+        scene = {k: v for k, v in scene.items() if k in fields and fields[k].compare}
+    else:
+        scene = scene_parameters(scene)
+    return json.dumps([solver, int(threads), scene, preset or "", profile, commit, host], sort_keys=True,
+                      default=str)
+
+
+def row_identity(row: dict) -> str:
+    """:func:`identity` of a stored row."""
+    return identity(row["solver"], int(row.get("threads") or 1), row.get("scene") or {}, row.get("preset", ""),
+                    row.get("profile_id", ""), row.get("commit", ""), row.get("host", ""))
