@@ -1,0 +1,101 @@
+"""Units of the harness that break first: the thread policy, run identity, the time predictor, the clock."""
+from __future__ import annotations
+
+import math
+import time
+
+import numba
+import pytest
+
+from pcabench import store
+from pcabench.clock import HostClock
+from pcabench.predict import predicted_seconds, step_model
+from pcabench.record import STEP_STAGES, RunRecord, step_seconds
+from pcabench.spec import ALL_CORES, OptionError, RunSpec, identity, resolve_threads, row_identity, usable_cores
+from solvers import STAGES, Scene
+
+
+# ---------------------------------------------------------------- the thread policy
+def test_threads_policy_one_spelling_each():
+    assert resolve_threads(1, "linkedlist-cpu") == 1
+    assert resolve_threads("1", "linkedlist-cpu") == 1
+    assert resolve_threads(ALL_CORES, "linkedlist-cpu") == usable_cores()
+    assert resolve_threads("ALL", "linkedlist-cpu") == usable_cores()
+    assert resolve_threads(ALL_CORES, "allpair-cpu") == 1  # "every core" of a serial solver is one
+
+
+@pytest.mark.parametrize("threads,solver,words", [
+    (0, "linkedlist-cpu", ">= 1"),
+    ("two", "linkedlist-cpu", "'all'"),
+    (2, "allpair-cpu", "allpair-cpu is serial"),
+    (2, "linkedlist-gpu", "linkedlist-gpu is serial"),
+    (numba.config.NUMBA_NUM_THREADS + 1, "linkedlist-cpu", "between 1 and"),
+])
+def test_bad_threads_name_the_option(threads, solver, words):
+    with pytest.raises(OptionError, match="--threads") as exc:
+        resolve_threads(threads, solver)
+    assert words in str(exc.value)
+
+
+# ---------------------------------------------------------------- run identity
+def test_a_spec_and_its_stored_row_have_one_identity():
+    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=3, cfl=0.3), ALL_CORES, "quick").resolved()
+    assert RunSpec.from_json(spec.to_json()) == spec
+    record = RunRecord.before_run(spec.scene, spec.solver, spec.threads, profile_id="machine-a")
+    record.preset, record.commit, record.host = spec.preset, "abc", "h1"
+    row = store.to_row(record)
+    key = identity(spec.solver, spec.threads, spec.scene, spec.preset, "machine-a", "abc", "h1")
+    assert row_identity(row) == key
+    # a different scene, thread count, preset, machine, commit or host is another run
+    others = [identity(spec.solver, spec.threads, spec.scene.replace(cfl=0.2), "quick", "machine-a", "abc", "h1"),
+              identity(spec.solver, spec.threads + 1, spec.scene, "quick", "machine-a", "abc", "h1"),
+              identity(spec.solver, spec.threads, spec.scene, "paper", "machine-a", "abc", "h1"),
+              identity(spec.solver, spec.threads, spec.scene, "quick", "machine-b", "abc", "h1"),
+              identity(spec.solver, spec.threads, spec.scene, "quick", "machine-a", "abd", "h1"),
+              identity(spec.solver, spec.threads, spec.scene, "quick", "machine-a", "abc", "h2")]
+    assert key not in others and len(set(others)) == len(others)
+
+
+# ---------------------------------------------------------------- the predictor
+def _ok_row(solver, n_dx, step_s, steps=10, threads=1):
+    scene = Scene(dx=n_dx, steps=steps)
+    stages = {s: 0.0 for s in STAGES}
+    stages["pi"] = step_s * steps
+    return {"status": "ok", "solver": solver, "threads": threads, "scene": scene.as_dict(),
+            "n_particles": scene.n_particles, "steps": steps, "stages": stages}
+
+
+def test_predictor_fits_the_power_law_and_extrapolates():
+    rows = [_ok_row("allpair-cpu", dx, 1e-3 * (1.0 / dx) ** 4) for dx in (1.0, 0.5, 0.25)]  # t ~ N^2
+    spec = RunSpec("allpair-cpu", Scene(dx=0.125, steps=10))
+    a, b, sizes = step_model(spec, rows)
+    assert b == pytest.approx(2.0) and sizes == [1000, 4000, 16000]
+    seconds, why = predicted_seconds(spec, rows)
+    assert seconds == pytest.approx(5.0 + 10 * 1e-3 * 8.0**4)  # start-up + steps x step at 64K
+    assert "N^2.00" in why
+    # one size only: the algorithm's order; other solvers, threads or failed runs are not used
+    one = [_ok_row("linkedlist-cpu", 1.0, 2e-3)]
+    ll = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=10))
+    assert step_model(ll, one)[1] == 1.0
+    assert predicted_seconds(ll, one)[0] == pytest.approx(5.0 + 10 * 2e-3 * 4)
+    assert predicted_seconds(RunSpec("linkedlist-cpu", Scene(dx=0.5), 2), one) == (None, "")
+    assert predicted_seconds(ll, [dict(one[0], status="error")]) == (None, "")
+
+
+# ---------------------------------------------------------------- the clock and step time
+def test_host_clock_books_each_operation_to_its_stage():
+    clock = HostClock()
+    clock.time("pi", time.sleep, 0.02)
+    clock.time("pi", time.sleep, 0.01)
+    clock.time("su", lambda: None)
+    totals = clock.totals()
+    assert set(totals) == set(STAGES)
+    assert 0.03 <= totals["pi"] < 0.5 and totals["snp"] == 0.0 and clock.calls["pi"] == 2
+
+
+def test_step_seconds_is_the_step_stages_per_step():
+    stages = {s: 0.0 for s in STAGES}
+    stages.update(input=5.0, init=7.0, output=9.0, snp=1.0, pi=2.0, su=3.0)
+    assert STEP_STAGES == ("snp", "pi", "su")
+    assert step_seconds(stages, 3) == pytest.approx(2.0)
+    assert math.isfinite(step_seconds(stages, 0))  # a run that failed before its first step
