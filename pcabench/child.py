@@ -19,7 +19,7 @@ from .store import to_row
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     spec = RunSpec.from_json(argv[0]).resolved()
-    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id())
+    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id(), pair_loop=spec.pair_loop)
     record.preset = spec.preset
     print(json.dumps(to_row(record), sort_keys=True), flush=True)
     return 0

@@ -26,7 +26,8 @@ from .spec import SERIAL, OptionError, RunSpec, parse_threads
 
 SOLVER_HELP = """solvers:
   allpair-cpu     every pair tested (the paper's all-pair search), serial
-  linkedlist-cpu  uniform cell list (the paper's cellBegin arrays), serial or --threads N|all
+  linkedlist-cpu  uniform cell list (the paper's cellBegin arrays), serial or --threads N|all;
+                  --pair-loop list (default where it fits) or gather (the paper's loop)
   linkedlist-gpu  the cell list on a CUDA GPU, CuPy + numba-cuda (pip install -e ".[gpu]")
 models:
   lagrangian  the paper's: particles move, rho = rho0 + drho (isothermal Euler at Ma 0.05)
@@ -119,6 +120,10 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
     p.add_argument("--threads", type=threads_option, **n,
                    help="CPU threads for linkedlist-cpu: N or 'all' (default 1: serial, like the paper's CPU code)")
+    p.add_argument("--pair-loop", choices=("auto", "list", "gather"), **n,
+                   help="linkedlist-cpu's pair loop: list (each pair once per search, kernel factors kept) or "
+                        "gather (the paper's: every particle's stencil in every sweep); default auto: list "
+                        "where it fits in memory")
 
 
 SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
@@ -134,15 +139,14 @@ def scene_from_args(args) -> Scene:
 def cmd_run(args) -> int:
     from .profiles import profile_id
     from .run import run
-    from .spec import resolve_threads
 
     scene = scene_from_args(args)
-    threads = resolve_threads(args.threads or SERIAL, args.solver)
+    spec = RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto").resolved()
     if not args.json:
-        print(f"pcabench run: {args.solver}, {scene.describe()}", flush=True)
+        print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
-    record = run(scene, args.solver, threads=threads, fields_path=args.fields, progress=progress,
-                 profile_id=profile_id())
+    record = run(scene, spec.solver, threads=spec.threads, fields_path=args.fields, progress=progress,
+                 profile_id=profile_id(), pair_loop=spec.pair_loop)
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
@@ -170,8 +174,9 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
         lists = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt)}
         return "matrix", matrix(args.solver or ["linkedlist-cpu"], args.dx, threads=args.threads or [SERIAL],
                                 steps=args.steps or [None], t_ends=args.t_end or [None], strip=args.strip,
-                                **lists)
-    if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads")) or args.strip:
+                                pair_loops=args.pair_loop or ["auto"], **lists)
+    if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")) \
+            or args.strip:
         raise OptionError("--dx is needed to build a matrix from the scene options (or use a preset alone)")
     name = "paper" if args.paper else "stability" if args.stability else "quick"
     return name, preset(name)
@@ -184,7 +189,7 @@ def check_specs(specs: list[RunSpec]) -> list[RunSpec]:
     resolved, solvers = [], {}
     for spec in specs:
         spec = spec.resolved()
-        key = (spec.solver, spec.threads)
+        key = (spec.solver, spec.threads, spec.pair_loop)
         if key not in solvers:
             solvers[key] = make_solver(*key)
         solvers[key].check_scene(spec.scene)

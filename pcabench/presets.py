@@ -26,12 +26,12 @@ STABILITY_H = (1.0, 1.3)  # h/dx beside the default 2.13
 INACCURATE_ABOVE = 0.20
 
 
-def _spec(solver="linkedlist-cpu", threads=SERIAL, strip=False, **scene) -> RunSpec:
+def _spec(solver="linkedlist-cpu", threads=SERIAL, strip=False, pair_loop="auto", **scene) -> RunSpec:
     """One run; ``strip`` puts it on the thinnest y-periodic strip Scene accepts."""
     if strip:
         scene["strip_height"] = Scene.thinnest_strip(scene["dx"], scene.get("cutoff_factor"),
                                                      scene.get("h_factor"))
-    return RunSpec(solver, Scene(**scene), threads)
+    return RunSpec(solver, Scene(**scene), threads, pair_loop=pair_loop)
 
 
 def quick() -> list[RunSpec]:
@@ -62,6 +62,7 @@ def paper() -> list[RunSpec]:
     for dx in (1.0, 0.5, 0.25, 0.2, 0.1, 0.05, 0.025):  # 1K .. 1.6M; Table 6 at 25K/100K/400K
         runs.append(_spec(dx=dx, steps=100))
         runs.append(_spec(dx=dx, steps=100, threads=ALL_CORES))
+        runs.append(_spec(dx=dx, steps=20, pair_loop="gather"))  # the paper's loop, for Table 4
     # Fig. 9 (the paper's 10th step, 1K .. 256K)
     for dx in (1.0, 0.5, 0.25, 0.125, 0.0625):
         runs.append(_spec(dx=dx, steps=10))
@@ -107,11 +108,11 @@ def preset(name: str) -> list[RunSpec]:
     """The run matrix of preset ``name``, each spec carrying the preset's name."""
     if name not in PRESETS:
         raise ValueError(f"preset must be one of {', '.join(PRESETS)} (got {name!r})")
-    return [RunSpec(s.solver, s.scene, s.threads, name) for s in PRESETS[name]()]
+    return [RunSpec(s.solver, s.scene, s.threads, name, s.pair_loop) for s in PRESETS[name]()]
 
 
 def matrix(solvers=("linkedlist-cpu",), dxs=(), threads=(SERIAL,), steps=(None,), t_ends=(None,),
-           strip=False, **scene_lists) -> list[RunSpec]:
+           strip=False, pair_loops=("auto",), **scene_lists) -> list[RunSpec]:
     """The product of the option lists, smallest N first, as run specs of preset ``matrix``.
 
     ``scene_lists`` maps Scene parameters (precision, model, integrator, cfl,
@@ -122,9 +123,11 @@ def matrix(solvers=("linkedlist-cpu",), dxs=(), threads=(SERIAL,), steps=(None,)
     names = sorted(scene_lists)
     ends = [{"steps": n} for n in steps if n] + [{"t_end": t} for t in t_ends if t] or [{}]
     runs = []
-    for solver, dx, nthreads, end, *values in itertools.product(
-            solvers, sorted(dxs, reverse=True), threads, ends, *(scene_lists[k] for k in names)):
+    for solver, dx, nthreads, loop, end, *values in itertools.product(
+            solvers, sorted(dxs, reverse=True), threads, pair_loops, ends, *(scene_lists[k] for k in names)):
         scene = dict(zip(names, values), dx=dx, **end)
-        spec = _spec(solver, threads=nthreads, strip=strip, **scene)
-        runs.append(RunSpec(spec.solver, spec.scene, spec.threads, "matrix"))
+        if solver != "linkedlist-cpu":
+            loop = "auto"  # the other solvers have one pair loop each
+        spec = _spec(solver, threads=nthreads, strip=strip, pair_loop=loop, **scene)
+        runs.append(RunSpec(spec.solver, spec.scene, spec.threads, "matrix", spec.pair_loop))
     return runs

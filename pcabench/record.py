@@ -35,6 +35,7 @@ class RunRecord:
     status: str
     failed_step: int | None
     threads: int = 1
+    pair_loop: str = ""  # how the solver visited pairs: list, gather (the paper's) or all-pairs
     steps_requested: int = 0
     scene: dict = field(default_factory=dict)
     message: str = ""
@@ -50,7 +51,7 @@ class RunRecord:
 
     @classmethod
     def before_run(cls, scene, solver: str, threads: int = 1, status: str = "error", message: str = "",
-                   profile_id: str = "", preset: str = "") -> "RunRecord":
+                   profile_id: str = "", preset: str = "", pair_loop: str = "") -> "RunRecord":
         """The record of ``scene`` on ``solver`` before any step: no times, no errors, provenance filled."""
         from .provenance import git_commit, host_id, package_versions
 
@@ -58,7 +59,7 @@ class RunRecord:
         return cls(solver=solver, precision=scene.precision, model=scene.model, integrator=scene.integrator,
                    dx=scene.dx, n_particles=scene.n_particles, steps=0, t_end=0.0,
                    stages={s: 0.0 for s in STAGES}, jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan,
-                   status=status, failed_step=None, threads=int(threads), steps_requested=scene.n_steps,
+                   status=status, failed_step=None, threads=int(threads), pair_loop=pair_loop, steps_requested=scene.n_steps,
                    scene=scene.as_dict(), message=message, profile_id=profile_id, commit=git_commit(),
                    versions=package_versions(), preset=preset, host=host_id())
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from solvers import Scene, SceneError, make_solver
+from solvers import Scene, SceneError, make_solver, resolve_pair_loop
 from solvers.analytic import errors as analytic_errors
 from solvers.integrators import step_program
 
@@ -23,17 +23,18 @@ def _is_oom(exc: BaseException) -> bool:
 
 
 def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int = 1,
-        fields_path=None, progress=None, profile_id: str | None = None) -> RunRecord:
+        fields_path=None, progress=None, profile_id: str | None = None, pair_loop: str = "auto") -> RunRecord:
     """Run ``scene`` with ``solver_name``; return its record. Never raises for a failed run."""
-    solver = make_solver(solver_name, threads=threads)
-    record = RunRecord.before_run(scene, solver_name, threads, profile_id=profile_id or "")
+    pair_loop = resolve_pair_loop(solver_name, scene, pair_loop)
+    solver = make_solver(solver_name, threads=threads, pair_loop=pair_loop)
+    record = RunRecord.before_run(scene, solver_name, threads, profile_id=profile_id or "", pair_loop=pair_loop)
     step = 0
     try:
         clock = None
         # JIT compilation and the first launch, on a tiny scene, outside the timed region.
         solver.input(scene)
         record.jit_seconds = solver.warmup()
-        solver = make_solver(solver_name, threads=threads)
+        solver = make_solver(solver_name, threads=threads, pair_loop=pair_loop)
         clock = clock_for(solver)
         clock.time("input", solver.input, scene)
         clock.time("init", solver.init)

@@ -15,7 +15,7 @@ import json
 import os
 from dataclasses import dataclass
 
-from solvers import SOLVERS, Scene
+from solvers import SOLVERS, Scene, check_pair_loop, resolve_pair_loop
 
 SERIAL = 1
 ALL_CORES = "all"
@@ -71,42 +71,47 @@ def resolve_threads(threads, solver: str) -> int:
 class RunSpec:
     """One run of a sweep: a solver on a scene, with ``threads`` CPU threads.
 
-    ``threads`` may be ``"all"`` until :meth:`resolved` turns it into a count.
-    ``preset`` names the study that asked for the run (quick, paper, stability,
-    matrix, gpu).
+    ``threads`` may be ``"all"`` and ``pair_loop`` ``"auto"`` until
+    :meth:`resolved` decides them for this machine. ``preset`` names the study
+    that asked for the run (quick, paper, stability, matrix, gpu).
     """
 
     solver: str
     scene: Scene
     threads: int | str = SERIAL
     preset: str = ""
+    pair_loop: str = "auto"
 
     def __post_init__(self):
         if self.solver not in SOLVERS:
             raise OptionError(f"--solver must be one of {', '.join(SOLVERS)} (got {self.solver!r})")
         parse_threads(self.threads)
+        check_pair_loop(self.solver, self.pair_loop)
 
     def resolved(self) -> "RunSpec":
-        """This spec with ``threads`` as a count on this machine."""
-        return RunSpec(self.solver, self.scene, resolve_threads(self.threads, self.solver), self.preset)
+        """This spec with ``threads`` as a count and ``pair_loop`` as the loop the solver will use here."""
+        return RunSpec(self.solver, self.scene, resolve_threads(self.threads, self.solver), self.preset,
+                       resolve_pair_loop(self.solver, self.scene, self.pair_loop))
 
     @property
     def label(self) -> str:
         """A short human label: solver, threads, N and the scene's non-default parameters."""
         s = self.scene
         threads = f" x{self.threads}" if self.threads not in (SERIAL, str(SERIAL)) else ""
+        loop = f" [{self.pair_loop}]" if self.pair_loop not in ("auto", "all-pairs") else ""
         changed = {k: v for k, v in scene_parameters(s).items() if v != Scene.default(k) and k != "dx"}
         extra = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in changed.items())
-        return f"{self.solver}{threads} dx={s.dx:g} N={s.n_particles:,}" + (f" {extra}" if extra else "")
+        return f"{self.solver}{threads}{loop} dx={s.dx:g} N={s.n_particles:,}" + (f" {extra}" if extra else "")
 
     def to_json(self) -> str:
         return json.dumps({"solver": self.solver, "threads": self.threads, "scene": scene_parameters(self.scene),
-                           "preset": self.preset}, sort_keys=True)
+                           "preset": self.preset, "pair_loop": self.pair_loop}, sort_keys=True)
 
     @classmethod
     def from_json(cls, text: str) -> "RunSpec":
         d = json.loads(text)
-        return cls(d["solver"], Scene(**d["scene"]), d.get("threads", SERIAL), d.get("preset", ""))
+        return cls(d["solver"], Scene(**d["scene"]), d.get("threads", SERIAL), d.get("preset", ""),
+                   d.get("pair_loop", "auto"))
 
 
 def scene_parameters(scene: Scene) -> dict:
@@ -122,21 +127,22 @@ def scene_from_row(row: dict) -> Scene:
 
 
 def identity(solver: str, threads: int, scene: Scene | dict, preset: str, profile: str, commit: str,
-             host: str) -> str:
+             host: str, pair_loop: str = "") -> str:
     """The key of a run for resuming and de-duplication: the same key is the same run.
 
     ``scene`` may be a Scene or a stored row's scene dict (its derived keys are ignored).
+    ``pair_loop`` is the loop the run used (rows from before pair loops had none).
     """
     if isinstance(scene, dict):
         fields = Scene.__dataclass_fields__
         scene = {k: v for k, v in scene.items() if k in fields and fields[k].compare}
     else:
         scene = scene_parameters(scene)
-    return json.dumps([solver, int(threads), scene, preset or "", profile, commit, host], sort_keys=True,
-                      default=str)
+    return json.dumps([solver, int(threads), scene, preset or "", profile, commit, host, pair_loop or ""],
+                      sort_keys=True, default=str)
 
 
 def row_identity(row: dict) -> str:
     """:func:`identity` of a stored row."""
     return identity(row["solver"], int(row.get("threads") or 1), row.get("scene") or {}, row.get("preset", ""),
-                    row.get("profile_id", ""), row.get("commit", ""), row.get("host", ""))
+                    row.get("profile_id", ""), row.get("commit", ""), row.get("host", ""), row.get("pair_loop", ""))

@@ -92,6 +92,7 @@ def load(paths):
         r["scene_key"] = json.dumps({k: v for k, v in scene.items() if k != "memory_limit_bytes"},
                                     sort_keys=True)
         r.setdefault("preset", "")
+        r.setdefault("pair_loop", "")  # rows from before the pair list: the gather loop
         r["threads"] = int(r.get("threads") or 1)
         flat.append(r)
     df = pd.DataFrame(flat)

@@ -31,7 +31,7 @@ def failed_record(spec: RunSpec, status: str, message: str, profile: str, second
     if seconds is not None:
         message = f"{message} (after {seconds:.0f} s)"
     record = RunRecord.before_run(spec.scene, spec.solver, spec.threads, status=status, message=message,
-                                  profile_id=profile)
+                                  profile_id=profile, pair_loop=spec.pair_loop)
     record.preset = spec.preset
     return record
 
@@ -64,7 +64,7 @@ def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budge
     for i, spec in enumerate(specs, 1):
         spec = spec.resolved()
         label = f"[{i}/{len(specs)}] {spec.label}"
-        if identity(spec.solver, spec.threads, spec.scene, spec.preset, profile, commit, host) in done:
+        if identity(spec.solver, spec.threads, spec.scene, spec.preset, profile, commit, host, spec.pair_loop) in done:
             print(f"{label}: already stored", file=stream, flush=True)
             continue
         left = sweep_budget - (time.perf_counter() - t_start)

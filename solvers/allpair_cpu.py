@@ -44,6 +44,7 @@ class AllPairCPU(Solver):
     """Every pair tested, serial, as in the paper's Fig. 9 comparison."""
 
     name = "allpair-cpu"
+    pair_loop = "all-pairs"
 
     def snp(self) -> None:
         """Nothing to build: the all-pair search happens inside the interaction loop."""

@@ -58,6 +58,7 @@ class Solver(abc.ABC):
 
     name: str = "abstract"
     device: str = "cpu"
+    pair_loop: str = "gather"  # how pairs are visited: gather (each particle's stencil), list, all-pairs
     xp = np
 
     def __init__(self, threads: int | None = None):

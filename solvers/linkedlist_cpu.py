@@ -8,9 +8,15 @@ order, so the three cells of a stencil row are one contiguous range and the
 pair loops stream through memory. Cells are one cutoff wide in x and at least
 one cutoff tall in y (a whole number of rows fills the periodic height).
 
-``threads=None`` or 1 runs the serial code, as the paper's CPU code did;
+``threads=1`` runs the serial code, as the paper's CPU code did;
 ``threads=N`` runs the same source compiled with numba's parallel loops on N
-threads, one particle per iteration, as the honest multi-core peer.
+threads, as the honest multi-core peer.
+
+Two pair loops (``pair_loop``): ``gather``, the paper's, visits every
+particle's 3x3 stencil in every sweep; ``list`` (solvers/pairlist.py) lists
+each pair once per search with its kernel factors and updates both sides,
+which is several times faster but takes memory. ``auto`` (the default) takes
+the list where it fits in memory and the gather loop where it does not.
 """
 from __future__ import annotations
 
@@ -20,6 +26,7 @@ from functools import lru_cache
 import numba
 import numpy as np
 
+from . import pairlist
 from .backend import cpu_pairs
 from .interface import Solver, cell_grid, tiny_scene
 from .scene import SceneError
@@ -78,6 +85,22 @@ class LinkedListCPU(Solver):
 
     name = "linkedlist-cpu"
 
+    def __init__(self, threads: int = 1, pair_loop: str = "auto"):
+        super().__init__(threads=threads)
+        self.requested_pair_loop = pair_loop
+
+    def input(self, scene) -> None:
+        super().input(scene)
+        self.pair_loop = self.choose_pair_loop(scene, self.requested_pair_loop)
+
+    @staticmethod
+    def choose_pair_loop(scene, requested: str = "auto") -> str:
+        """``auto``: ``list`` where the arrays and the pair list fit in the scene's memory limit, else ``gather``."""
+        if requested != "auto":
+            return requested
+        fits = scene.memory_bytes() + pairlist.list_bytes(scene) <= scene.memory_limit()
+        return "list" if fits else "gather"
+
     def check_scene(self, scene) -> None:
         if self.threads is not None:
             if not isinstance(self.threads, int) or self.threads < 1:
@@ -105,6 +128,7 @@ class LinkedListCPU(Solver):
         # neighbour load (measured 20-25 % faster sweeps)
         self.begin = np.zeros(ncells + 1, np.uint32)
         self.cells_valid = False
+        self.pairs = pairlist.PairList(s, self.threads or 1) if self.pair_loop == "list" else None
 
     def snp(self) -> None:
         """Cell list for the current positions: once for fixed particles, every step if moving."""
@@ -115,13 +139,23 @@ class LinkedListCPU(Solver):
         self.kernels["cell_ids"](a["lx"], a["ly"], a["sx"], a["sy"], self.cell, s.dx, -self.cw,
                                  s.height, self.cw, self.ch, self.ncx, self.ncy)
         counting_sort(self.cell, self.ncx * self.ncy, self.begin, self.order, self.sorted_cell)
+        if self.pairs is not None:  # the list scans x-sorted stencil rows
+            pairlist.sort_cells_by_x(self.order, self.begin, a["lx"], a["sx"], s.dx)
         self.permute(self.order)
         self.cell, self.sorted_cell = self.sorted_cell, self.cell
+        if self.pairs is not None:
+            self.pairs.build(self.cell, self.begin, self.ncx, self.ncy, a["lx"], a["ly"], a["sx"], a["sy"], self.k)
         self.cells_valid = True
 
     def _sweep(self, continuity: bool, momentum: bool) -> None:
         self._threads()
         a, kk = self.arrays, self.kernels
+        if self.pairs is not None:
+            if continuity:
+                self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+            if momentum:
+                self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
+            return
         geo = (self.cell, self.begin, self.ncx, self.ncy, a["lx"], a["ly"], a["sx"], a["sy"])
         if continuity:
             kk["continuity"](*geo, a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
@@ -138,7 +172,7 @@ class LinkedListCPU(Solver):
 
     def warmup(self) -> float:
         t0 = time.perf_counter()
-        probe = type(self)(threads=self.threads)
+        probe = type(self)(threads=self.threads, pair_loop=self.pair_loop)
         probe.input(tiny_scene(self.scene))
         probe.init()
         probe.snp()

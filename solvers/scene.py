@@ -38,11 +38,38 @@ class SceneError(ValueError):
     """A scene parameter is outside its allowed range."""
 
 
-def _host_memory_bytes() -> int:
+def _read_int(path: str) -> int | None:
     try:
-        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-        return 16 * 2**30
+        with open(path) as f:
+            text = f.read().split()[0]
+        return None if text == "max" else int(text)
+    except (OSError, ValueError, IndexError):
+        return None
+
+
+def available_memory_bytes() -> int:
+    """Memory this process may still use, bytes: the smallest of the host's available memory
+    (MemAvailable) and the cgroup's limit less its usage (cgroup v2 memory.max, or v1's limit)."""
+    limits = []
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    limits.append(int(line.split()[1]) * 1024)
+    except (OSError, ValueError):
+        pass
+    for limit_path, usage_path in (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                                   ("/sys/fs/cgroup/memory/memory.limit_in_bytes",
+                                    "/sys/fs/cgroup/memory/memory.usage_in_bytes")):
+        limit = _read_int(limit_path)
+        if limit is not None and limit < 2**60:
+            limits.append(max(limit - (_read_int(usage_path) or 0), 0))
+    if not limits:
+        try:
+            limits.append(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+        except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+            limits.append(16 * 2**30)
+    return min(limits)
 
 
 def bytes_per_particle(precision: str) -> int:
@@ -137,7 +164,7 @@ class Scene:
              f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
              f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)")
         need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
-        limit = self.memory_limit_bytes if self.memory_limit_bytes is not None else _host_memory_bytes()
+        limit = self.memory_limit()
         need(self.memory_bytes() <= limit,
              f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
              f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
@@ -210,8 +237,12 @@ class Scene:
         return self.n_steps * self.dt
 
     # ------------------------------------------------------------ memory
+    def memory_limit(self) -> int:
+        """Memory a run of this scene may use, bytes: ``memory_limit_bytes``, else what is available now."""
+        return self.memory_limit_bytes if self.memory_limit_bytes is not None else available_memory_bytes()
+
     def memory_bytes(self) -> int:
-        """Upper bound of the memory the particle arrays need, bytes."""
+        """Upper bound of the memory the particle arrays need, bytes (a pair list, where used, comes on top)."""
         return self.n_particles * bytes_per_particle(self.precision)
 
     def smallest_dx_fitting(self, limit_bytes: float) -> float:

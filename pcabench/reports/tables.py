@@ -27,13 +27,15 @@ def published(system: str = "paper-system-1") -> dict:
 
 
 def label(r) -> str:
-    """``solver precision`` plus ``xN`` for a multi-threaded run."""
-    return f"{r['solver']} {r['precision']}" + (f" x{int(r['threads'])}" if int(r["threads"]) > 1 else "")
+    """``solver precision``, ``xN`` for a multi-threaded run, and ``[list]`` or ``[gather]``, the pair loop
+    of a linked-list CPU run (rows made before the pair list have none: they used the gather loop)."""
+    loop = f" [{r['pair_loop']}]" if r["solver"] == "linkedlist-cpu" and r.get("pair_loop") else ""
+    return f"{r['solver']} {r['precision']}" + (f" x{int(r['threads'])}" if int(r["threads"]) > 1 else "") + loop
 
 
 def latest(df: pd.DataFrame) -> pd.DataFrame:
     """One row per configuration and machine, the newest: reruns and overlapping presets count once."""
-    return df if df.empty else _newest_per(df, ["profile_id", "solver", "threads", "scene_key"])
+    return df if df.empty else _newest_per(df, ["profile_id", "solver", "threads", "pair_loop", "scene_key"])
 
 
 def default_numerics(df: pd.DataFrame) -> pd.DataFrame:
@@ -64,8 +66,8 @@ def table4(df) -> list[dict]:
     """Stage times by N: input, init, output in ms per run; SNP, PI, SU in ms per step."""
     t4 = published()["table4"]["rows"]
     rows = []
-    for _, r in _newest_per(paper_scene(df), ["solver", "precision", "threads", "n_particles"]) \
-            .sort_values(["solver", "precision", "threads", "n_particles"]).iterrows():
+    keys = ["solver", "precision", "threads", "pair_loop", "n_particles"]
+    for _, r in _newest_per(paper_scene(df), keys).sort_values(keys).iterrows():
         row = {"config": label(r), "N": int(r.n_particles)}
         row.update({s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")})
         row.update(per_step_ms(r))

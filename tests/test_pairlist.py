@@ -1,0 +1,89 @@
+"""The CPU pair list: the same physics as the paper's gather loop, each pair once, and a fallback that fits."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from solvers import Scene, make_solver, resolve_pair_loop
+from solvers import pairlist
+from solvers.integrators import step_program
+
+from .conftest import strip_for
+
+
+def max_rel(a, b):
+    return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+
+
+def stepped(scene, pair_loop, threads=1, steps=None):
+    """A linkedlist-cpu solver after ``steps`` Verlet steps (all of the scene's by default)."""
+    s = make_solver("linkedlist-cpu", threads=threads, pair_loop=pair_loop)
+    s.input(scene)
+    s.init()
+    for n in range(steps or scene.n_steps):
+        for _, op in step_program(scene.integrator, s, first=(n == 0)):
+            op()
+    return s
+
+
+@pytest.mark.parametrize("model,threads", [("lagrangian", 1), ("lagrangian", 2), ("linear", 1)])
+def test_list_agrees_with_gather_to_roundoff(tmp_path, model, threads):
+    scene = Scene(dx=0.25, x_min=-10, x_max=20, steps=30, model=model, strip_height=strip_for(0.25))
+    gather = stepped(scene, "gather").output()
+    listed = stepped(scene, "list", threads=threads).output()
+    for name in ("u", "drho", "x"):
+        assert max_rel(getattr(listed, name), getattr(gather, name)) < 1e-12, name
+
+
+def test_each_pair_listed_once_with_its_kernel_factor():
+    scene = Scene(dx=0.5, x_min=-10, x_max=10, steps=1, strip_height=strip_for(0.5))
+    s = stepped(scene, "list", steps=1)
+    a, pl = s.arrays, s.pairs
+    x = (a["lx"] + 0.5) * scene.dx + a["sx"]
+    y = (a["ly"] + 0.5) * scene.dx + a["sy"]
+    n, height = scene.n_particles, scene.height
+    # every pair within the cutoff by brute force (minimum image in y)
+    dx_ = x[:, None] - x[None, :]
+    dy_ = y[:, None] - y[None, :]
+    dy_ -= height * np.round(dy_ / height)
+    r2 = dx_**2 + dy_**2
+    inside = (r2 < scene.cutoff**2) & ~np.eye(n, dtype=bool)
+    listed = np.zeros((n, n), int)
+    for i in range(n):
+        for m in range(pl.count[i]):
+            j = pl.nbr[i, m]
+            listed[i, j] += 1
+            listed[j, i] += 1
+            g = -2 / (np.pi * scene.h**4) * np.exp(-r2[i, j] / scene.h**2)
+            assert pl.fx[i, m] == pytest.approx(g * dx_[i, j], rel=1e-12, abs=1e-18)
+            assert pl.fy[i, m] == pytest.approx(g * dy_[i, j], rel=1e-12, abs=1e-18)
+    assert np.array_equal(listed, inside.astype(int))  # each pair once, from one side, and no other
+
+
+def test_rows_grow_when_a_particle_has_more_pairs_than_room(monkeypatch):
+    scene = Scene(dx=0.5, x_min=-10, x_max=10, steps=12, strip_height=strip_for(0.5))
+    reference = stepped(scene, "list").output()
+    monkeypatch.setattr(pairlist, "capacity", lambda scene: 4)  # far too few: the first build overflows
+    small = stepped(scene, "list")
+    assert small.pairs.nbr.shape[1] > 4
+    assert max_rel(small.output().u, reference.u) < 1e-14
+
+
+def test_cells_sorted_by_x_after_the_search():
+    scene = Scene(dx=0.5, x_min=-10, x_max=10, steps=10, strip_height=strip_for(0.5))
+    s = stepped(scene, "list")
+    a = s.arrays
+    x = (a["lx"] + 0.5) * scene.dx + a["sx"]
+    for c in range(len(s.begin) - 1):
+        seg = x[s.begin[c]:s.begin[c + 1]]
+        assert np.all(np.diff(seg) >= 0), c
+
+
+def test_auto_falls_back_to_gather_where_the_list_does_not_fit():
+    scene = Scene(dx=0.1)
+    roomy = scene.replace(memory_limit_bytes=scene.memory_bytes() + pairlist.list_bytes(scene))
+    tight = scene.replace(memory_limit_bytes=scene.memory_bytes() + pairlist.list_bytes(scene) // 2)
+    assert resolve_pair_loop("linkedlist-cpu", roomy) == "list"
+    assert resolve_pair_loop("linkedlist-cpu", tight) == "gather"  # the largest scene still runs
+    assert resolve_pair_loop("linkedlist-cpu", tight, "list") == "list"  # asked for explicitly
+    assert resolve_pair_loop("allpair-cpu", scene) == "all-pairs"
