@@ -11,6 +11,7 @@ import json
 import sys
 
 from .profiles import profile_id
+from .progress import Progress
 from .run import run
 from .spec import RunSpec
 from .store import to_row
@@ -19,7 +20,9 @@ from .store import to_row
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     spec = RunSpec.from_json(argv[0]).resolved()
-    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id(), pair_loop=spec.pair_loop)
+    progress = Progress(f"    {spec.solver} N={spec.scene.n_particles:,}", every=5.0)
+    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id(), pair_loop=spec.pair_loop,
+                 progress=progress)
     record.preset = spec.preset
     print(json.dumps(to_row(record), sort_keys=True), flush=True)
     return 0

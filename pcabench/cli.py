@@ -15,14 +15,16 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
-import time
 from pathlib import Path
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
 
 from . import __version__, paths
+from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
+from .store import StoreError
 
 SOLVER_HELP = """solvers:
   allpair-cpu     every pair tested (the paper's all-pair search), serial
@@ -45,29 +47,6 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
-
-
-class Progress:
-    """Step progress on stderr, at most every ``every`` seconds, with an ETA."""
-
-    def __init__(self, label: str, every: float = 2.0, stream=sys.stderr):
-        self.label, self.every, self.stream = label, every, stream
-        self.t0 = self.last = time.perf_counter()
-
-    def __call__(self, done: int, total: int) -> None:
-        now = time.perf_counter()
-        if done <= 1:  # the clock starts with the first step, after compilation
-            self.t0 = self.last = now
-            return
-        if now - self.last < self.every and done < total:
-            return
-        self.last = now
-        eta = (now - self.t0) / max(done, 1) * (total - done)
-        self.stream.write(f"\r{self.label}: step {done}/{total} ({100 * done / total:5.1f} %), "
-                          f"eta {eta:6.1f} s ")
-        if done == total:
-            self.stream.write("\n")
-        self.stream.flush()
 
 
 # ---------------------------------------------------------------- option types
@@ -135,13 +114,27 @@ def scene_from_args(args) -> Scene:
     return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height, **given)
 
 
+def check_output_path(path, option: str) -> None:
+    """OptionError naming ``option`` unless a file can be written at ``path`` (checked before any work)."""
+    path = Path(path)
+    if path.is_dir():
+        raise OptionError(f"{option} {path} is a folder; give a file name")
+    if not path.parent.is_dir():
+        raise OptionError(f"{option} {path}: the folder {path.parent} does not exist")
+    if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise OptionError(f"{option} {path} is not writable")
+
+
 # ---------------------------------------------------------------- commands
 def cmd_run(args) -> int:
     from .profiles import profile_id
     from .run import run
+    from .store import to_row
 
     scene = scene_from_args(args)
     spec = RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto").resolved()
+    if args.fields:
+        check_output_path(args.fields, "--fields")
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
@@ -151,7 +144,7 @@ def cmd_run(args) -> int:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
         out["message"] = record.message
-        print(json.dumps(out, allow_nan=True))
+        print(json.dumps(to_row(out), allow_nan=False))  # standard JSON: null, never NaN
     else:
         print(record.stage_table())
         print(f"particles        {record.n_particles:,}")
@@ -201,6 +194,7 @@ def cmd_study(args) -> int:
     from . import profiles
     from .presets import RUN_BUDGET
     from .reports import write_reports
+    from .store import check_writable, store_name
     from .sweep import sweep
 
     name, specs = study_specs(args)
@@ -210,11 +204,12 @@ def cmd_study(args) -> int:
         if not value > 0:
             raise OptionError(f"{flag} must be > 0 seconds (got {value})")
     profile = profiles.capture()
+    store_path = Path(args.results) / store_name(profile["id"])
+    check_writable(store_path)
     profiles.save(profile)
-    store_path = Path(args.results) / f"{profile['id']}.jsonl"
     print(f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
           f"store {store_path}", file=sys.stderr, flush=True)
-    sweep(specs, store_path, run_budget, args.sweep_budget)
+    sweep(specs, store_path, run_budget, args.sweep_budget, retry_failed=args.retry_failed)
     if args.no_report:
         return 0
     for p in write_reports(Path(args.results), Path(args.reports)):
@@ -297,6 +292,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0,
                    help="seconds for the whole sweep")
     p.add_argument("--no-report", action="store_true", help="store the runs, do not write the reports")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="run again the stored runs that timed out, were skipped or ended in an error")
     p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("report", help="regenerate the reports from the stored results")
@@ -338,7 +335,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (SceneError, OptionError) as exc:
+    except (SceneError, OptionError, StoreError) as exc:
         parser.exit(2, f"pcabench: error: {exc}\n")
     except SolverUnavailable as exc:
         parser.exit(3, f"pcabench: {exc}\n")

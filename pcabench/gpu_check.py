@@ -32,6 +32,7 @@ from solvers.linkedlist_gpu import device_backend
 from .record import STEP_STAGES, step_seconds
 from .run import run
 from .spec import ALL_CORES, SERIAL, RunSpec
+from .store import store_name
 
 GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles
 CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
@@ -208,7 +209,7 @@ def gpu_check(out: Path, results: Path, reports: Path, sizes=GPU_DX, steps: int 
                                 stdout=log, stderr=subprocess.STDOUT).returncode
         print(f"pytest -m gpu: exit {rc} (log in {out / 'pytest_gpu.log'})", flush=True)
     compare_rows = compare_with_cpu() if compare else []
-    store_path = results / f"{profile['id']}.jsonl"
+    store_path = results / store_name(profile["id"])
     gpu_rows = sweep(gpu_specs(sizes, steps, models), store_path, run_budget, sweep_budget=24 * 3600.0)
     cpu_rows = sweep(cpu_peer_specs(), store_path, run_budget, sweep_budget=24 * 3600.0) if cpu_peer else []
     text = markdown(profile, compare_rows, gpu_rows, steps, cpu_rows)

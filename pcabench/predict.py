@@ -1,6 +1,6 @@
 """Predict a run's wall time from the finished runs of the same solver, to skip hopeless sizes.
 
-The time of one step is fitted as ``a * N**b`` over this machine's finished runs
+The time of one step is fitted as ``a * N**b`` over this host's finished runs
 of the same solver, precision, model and threads (any protocol). With two or
 more sizes ``b`` is fitted; with one, ``b`` is the algorithm's order (2 for
 all-pair, 1 for a cell list). A run whose predicted time, steps times step
@@ -48,7 +48,7 @@ def step_model(spec, rows: list[dict]):
 
 
 def predicted_seconds(spec, rows: list[dict]):
-    """``(seconds, why)`` for the RunSpec ``spec`` from ``rows`` of this machine, or ``(None, "")`` without data."""
+    """``(seconds, why)`` for the RunSpec ``spec`` from ``rows`` of this host, or ``(None, "")`` without data."""
     scene = spec.scene
     model = step_model(spec, rows)
     if model is None:
@@ -58,5 +58,5 @@ def predicted_seconds(spec, rows: list[dict]):
     seconds = START_UP + scene.n_steps * step
     sizes_txt = ", ".join(f"{n:,}" for n in sizes[-3:])
     why = (f"predicted {seconds:.3g} s ({scene.n_steps} steps x {1e3 * step:.3g} ms; step time "
-           f"~ N^{b:.2f} fitted to N = {sizes_txt} on this machine)")
+           f"~ N^{b:.2f} fitted to N = {sizes_txt} on this host)")
     return (seconds if math.isfinite(seconds) else None), why

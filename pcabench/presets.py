@@ -121,7 +121,7 @@ def matrix(solvers=("linkedlist-cpu",), dxs=(), threads=(SERIAL,), steps=(None,)
     means the paper's 100 steps).
     """
     names = sorted(scene_lists)
-    ends = [{"steps": n} for n in steps if n] + [{"t_end": t} for t in t_ends if t] or [{}]
+    ends = [{"steps": n} for n in steps if n is not None] + [{"t_end": t} for t in t_ends if t is not None] or [{}]
     runs = []
     for solver, dx, nthreads, loop, end, *values in itertools.product(
             solvers, sorted(dxs, reverse=True), threads, pair_loops, ends, *(scene_lists[k] for k in names)):

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import datetime as _dt
+import uuid
 from dataclasses import asdict, dataclass, field
 
 from solvers import STAGES
@@ -45,6 +46,7 @@ class RunRecord:
     preset: str = ""  # the study preset that asked for the run (quick, paper, stability, matrix), if any
     host: str = ""  # provenance.host_id(): which computer of this hardware profile made the run
     timestamp: str = field(default_factory=lambda: _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
+    run_id: str = field(default_factory=lambda: uuid.uuid4().hex[:16])  # this record, wherever it is copied
 
     CONTRACT = ("solver", "precision", "model", "integrator", "dx", "n_particles", "steps", "t_end",
                 "stages", "jit_seconds", "mse", "me", "mean_neighbours", "status", "failed_step")

@@ -2,19 +2,25 @@
 
 Each run is a child process (``python -m pcabench.child``) with a time budget:
 a crash, hang or out-of-memory in one run is recorded (status error /
-timeout / out-of-memory) and the sweep goes on. The sweep is the only writer
-of the store; every finished run is appended at once, and a rerun skips the
-runs the store already holds for this machine (hardware profile and host),
-commit and preset (:func:`pcabench.spec.identity`), so an interrupted sweep
-resumes where it stopped. A run predicted to take longer than the run budget
-is stored as ``skipped`` with the prediction.
+timeout / out-of-memory, naming the signal or exit code) and the sweep goes
+on. A child dies with its parent (Linux: PR_SET_PDEATHSIG), so a killed sweep
+leaves no run going on unsupervised. The sweep holds the store's lock and is
+its only writer; every finished run is appended at once, and a rerun skips
+the runs the store already holds for this machine (hardware profile and
+host), commit and preset (:func:`pcabench.spec.identity`), so an interrupted
+sweep resumes where it stopped; ``retry_failed`` reruns timeouts, skips and
+errors. A run predicted to take longer than the run budget is stored as
+``skipped`` with the prediction.
 """
 from __future__ import annotations
 
+import ctypes
 import json
 import os
+import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -24,6 +30,9 @@ from .profiles import profile_id as this_profile_id
 from .provenance import git_commit, host_id
 from .record import RunRecord, step_seconds
 from .spec import RunSpec, identity, row_identity
+
+RETRIED = ("timeout", "skipped", "error")  # statuses --retry-failed runs again
+OOM_EVENTS = "/sys/fs/cgroup/memory.events"  # cgroup v2: counts the kernel's OOM kills
 
 
 def failed_record(spec: RunSpec, status: str, message: str, profile: str, seconds: float | None = None) -> RunRecord:
@@ -36,35 +45,117 @@ def failed_record(spec: RunSpec, status: str, message: str, profile: str, second
     return record
 
 
-def run_child(spec: RunSpec, timeout: float, commit: str) -> dict:
-    """Run ``spec`` in a child process; its record as a row. Raises subprocess.TimeoutExpired."""
+def _die_with_parent() -> None:
+    """In the child, before exec: receive SIGKILL when the parent dies (Linux only; else nothing)."""
+    try:
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        pass
+
+
+def oom_kills() -> int | None:
+    """The cgroup's count of OOM kills so far, or None where the kernel does not say."""
+    try:
+        with open(OOM_EVENTS) as f:
+            for line in f:
+                if line.startswith("oom_kill "):
+                    return int(line.split()[1])
+    except (OSError, ValueError):
+        pass
+    return None
+
+
+def exit_status(returncode: int, oom_before: int | None, oom_after: int | None) -> tuple[str, str]:
+    """(status, what happened) of a child that ended without a record."""
+    if returncode < 0:
+        name = signal.Signals(-returncode).name if -returncode in signal.valid_signals() else f"signal {-returncode}"
+        if -returncode == signal.SIGKILL and oom_before is not None and oom_after is not None \
+                and oom_after > oom_before:
+            return "out-of-memory", f"killed by {name}: the kernel's OOM killer (cgroup oom_kill count rose)"
+        return "error", f"killed by {name}"
+    return "error", f"exit code {returncode}"
+
+
+def run_child(spec: RunSpec, timeout: float, commit: str, stream=sys.stderr) -> dict:
+    """Run ``spec`` in a child process, relaying its progress to ``stream``; its record as a row.
+
+    Raises subprocess.TimeoutExpired (the child is killed first) past ``timeout`` seconds.
+    """
     cmd = [sys.executable, "-m", "pcabench.child", spec.to_json()]
     env = dict(os.environ, PCABENCH_COMMIT=commit)  # every run of a sweep carries the sweep's commit
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
-    lines = proc.stdout.strip().splitlines()
+    oom_before = oom_kills()
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
+                            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
+    tail = []
+
+    def relay():  # the child's progress lines go on to the user; the end is kept for the record
+        for raw in iter(lambda: proc.stderr.read1(4096), b""):
+            text = raw.decode("utf-8", "replace")
+            if stream is not None:
+                stream.write(text)
+                stream.flush()
+            tail.append(text)
+            del tail[:-50]
+
+    reader = threading.Thread(target=relay, daemon=True)
+    reader.start()
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+    except BaseException:
+        proc.kill()
+        proc.wait()
+        raise
+    finally:
+        reader.join(timeout=5)
+        if stream is not None and tail and not tail[-1].endswith("\n"):
+            stream.write("\n")  # end the child's last progress line
+    lines = out.decode("utf-8", "replace").strip().splitlines()
     if proc.returncode == 0 and lines:
         return json.loads(lines[-1])
-    status = "out-of-memory" if proc.returncode in (-9, 137) else "error"
-    return store.to_row(failed_record(spec, status, proc.stderr.strip()[-400:], this_profile_id()))
+    status, what = exit_status(proc.returncode, oom_before, oom_kills())
+    stderr = "".join(tail).strip()[-400:]
+    return store.to_row(failed_record(spec, status, what + (f": {stderr}" if stderr else ""), this_profile_id()))
+
+
+def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None) -> str:
+    """The sweep's ETA and how sure it is: predicted runs from this host's timings, the rest at the mean so far."""
+    if not remaining:
+        return "done"
+    predicted = [predicted_seconds(s, mine)[0] for s in remaining]
+    known = [p for p in predicted if p is not None]
+    unknown = len(predicted) - len(known)
+    if unknown and seconds_per_run is None:
+        return f"eta unknown ({len(remaining)} runs left, {len(known)} predicted)"
+    total = sum(known) + unknown * (seconds_per_run or 0.0)
+    how = (f"{len(known)} of {len(remaining)} runs predicted from this host's timings"
+           + (f", {unknown} at the mean so far" if unknown else ""))
+    return f"eta {total / 60:.1f} min ({how})"
 
 
 def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budget: float,
-          stream=sys.stderr) -> list[dict]:
+          stream=sys.stderr, retry_failed: bool = False) -> list[dict]:
     """Run ``specs`` (skipping those already stored), one child process each; the rows stored.
 
-    Before each run its time is predicted from this machine's finished runs
+    Before each run its time is predicted from this host's finished runs
     (``predict.py``); a run predicted past ``run_budget`` is stored as
     ``skipped`` with the prediction instead of being run into the wall.
     """
+    store.check_writable(store_path)
+    with store.SweepLock(store_path):
+        return _sweep(specs, Path(store_path), run_budget, sweep_budget, stream, retry_failed)
+
+
+def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed) -> list[dict]:
     profile, commit, host = this_profile_id(), git_commit(), host_id()
-    rows = store.read_rows(store_path) if Path(store_path).exists() else []
-    done = {row_identity(r) for r in rows}
-    mine = [r for r in rows if r.get("profile_id") == profile]
-    t_start, stored = time.perf_counter(), []
+    rows = store.read_rows(store_path) if store_path.exists() else []
+    done = {row_identity(r) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
+    mine = [r for r in rows if r.get("profile_id") == profile and r.get("host") == host]
+    t_start, stored, failed = time.perf_counter(), [], 0
+    specs = [s.resolved() for s in specs]
     for i, spec in enumerate(specs, 1):
-        spec = spec.resolved()
         label = f"[{i}/{len(specs)}] {spec.label}"
-        if identity(spec.solver, spec.threads, spec.scene, spec.preset, profile, commit, host, spec.pair_loop) in done:
+        if identity(spec.solver, spec.threads, spec.scene, spec.preset, profile, commit, host,
+                    spec.pair_loop) in done:
             print(f"{label}: already stored", file=stream, flush=True)
             continue
         left = sweep_budget - (time.perf_counter() - t_start)
@@ -77,9 +168,11 @@ def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budge
                                                      profile), store_path))
             print(f"{label}: skipped, {why}", file=stream, flush=True)
             continue
+        print(f"{label}: running" + (f" (predicted {seconds:.0f} s)" if seconds is not None else ""),
+              file=stream, flush=True)
         t0 = time.perf_counter()
         try:
-            row = run_child(spec, min(run_budget, left), commit)
+            row = run_child(spec, min(run_budget, left), commit, stream)
         except subprocess.TimeoutExpired:
             if left < run_budget:  # the sweep's budget ran out, not the run's: nothing to record
                 print(f"{label}: sweep budget spent during the run, not stored (rerun to resume)",
@@ -90,9 +183,12 @@ def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budge
         row = store.append(row, store_path)
         stored.append(row)
         mine.append(row)
-        eta = (time.perf_counter() - t_start) / len(stored) * (len(specs) - i)
+        failed += row["status"] != "ok"
         step_ms = 1e3 * step_seconds(row["stages"], row["steps"])
         mse = row.get("mse")
+        made = [r for r in stored if r["status"] != "skipped"]
+        per_run = (time.perf_counter() - t_start) / len(made) if made else None
         print(f"{label}: {row['status']}, step {step_ms:.2f} ms, MSE {'-' if mse is None else f'{mse:.4g}'}, "
-              f"{time.perf_counter() - t0:.1f} s (sweep eta <= {eta / 60:.1f} min)", file=stream, flush=True)
+              f"{time.perf_counter() - t0:.1f} s | sweep: {i}/{len(specs)} done, {failed} not ok, "
+              f"{eta_text(specs[i:], mine, per_run)}", file=stream, flush=True)
     return stored

@@ -47,6 +47,11 @@ def _read_int(path: str) -> int | None:
         return None
 
 
+# cgroup (v2, then v1) files of the memory limit and the usage: (limit, usage)
+CGROUP_FILES = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+                ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"))
+
+
 def available_memory_bytes() -> int:
     """Memory this process may still use, bytes: the smallest of the host's available memory
     (MemAvailable) and the cgroup's limit less its usage (cgroup v2 memory.max, or v1's limit)."""
@@ -58,9 +63,7 @@ def available_memory_bytes() -> int:
                     limits.append(int(line.split()[1]) * 1024)
     except (OSError, ValueError):
         pass
-    for limit_path, usage_path in (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
-                                   ("/sys/fs/cgroup/memory/memory.limit_in_bytes",
-                                    "/sys/fs/cgroup/memory/memory.usage_in_bytes")):
+    for limit_path, usage_path in CGROUP_FILES:
         limit = _read_int(limit_path)
         if limit is not None and limit < 2**60:
             limits.append(max(limit - (_read_int(usage_path) or 0), 0))
@@ -128,6 +131,16 @@ class Scene:
         need(self.dx > 0, f"dx must be > 0 m (got {self.dx})")
         need(self.x_max > self.x_min, f"x_max must be > x_min (got {self.x_min}..{self.x_max})")
         need(self.y_max > self.y_min, f"y_max must be > y_min (got {self.y_min}..{self.y_max})")
+        if self.strip_height is not None:
+            finite("strip_height")
+            need(self.strip_height > 0, f"strip_height must be > 0 m (got {self.strip_height})")
+        # the particle count in floating point first: a tiny dx must not overflow an integer
+        count = (self.x_max - self.x_min) / self.dx * (self.height_span / self.dx)
+        if not count <= 2**31 - 1:
+            limit = self.memory_limit()
+            need(False, f"dx = {self.dx} m gives {count:.3g} particles: more than the 2^31-1 supported and the "
+                        f"memory available ({limit / 2**30:.3g} GiB); the smallest dx that fits is about "
+                        f"{max(self.smallest_dx_fitting(limit), self.dx_for_particles(2**31 - 1)):.3g} m")
         need(self.rho0 > 0, f"rho0 must be > 0 kg/m^3 (got {self.rho0})")
         need(self.c0 > 0, f"c0 must be > 0 m/s (got {self.c0})")
         need(0 < self.mach < 1, f"mach must be in (0, 1) (got {self.mach})")
@@ -155,9 +168,6 @@ class Scene:
             need(self.t_end > 0, f"t_end must be > 0 s (got {self.t_end})")
             need(self.t_end / self.dt_max <= 10_000_000,
                  f"t_end = {self.t_end} s needs more than 1e7 steps at dt = {self.dt_max:g} s")
-        if self.strip_height is not None:
-            finite("strip_height")
-            need(self.strip_height > 0, f"strip_height must be > 0 m (got {self.strip_height})")
         least = STRIP_CUTOFFS * self.cutoff
         need(self.height >= least * (1 - 1e-9),
              f"{'strip_height' if self.strip_height is not None else 'y_max - y_min'} must be at least "
@@ -169,8 +179,6 @@ class Scene:
              f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
              f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
              f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m")
-        need(self.nx * self.ny <= 2**31 - 1,
-             f"dx = {self.dx} m gives {self.nx * self.ny:.3g} particles; at most 2^31-1 are supported")
 
     # ------------------------------------------------------------ geometry
     @property
@@ -249,6 +257,10 @@ class Scene:
         """The smallest lattice spacing whose arrays fit in ``limit_bytes``, m."""
         area = (self.x_max - self.x_min) * self.height_span
         return math.sqrt(area * bytes_per_particle(self.precision) / max(limit_bytes, 1))
+
+    def dx_for_particles(self, n: float) -> float:
+        """The lattice spacing that gives about ``n`` particles on this domain, m."""
+        return math.sqrt((self.x_max - self.x_min) * self.height_span / n)
 
     @property
     def height_span(self) -> float:

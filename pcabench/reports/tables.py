@@ -82,6 +82,8 @@ def table5(df) -> list[dict]:
     rows = []
     for row in table4(df):
         total = sum(row[s] for s in STEP_STAGES)
+        if not total > 0:
+            continue  # no timed step: no shares
         rows.append({"config": row["config"], "N": row["N"],
                      **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": t5.get(str(row["N"]))})
     return rows

@@ -1,0 +1,28 @@
+"""Progress of a run on stderr: its steps, and an ETA from the steps so far."""
+from __future__ import annotations
+
+import sys
+import time
+
+
+class Progress:
+    """Step progress on stderr, at most every ``every`` seconds, with an ETA."""
+
+    def __init__(self, label: str, every: float = 2.0, stream=sys.stderr):
+        self.label, self.every, self.stream = label, every, stream
+        self.t0 = self.last = time.perf_counter()
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.perf_counter()
+        if done <= 1:  # the clock starts with the first step, after compilation
+            self.t0 = self.last = now
+            return
+        if now - self.last < self.every and done < total:
+            return
+        self.last = now
+        eta = (now - self.t0) / max(done, 1) * (total - done)
+        self.stream.write(f"\r{self.label}: step {done}/{total} ({100 * done / total:5.1f} %), "
+                          f"eta {eta:6.1f} s ")
+        if done == total:
+            self.stream.write("\n")
+        self.stream.flush()
