@@ -198,18 +198,29 @@ def cmd_study(args) -> int:
     from .sweep import sweep
 
     name, specs = study_specs(args)
-    check_specs(specs)
+    if args.cluster:  # the workers check their own solvers (a GPU run needs a GPU worker, not a GPU here)
+        specs = [spec.resolved() for spec in specs]
+    else:
+        check_specs(specs)
     run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
             raise OptionError(f"{flag} must be > 0 seconds (got {value})")
-    profile = profiles.capture()
-    store_path = Path(args.results) / store_name(profile["id"])
-    check_writable(store_path)
-    profiles.save(profile)
-    print(f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
-          f"store {store_path}", file=sys.stderr, flush=True)
-    sweep(specs, store_path, run_budget, args.sweep_budget, retry_failed=args.retry_failed)
+    if args.cluster:
+        from .cluster import cluster_sweep, dask_distributed
+
+        dask_distributed()  # one line naming the extra, before anything else
+        print(f"pcabench study ({name}): {len(specs)} runs on the Dask cluster {args.cluster}, "
+              f"{run_budget:.0f} s per run at most, stores in {args.results}", file=sys.stderr, flush=True)
+        cluster_sweep(specs, Path(args.results), run_budget, args.cluster, retry_failed=args.retry_failed)
+    else:
+        profile = profiles.capture()
+        store_path = Path(args.results) / store_name(profile["id"])
+        check_writable(store_path)
+        profiles.save(profile)
+        print(f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
+              f"store {store_path}", file=sys.stderr, flush=True)
+        sweep(specs, store_path, run_budget, args.sweep_budget, retry_failed=args.retry_failed)
     if args.no_report:
         return 0
     for p in write_reports(Path(args.results), Path(args.reports)):
@@ -292,6 +303,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0,
                    help="seconds for the whole sweep")
     p.add_argument("--no-report", action="store_true", help="store the runs, do not write the reports")
+    p.add_argument("--cluster", metavar="ADDRESS",
+                   help="run each run as a Dask task: a scheduler address (tcp://host:8786) or local:N for a "
+                        "LocalCluster of N workers (pip install -e \".[cluster]\")")
     p.add_argument("--retry-failed", action="store_true",
                    help="run again the stored runs that timed out, were skipped or ended in an error")
     p.set_defaults(func=cmd_study)

@@ -117,8 +117,9 @@ def run_child(spec: RunSpec, timeout: float, commit: str, stream=sys.stderr) -> 
     return store.to_row(failed_record(spec, status, what + (f": {stderr}" if stderr else ""), this_profile_id()))
 
 
-def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None) -> str:
-    """The sweep's ETA and how sure it is: predicted runs from this host's timings, the rest at the mean so far."""
+def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None,
+             whose: str = "this host's") -> str:
+    """The sweep's ETA and how sure it is: runs predicted from ``whose`` timings, the rest at the mean so far."""
     if not remaining:
         return "done"
     predicted = [predicted_seconds(s, mine)[0] for s in remaining]
@@ -127,7 +128,7 @@ def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float 
     if unknown and seconds_per_run is None:
         return f"eta unknown ({len(remaining)} runs left, {len(known)} predicted)"
     total = sum(known) + unknown * (seconds_per_run or 0.0)
-    how = (f"{len(known)} of {len(remaining)} runs predicted from this host's timings"
+    how = (f"{len(known)} of {len(remaining)} runs predicted from {whose} timings"
            + (f", {unknown} at the mean so far" if unknown else ""))
     return f"eta {total / 60:.1f} min ({how})"
 

@@ -1,0 +1,82 @@
+"""Sweeps on a Dask cluster: the same runs as a serial sweep, resume, worker loss, and the optional extra."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+
+from pcabench import cli, store
+
+pytest.importorskip("dask.distributed")
+
+SWEEP = ["--dx", "1", "0.5", "--solver", "linkedlist-cpu", "allpair-cpu", "--steps", "3", "--no-report"]
+
+
+def study(results, *args, **kw):
+    return subprocess.run([sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(results)],
+                          capture_output=True, text=True, timeout=600, **kw)
+
+
+def outcome(results):
+    """What a sweep found, without timings or where it ran: one entry per run."""
+    return sorted((r["solver"], r["dx"], r["status"], r["steps"], round(r["mse"], 12), r["pair_loop"])
+                  for r in store.read_rows(results))
+
+
+def test_a_cluster_sweep_makes_the_same_runs_as_a_serial_one_and_resumes(tmp_path):
+    serial, dask = tmp_path / "serial", tmp_path / "dask"
+    assert study(serial, *SWEEP).returncode == 0
+    proc = study(dask, *SWEEP, "--cluster", "local:2")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert "dashboard at http" in proc.stderr and "4/4 done" in proc.stderr
+    assert outcome(dask) == outcome(serial) and len(outcome(dask)) == 4
+    rows = store.read_rows(dask)
+    assert all(r["profile_id"] and r["host"] for r in rows)  # captured on the worker
+    again = study(dask, *SWEEP, "--cluster", "local:2")
+    assert again.returncode == 0 and again.stderr.count("already stored") == 4
+    assert len(store.read_rows(dask)) == 4
+
+
+def test_a_killed_worker_loses_and_duplicates_nothing(tmp_path):
+    args = ["--dx", "0.25", "0.2", "--steps", "150", "--no-report", "--cluster", "local:2"]
+    proc = subprocess.Popen([sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(tmp_path)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    worker = None
+    deadline = time.time() + 180
+    while time.time() < deadline and worker is None and proc.poll() is None:
+        out = subprocess.run(["pgrep", "-f", "pcabench.child"], capture_output=True, text=True).stdout.split()
+        for pid in out:
+            try:
+                ppid = int(next(l for l in open(f"/proc/{pid}/status") if l.startswith("PPid:")).split()[1])
+            except (OSError, StopIteration):
+                continue
+            if ppid != proc.pid:  # a run's child under a Dask worker process
+                worker = ppid
+                break
+        time.sleep(0.1)
+    assert worker is not None, "no run started on a worker"
+    os.kill(worker, 9)  # the worker dies mid-run; its run's child dies with it
+    _, err = proc.communicate(timeout=600)
+    assert proc.returncode == 0, err[-2000:]
+    rows = store.read_rows(tmp_path)
+    assert sorted(r["dx"] for r in rows) == [0.2, 0.25]  # each run once: retried elsewhere, or recorded as lost
+    assert all(r["status"] == "ok" or "lost" in r["message"] for r in rows)
+
+
+def test_without_dask_the_option_names_the_extra(monkeypatch, capsys, tmp_path):
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # import fails as if dask were not installed
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["study", *SWEEP, "--cluster", "local:2", "--results", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "[cluster]" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("address", ["local:0", "local:x", "host:8786"])
+def test_bad_cluster_addresses_are_one_line(address, capsys, tmp_path):
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["study", *SWEEP, "--cluster", address, "--results", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "--cluster" in err and "Traceback" not in err
