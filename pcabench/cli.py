@@ -242,6 +242,34 @@ def cmd_report(args) -> int:
     return 0
 
 
+def cmd_runs(args) -> int:
+    import warnings
+
+    import pandas as pd
+
+    from . import runs
+    from .store import load
+
+    results = args.results or (paths.reference_results() if args.reference else paths.user_results())
+    with warnings.catch_warnings():
+        warnings.simplefilter("default")
+        df = load(results)
+    with pd.option_context("display.max_columns", None, "display.width", 200):
+        if args.compare:
+            try:
+                out = runs.compare(df, *args.compare)
+            except KeyError as exc:
+                raise OptionError(exc.args[0]) from None
+            print(out.to_string(float_format=lambda v: f"{v:.4g}") if not out.empty else
+                  "no configuration was run by both")
+        else:
+            out = runs.table(df, solver=args.solver, status=args.status, machine=args.machine, commit=args.commit,
+                             model=args.model).tail(args.limit)
+            print(out.to_string(index=False, float_format=lambda v: f"{v:.4g}") if not out.empty else
+                  f"no stored runs match in {results}")
+    return 0
+
+
 def cmd_profile(args) -> int:
     from . import profiles
 
@@ -316,6 +344,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--results", help=results_help)
     p.add_argument("--out", help=reports_help)
     p.set_defaults(func=cmd_report)
+
+    p = sub.add_parser("runs", help="list and filter stored runs, or compare two machines or commits")
+    p.add_argument("--results", help=results_help)
+    p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
+    p.add_argument("--solver")
+    p.add_argument("--status")
+    p.add_argument("--machine", help="a machine (profile id, or profile--host), or a prefix of one")
+    p.add_argument("--commit", help="a commit prefix")
+    p.add_argument("--model")
+    p.add_argument("--compare", nargs=2, metavar=("A", "B"),
+                   help="the runs both A and B made (machines, or commit prefixes): step times, ratio, errors")
+    p.add_argument("--limit", type=positive_int("--limit"), default=200, help="the newest rows to print at most")
+    p.set_defaults(func=cmd_runs)
 
     p = sub.add_parser("profile", help="capture this machine's hardware profile")
     p.add_argument("--save", action="store_true", help="store it among the user's profiles")

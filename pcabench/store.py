@@ -29,6 +29,8 @@ import shutil
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from .record import STEP_STAGES
 
 SCHEMA = 2  # version of the row format; rows from before versioning are schema 1
@@ -259,6 +261,12 @@ def load(paths):
         flat.append(r)
     df = pd.DataFrame(flat)
     if not df.empty:
+        if "host" not in df:
+            df["host"] = ""
+        df["host"] = df["host"].fillna("")
+        # one machine: a hardware profile, and its host where several hosts share the profile
+        hosts = df.groupby("profile_id")["host"].transform("nunique")
+        df["machine"] = np.where(hosts > 1, df["profile_id"] + "--" + df["host"], df["profile_id"])
         step_total = sum(df[f"t_{s}"] for s in STEP_STAGES)
         df["t_step"] = step_total / df["steps"].clip(lower=1)
         df["t_solution"] = df["t_init"] + step_total  # s, without JIT and I/O

@@ -54,34 +54,60 @@ def _sections_timing(df) -> list[str]:
     rows4 = T.table4(df)
     if rows4:
         lines += ["## Table 4: stage times (the paper's scene: lagrangian, full domain)", "",
-                  "input, init and output in ms per run; SNP, PI and SU in ms per step. The paper's column is its "
-                  "published Table 4 (Tesla K20c, GPU, one step, ms: input / init / SNP / PI / SU / output).", "",
-                  md_table(["config", "N", "input", "init", "SNP", "PI", "SU", "output", "paper (K20c)"],
+                  "input, init and output in ms per run; SNP, PI and SU in ms per step. The paper's column compares "
+                  "like with like: beside a GPU row its Table 4 (Tesla K20c, one step, ms: input / init / SNP / PI "
+                  "/ SU / output), beside a CPU row its serial CPU step (Xeon E5-2680, ms: the 400K figure of its "
+                  "text, and its Table 6 CPU runs / 100 steps). `[list]` and `[gather]` name the linked list's "
+                  "pair loop (gather is the paper's); rows without one predate the pair list and used gather.", "",
+                  md_table(["config", "N", "input", "init", "SNP", "PI", "SU", "output", "commit",
+                            "paper, same kind (published)"],
                            [[r["config"], f"{r['N']:,}", fmt(r["input"], ".2f"), fmt(r["init"], ".2f"),
                              fmt(r["snp"], ".3f"), fmt(r["pi"], ".3f"), fmt(r["su"], ".3f"), fmt(r["output"], ".2f"),
-                             " / ".join(f"{v:g}" for v in r["paper"]) if r["paper"] else "-"] for r in rows4]), "",
+                             r["commit"], _paper_cell(r)] for r in rows4]), "",
                   "## Table 5 and Fig. 11: share of a step", "",
-                  "The paper's Table 5 is its GPU code; its Fig. 11 (serial CPU) gives about 43 % SNP and "
-                  "53 % PI.", "",
-                  md_table(["config", "N", "SNP %", "PI %", "SU %", "paper K20c SNP / PI / SU %"],
+                  "The paper's column compares like with like: beside a GPU row its Table 5 (Tesla K20c), beside a "
+                  "CPU row its Fig. 11 (serial CPU: about 43 % SNP and 53 % PI, all N).", "",
+                  md_table(["config", "N", "SNP %", "PI %", "SU %", "paper, same kind: SNP / PI / SU % (published)"],
                            [[r["config"], f"{r['N']:,}", fmt(r["snp"], ".1f"), fmt(r["pi"], ".1f"),
                              fmt(r["su"], ".1f"), " / ".join(f"{v:g}" for v in r["paper"]) if r["paper"] else "-"]
                             for r in T.table5(df)]), ""]
     return lines
 
 
+def _paper_cell(r) -> str:
+    if r["paper"] is None:
+        return "-"
+    if r["paper_kind"] == "gpu":
+        return "K20c " + " / ".join(f"{v:g}" for v in r["paper"])
+    return f"CPU step {r['paper']:g}"
+
+
 def _section_table6(df_all, pid) -> list[str]:
     rows = [r for r in T.table6(df_all) if pid in (r["gpu_profile"],)]
     if not rows:
         return []
-    return ["## Table 6: CPU against GPU, one step", "",
-            "CPU: linkedlist-cpu float64, one thread (as the paper's), and all cores where measured. "
-            "A CPU measured on another machine is named; see [cards.md](../cards.md) for every system.", "",
-            md_table(["N", "GPU precision", "GPU ms", "CPU (profile)", "CPU ms", "speedup", "speedup vs all cores"],
-                     [[f"{r['N']:,}", r["precision"], fmt(r["gpu_ms"], ".3f"), r["cpu_profile"],
-                       fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
-                       "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f} "
-                                                                   f"(x{r['cpu_threads']})"] for r in rows]), ""]
+    same = [r for r in rows if r["same_machine"]]
+    other = [r for r in rows if not r["same_machine"]]
+    lines = ["## Table 6: CPU against GPU, one step", "",
+             "Speedups from one machine only: this GPU against its own host's CPU (linkedlist-cpu float64), one "
+             "thread (as the paper's) and every core (the honest peer). See [cards.md](../cards.md) for every "
+             "system.", ""]
+    lines += [_table6_md(same) if same else
+              "No CPU run of the paper's scene on this GPU's host yet: no same-machine speedup to show "
+              "(`pcabench gpu-check` times the host's CPU too).", ""]
+    if other:
+        lines += ["### Across machines (not a speedup of one machine)", "",
+                  "This GPU's times against a CPU measured on another machine, named per row: a comparison of "
+                  "two computers, not what a GPU buys one of them.", "", _table6_md(other), ""]
+    return lines
+
+
+def _table6_md(rows) -> str:
+    return md_table(["N", "GPU precision", "GPU ms", "CPU (profile)", "CPU ms", "speedup", "speedup vs all cores"],
+                    [[f"{r['N']:,}", r["precision"], fmt(r["gpu_ms"], ".3f"), r["cpu_profile"],
+                      fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
+                      "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f} "
+                                                                  f"(x{r['cpu_threads']})"] for r in rows])
 
 
 def _section_fig9(df) -> list[str]:
@@ -235,10 +261,12 @@ def _section_failed(df) -> list[str]:
                       "message"], rows), ""]
 
 
-def report_for(df, df_all, pid: str, out: Path) -> Path:
+def report_for(df, df_all, name: str, out: Path) -> Path:
+    """The report of one machine's runs (``name``: its profile id, with its host where a profile has several)."""
     out.mkdir(parents=True, exist_ok=True)
-    figs = [f(df, out, pid) for f in (F.fig8, F.fig9, F.fig10, F.fig11, F.fig13, F.speed_vs_accuracy)]
-    figs.append(F.stability_map(df, out, pid, INACCURATE_ABOVE))
+    pid = str(df.profile_id.iloc[0])
+    figs = [f(df, out, name) for f in (F.fig8, F.fig9, F.fig10, F.fig11, F.fig13, F.speed_vs_accuracy)]
+    figs.append(F.stability_map(df, out, name, INACCURATE_ABOVE))
     if T.table6(df_all) and any(r["gpu_profile"] == pid for r in T.table6(df_all)):
         figs.append(F.fig14(df_all[df_all.profile_id.isin({pid} | {r["cpu_profile"] for r in T.table6(df_all)})],
                             out, pid))
@@ -247,9 +275,11 @@ def report_for(df, df_all, pid: str, out: Path) -> Path:
         stale.unlink()
     counts = df.status.value_counts().to_dict()
     commits = sorted({c[:12] + ("+dirty" if c.endswith("+dirty") else "") for c in df.commit.astype(str)})
-    lines = [f"# pcabench report: {pid}", "", f"Machine: {_machine(pid)}.", "",
+    hosts = sorted({str(h) for h in df.host.fillna("") if h}) or ["not recorded"]
+    lines = [f"# pcabench report: {name}", "", f"Machine: {_machine(pid)}; host {', '.join(hosts)}.", "",
              f"Runs: {len(df)} ({', '.join(f'{v} {k}' for k, v in sorted(counts.items()))}); commits: "
-             f"{', '.join(commits)}. Regenerate with `pcabench report`.", ""]
+             f"{', '.join(commits)}. Every row below is from this machine (a table headed \"across machines\" names "
+             "the other one); Table 4 names the commit of each row. Regenerate with `pcabench report`.", ""]
     for section in (_sections_timing(df), _section_table6(df_all, pid), _section_fig9(df), _section_fig8(df),
                     _section_front(df), _section_simplifications(df), _section_stability(df), _section_failed(df)):
         lines += section
@@ -266,11 +296,23 @@ def cards_page(df_all, reports_dir: Path) -> list[Path]:
     ours, pub, cards = T.table6(df_all), T.table6_published(), T.cards(df_all)
     lines = ["# Systems and GPU cards side by side", "",
              "Regenerated by `pcabench report` from every results store and stored profile.", "",
-             "## Table 6: CPU against GPU per step", "", "Measured:", ""]
-    lines += [md_table(["GPU profile", "N", "precision", "GPU ms", "CPU profile", "CPU ms (1 thread)", "speedup"],
-                       [[r["gpu_profile"], f"{r['N']:,}", r["precision"], fmt(r["gpu_ms"], ".3f"), r["cpu_profile"],
-                         fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f")] for r in ours])
-              if ours else "No profile holds both GPU and serial CPU runs of the paper's scene at the same N yet."]
+             "## Table 6: CPU against GPU per step", "",
+             "Measured, each GPU against its own host's CPU (one thread):", ""]
+    same = [r for r in ours if r["same_machine"]]
+    other = [r for r in ours if not r["same_machine"]]
+    lines += [md_table(["GPU profile", "N", "precision", "GPU ms", "CPU ms (1 thread)", "speedup",
+                        "speedup vs all cores"],
+                       [[r["gpu_profile"], f"{r['N']:,}", r["precision"], fmt(r["gpu_ms"], ".3f"),
+                         fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
+                         "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f}"] for r in same])
+              if same else "No GPU has been measured with its own host's CPU at the same N yet."]
+    if other:
+        lines += ["", "Across machines (a GPU against another machine's CPU core; not a speedup of one machine):",
+                  "", md_table(["GPU profile", "N", "precision", "GPU ms", "CPU profile", "CPU ms (1 thread)",
+                                "ratio"],
+                               [[r["gpu_profile"], f"{r['N']:,}", r["precision"], fmt(r["gpu_ms"], ".3f"),
+                                 r["cpu_profile"], fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f")]
+                                for r in other])]
     lines += ["", "Published (the paper's Table 6, 100 steps; its runtime unit is printed as min, but Table 4 "
                   "makes seconds the consistent reading):", "",
               md_table(["system", "card", "N", "CPU runtime", "GPU runtime", "speedup per step"],
@@ -278,10 +320,28 @@ def cards_page(df_all, reports_dir: Path) -> list[Path]:
                         for r in pub]), ""]
     lines += ["## GPU cards: one lagrangian step (SNP + PI + SU)", ""]
     if cards:
-        lines += [md_table(["card", "precision", "N", "step ms", "SNP ms", "PI ms", "SU ms", "ps per particle-step"],
+        lines += [md_table(["card", "precision", "N", "step ms", "SNP %", "PI %", "SU %", "ns per particle-step",
+                            "ps per pair"],
                            [[r["card"], r["precision"], f"{r['N']:,}", fmt(r["step_ms"], ".3f"),
-                             fmt(r["snp_ms"], ".3f"), fmt(r["pi_ms"], ".3f"), fmt(r["su_ms"], ".3f"),
-                             fmt(r["ps_per_particle_step"], ".0f")] for r in cards]), ""]
+                             fmt(r["snp_pct"], ".1f"), fmt(r["pi_pct"], ".1f"), fmt(r["su_pct"], ".1f"),
+                             fmt(r["ns_per_particle_step"], ".2f"), fmt(r["ps_per_pair"], ".2f")] for r in cards]),
+                  "", "ps per pair counts both sweeps of a Verlet step (2 x N x mean neighbours pairs).", ""]
+        ceilings = T.card_ceilings(df_all)
+        if ceilings:
+            lines += ["### Each card's measured ceilings", "",
+                      md_table(["card", "copy bandwidth TB/s", "FP32 FMA TFLOP/s", "FP64 FMA TFLOP/s"],
+                               [[c["card"], fmt(c["copy_bandwidth_tbs"]), fmt(c["fp32_fma_tflops"]),
+                                 fmt(c["fp64_fma_tflops"])] for c in ceilings]), ""]
+        ratios = T.card_ratios(df_all)
+        if ratios:
+            lines += ["### Two cards against the ratio of their ceilings", "",
+                      "Step-time ratio at the same N and precision beside the ratio of each measured ceiling: a "
+                      "kernel bound by memory follows the bandwidth ratio, one bound by instruction issue follows "
+                      "the FMA ratio.", "",
+                      md_table(["cards (A / B)", "precision", "N", "step time B / A", "bandwidth A / B",
+                                "FMA A / B"],
+                               [[f"{r['a']} / {r['b']}", r["precision"], f"{r['N']:,}", fmt(r["speed_ratio"]),
+                                 fmt(r["bandwidth_ratio"]), fmt(r["fma_ratio"])] for r in ratios]), ""]
     else:
         lines += ["No GPU runs stored yet: run `pcabench gpu-check` on a GPU machine and merge its results.", ""]
     figs = [F.fig14(df_all, reports_dir, "all systems"), F.cards_figure(df_all, reports_dir)]
@@ -297,11 +357,12 @@ def write_reports(results_dir: Path, reports_dir: Path) -> list[Path]:
         raise SystemExit(f"no results in {results_dir}: run `pcabench study --quick` first")
     reports_dir = Path(reports_dir)
     reports_dir.mkdir(parents=True, exist_ok=True)
-    paths = [report_for(g, df_all, str(pid), reports_dir / str(pid)) for pid, g in df_all.groupby("profile_id")]
+    paths = [report_for(g, df_all, str(name), reports_dir / str(name)) for name, g in df_all.groupby("machine")]
     paths += cards_page(df_all, reports_dir)
-    index = ["# Reports", "", "Regenerated by `pcabench report` from `results/*.jsonl`.", "",
+    index = ["# Reports", "", f"Regenerated by `pcabench report` from the stores in `{Path(results_dir).name}/`; "
+             "one report per machine (hardware profile, and host where one profile has several).", "",
              "- [cards.md](cards.md): Table 6, Fig. 14 and the GPU cards side by side, every system"]
-    index += [f"- [{p.parent.name}]({p.parent.name}/report.md): {_machine(p.parent.name)}"
+    index += [f"- [{p.parent.name}]({p.parent.name}/report.md): {_machine(p.parent.name.split('--')[0])}"
               for p in paths if p.name == "report.md"]
     index += ["", "GPU check tables and Nsight Compute profiles: [gpu/](gpu/); notes: [gpu/NOTES.md](gpu/NOTES.md)."]
     (reports_dir / "README.md").write_text("\n".join(index) + "\n")

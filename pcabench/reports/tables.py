@@ -62,16 +62,33 @@ def _newest_per(df, keys):
 
 
 # ---------------------------------------------------------------- Tables 4, 5 and Figs. 11, 13
+def paper_cpu_step_ms() -> dict:
+    """The paper's serial CPU step (Xeon E5-2680), ms, by N: its 400K figure and Table 6's CPU runs / 100 steps
+    (read as s, as for its GPU column)."""
+    pub = published()
+    out = {int(n): 1e3 * cpu / 100 for n, (cpu, _gpu, _s) in pub["table6"]["rows"].items()}
+    out[400_000] = pub["text"]["cpu_vs_gpu_step_400k_ms"]["cpu"]
+    return dict(sorted(out.items()))
+
+
 def table4(df) -> list[dict]:
-    """Stage times by N: input, init, output in ms per run; SNP, PI, SU in ms per step."""
+    """Stage times by N: input, init, output in ms per run; SNP, PI, SU in ms per step.
+
+    ``paper`` is the paper's number for the same kind of processor: its K20c
+    stage times (Table 4) beside a GPU row, its serial CPU step beside a CPU row.
+    """
     t4 = published()["table4"]["rows"]
+    cpu_ms = paper_cpu_step_ms()
     rows = []
     keys = ["solver", "precision", "threads", "pair_loop", "n_particles"]
     for _, r in _newest_per(paper_scene(df), keys).sort_values(keys).iterrows():
-        row = {"config": label(r), "N": int(r.n_particles)}
+        row = {"config": label(r), "N": int(r.n_particles), "commit": str(r.commit)[:7]}
         row.update({s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")})
         row.update(per_step_ms(r))
-        row["paper"] = t4.get(str(int(r.n_particles)))
+        if r.solver == "linkedlist-gpu":
+            row["paper"], row["paper_kind"] = t4.get(str(int(r.n_particles))), "gpu"
+        else:
+            row["paper"], row["paper_kind"] = cpu_ms.get(int(r.n_particles)), "cpu"
         rows.append(row)
     return rows
 
@@ -79,13 +96,18 @@ def table4(df) -> list[dict]:
 def table5(df) -> list[dict]:
     """Each step stage's share of a step, %, with the paper's (GPU, Table 5) beside it."""
     t5 = published()["table5"]["rows"]
+    cpu = published()["text"]["fig11_cpu_step_shares_pct"]
     rows = []
     for row in table4(df):
         total = sum(row[s] for s in STEP_STAGES)
         if not total > 0:
             continue  # no timed step: no shares
+        if row["paper_kind"] == "gpu":  # Table 5 is the paper's GPU; its Fig. 11 text gives its serial CPU
+            paper = t5.get(str(row["N"]))
+        else:
+            paper = [cpu["snp"], cpu["pi"], 100 - cpu["snp"] - cpu["pi"]]
         rows.append({"config": row["config"], "N": row["N"],
-                     **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": t5.get(str(row["N"]))})
+                     **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": paper})
     return rows
 
 
@@ -119,7 +141,8 @@ def table6(df_all) -> list[dict]:
         c = (here if not here.empty else serial).sort_values("timestamp").iloc[-1]
         multi = same_n[(same_n.threads > 1) & (same_n.profile_id == c.profile_id)]
         m = multi.sort_values("threads").iloc[-1] if not multi.empty else None
-        rows.append({"gpu_profile": g.profile_id, "cpu_profile": c.profile_id, "N": int(g.n_particles),
+        rows.append({"gpu_profile": g.profile_id, "cpu_profile": c.profile_id, "same_machine": c.profile_id ==
+                     g.profile_id, "N": int(g.n_particles),
                      "precision": g.precision, "cpu_ms": 1e3 * c.t_step, "gpu_ms": 1e3 * g.t_step,
                      "speedup": c.t_step / g.t_step,
                      "cpu_threads": None if m is None else int(m.threads),
@@ -355,10 +378,49 @@ def cards(df_all) -> list[dict]:
     rows = []
     for _, r in gpu.sort_values(["n_particles", "profile_id", "precision"]).iterrows():
         card = (profiles.stored().get(r.profile_id, {}).get("gpu") or {}).get("name", r.profile_id)
+        per = per_step_ms(r)
+        total = sum(per.values())
+        pairs = 2 * r.n_particles * (r.mean_neighbours if np.isfinite(r.mean_neighbours or np.nan) else np.nan)
         rows.append({"profile": r.profile_id, "card": card, "precision": r.precision, "N": int(r.n_particles),
-                     "step_ms": 1e3 * r.t_step, **{f"{s}_ms": v for s, v in per_step_ms(r).items()},
-                     "ps_per_particle_step": 1e12 * r.t_step / r.n_particles})
+                     "step_ms": 1e3 * r.t_step, **{f"{s}_ms": v for s, v in per.items()},
+                     **{f"{s}_pct": 100 * v / total if total else np.nan for s, v in per.items()},
+                     "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
+                     "ps_per_pair": 1e12 * r.t_step / pairs if pairs and np.isfinite(pairs) else np.nan})
     return rows
+
+
+def card_ceilings(df_all) -> list[dict]:
+    """Each measured card's ceilings from its profile (``pcabench gpu-check``: copy bandwidth, FMA rates)."""
+    out = []
+    for pid in sorted({r["profile"] for r in cards(df_all)}):
+        prof = profiles.stored().get(pid, {})
+        measured = prof.get("measured") or {}
+        if measured:
+            out.append({"profile": pid, "card": (prof.get("gpu") or {}).get("name", pid),
+                        **{k: measured.get(k) for k in ("copy_bandwidth_tbs", "fp32_fma_tflops", "fp64_fma_tflops")}})
+    return out
+
+
+def card_ratios(df_all) -> list[dict]:
+    """For every two measured cards: step-time ratio at each shared N and precision beside their ceiling ratios."""
+    rows, ceil = cards(df_all), {c["profile"]: c for c in card_ceilings(df_all)}
+    out = []
+    pids = sorted(ceil)
+    for i, a in enumerate(pids):
+        for b in pids[i + 1:]:
+            ta = {(r["precision"], r["N"]): r["step_ms"] for r in rows if r["profile"] == a}
+            tb = {(r["precision"], r["N"]): r["step_ms"] for r in rows if r["profile"] == b}
+            for precision, n in sorted(set(ta) & set(tb)):
+                fma = "fp32_fma_tflops" if precision == "float32" else "fp64_fma_tflops"
+                out.append({"a": ceil[a]["card"], "b": ceil[b]["card"], "precision": precision, "N": n,
+                            "speed_ratio": tb[(precision, n)] / ta[(precision, n)],
+                            "bandwidth_ratio": _ratio(ceil[a]["copy_bandwidth_tbs"], ceil[b]["copy_bandwidth_tbs"]),
+                            "fma_ratio": _ratio(ceil[a][fma], ceil[b][fma])})
+    return out
+
+
+def _ratio(x, y):
+    return x / y if x and y else None
 
 
 def cards_published() -> list[dict]:
