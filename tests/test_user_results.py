@@ -1,0 +1,151 @@
+"""What a new user meets in the first hour: their own store, honest comparisons, progress, output paths,
+a CLI that agrees with the README, and a table of stored runs."""
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+
+import pytest
+
+from pcabench import __version__, cli, paths, runs, store
+from pcabench.spec import RunSpec
+from pcabench.sweep import sweep
+from solvers import Scene
+
+from .test_study import fixture_rows
+
+
+def main(*args, capsys):
+    try:
+        code = cli.main(list(args))
+    except SystemExit as exc:
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+# ---------------------------------------------------------------- a user's runs are their own
+def test_a_users_runs_go_to_an_ignored_folder_never_to_tracked_files(monkeypatch):
+    monkeypatch.delenv("PCABENCH_HOME", raising=False)
+    root = paths.checkout()
+    assert root is not None and paths.user_results().is_relative_to(root)
+    assert paths.user_results() != paths.reference_results()
+    target = paths.user_results().relative_to(root) / "machine--host.jsonl"
+    ignored = subprocess.run(["git", "check-ignore", "-q", str(target)], cwd=root)
+    assert ignored.returncode == 0, f"{target} is not ignored by git"
+    monkeypatch.setenv("PCABENCH_HOME", "/tmp/elsewhere")
+    assert str(paths.user_results()).startswith("/tmp/elsewhere")
+
+
+def test_two_hosts_of_one_profile_get_two_stores_and_two_reports(tmp_path):
+    assert store.store_name("amd-epyc", "h1") != store.store_name("amd-epyc", "h2")
+    results = tmp_path / "results"
+    for host in ("h1", "h2"):
+        for r in fixture_rows()[:4]:
+            r.host = host
+            r.run_id = f"{host}-{r.run_id}"
+            store.append(r, results / store.store_name(r.profile_id, host))
+    from pcabench.reports import write_reports
+
+    write_reports(results, tmp_path / "out")
+    assert (tmp_path / "out" / "machine-a--h1" / "report.md").exists()
+    assert (tmp_path / "out" / "machine-a--h2" / "report.md").exists()
+    assert "host h2" in (tmp_path / "out" / "machine-a--h2" / "report.md").read_text()
+
+
+# ---------------------------------------------------------------- honest comparisons
+@pytest.fixture
+def reports(tmp_path):
+    results = tmp_path / "results"
+    for r in fixture_rows():
+        store.append(r, results / f"{r.profile_id}.jsonl")
+    from pcabench.reports import write_reports
+
+    write_reports(results, tmp_path / "out")
+    return tmp_path / "out"
+
+
+def test_table4_sets_cpu_beside_the_papers_cpu_and_gpu_beside_its_gpu(reports):
+    text = (reports / "machine-a" / "report.md").read_text()
+    table4 = text.split("## Table 4")[1].split("## Table 5")[0]
+    for line in table4.splitlines():
+        if line.startswith("| linkedlist-cpu") or line.startswith("| allpair-cpu"):
+            assert "K20c" not in line, line
+        if line.startswith("| linkedlist-gpu") and "1,000" not in line:
+            assert "CPU step" not in line, line
+
+
+def test_cross_machine_speedups_stand_apart_from_same_machine_ones(reports):
+    b = (reports / "machine-b" / "report.md").read_text()
+    table6 = b.split("## Table 6")[1].split("\n## ")[0]
+    same, _, across = table6.partition("### Across machines")
+    assert "machine-a" not in same  # no same-machine row borrows another CPU
+    assert "machine-a" in across
+    cards = (reports / "cards.md").read_text()
+    measured, _, rest = cards.partition("Across machines")
+    assert "| machine-b |" not in measured.split("Published")[0]
+
+
+# ---------------------------------------------------------------- progress and output paths
+def test_a_sweep_shows_the_run_in_progress_its_size_and_a_qualified_eta(tmp_path):
+    stream = io.StringIO()
+    specs = [RunSpec("linkedlist-cpu", Scene(dx=dx, steps=3)) for dx in (1.0, 0.5)]
+    sweep(specs, tmp_path / "s.jsonl", run_budget=300, sweep_budget=600, stream=stream)
+    text = stream.getvalue()
+    assert "[1/2] linkedlist-cpu [list] dx=1 N=1,000 steps=3: running" in text
+    assert "N=4,000" in text and "sweep: 2/2 done" in text
+    assert "eta" in text and "predicted from this host's timings" in text
+
+
+def test_a_bad_fields_path_is_refused_before_the_run(tmp_path, capsys):
+    code, out, err = main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--fields",
+                          str(tmp_path / "no" / "such" / "f.npz"), capsys=capsys)
+    assert code == 2 and "--fields" in err and "Traceback" not in err and "stage" not in out
+
+
+def test_json_is_standard_json_null_never_nan(capsys):
+    code, out, _ = main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
+                        "--model", "linear", "--json", "--quiet", capsys=capsys)
+
+    def refuse(name):
+        raise ValueError(f"non-standard JSON constant {name}")
+
+    row = json.loads(out, parse_constant=refuse)
+    assert code == 1 and row["status"] == "unstable" and row["mse"] is None
+
+
+# ---------------------------------------------------------------- the CLI agrees with the README
+def test_study_lists_take_several_values_as_documented():
+    parser = cli.build_parser()
+    args = parser.parse_args(["study", "--dx", "1", "0.5", "--steps", "5", "10", "--threads", "1", "all"])
+    name, specs = cli.study_specs(args)
+    assert name == "matrix" and len(specs) == 2 * 2 * 2
+    assert {s.scene.steps for s in specs} == {5, 10} and {s.threads for s in specs} == {1, "all"}
+
+
+def test_usage_errors_are_one_line_and_version_is_there(capsys):
+    code, _, err = main("run", "--solver", "linkedlist-cpu", "--dx", capsys=capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "--dx" in err
+    code, out, _ = main("--version", capsys=capsys)
+    assert code == 0 and __version__ in out
+    code, out, _ = main("run", "--help", capsys=capsys)
+    for word in ("allpair-cpu", "lagrangian", "fixed", "linear", "verlet", "kdk1", "euler", "rk2", "gather"):
+        assert word in out, word
+
+
+# ---------------------------------------------------------------- stored runs as a table
+def test_runs_lists_filters_and_compares(tmp_path):
+    results = tmp_path / "results"
+    for r in fixture_rows():
+        store.append(r, results / f"{r.profile_id}.jsonl")
+    df = store.load(results)
+    gpu = runs.table(df, solver="linkedlist-gpu", machine="machine-a")
+    assert set(gpu.solver) == {"linkedlist-gpu"} and set(gpu.machine) == {"machine-a"} and len(gpu) == 2
+    both = runs.compare(df, "machine-a", "machine-b")
+    row = both[(both.solver == "linkedlist-gpu") & (both.N == 1000)]
+    assert len(row) == 0  # machine-a's GPU ran float32, machine-b's float64: not the same configuration
+    with pytest.raises(KeyError, match="neither a machine nor a commit"):
+        runs.compare(df, "machine-a", "nowhere")
+    same = runs.compare(df, "machine-a", "abc")  # a machine against a commit it made: every run matches itself
+    assert len(same) > 0 and (same["b / a"] == 1.0).all()
