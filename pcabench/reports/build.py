@@ -110,6 +110,19 @@ def _table6_md(rows) -> str:
                                                                   f"(x{r['cpu_threads']})"] for r in rows])
 
 
+def _section_speed(df) -> list[str]:
+    rows = T.speed(df)
+    if not rows:
+        return []
+    return ["## Speed per particle-step and per neighbour pair (the paper's domain)", "",
+            "One step (SNP + PI + SU) per particle, and per neighbour pair (two sweeps over N x mean neighbours "
+            "pairs per Verlet step). `[list]`: each pair once per search with its kernel factors; `[gather]`: "
+            "the paper's loop over each particle's stencil in every sweep.", "",
+            md_table(["config", "model", "N", "ns per particle-step", "ns per pair", "SNP %", "commit"],
+                     [[r["config"], r["model"], f"{r['N']:,}", fmt(r["ns_per_particle_step"], ".0f"),
+                       fmt(r["ns_per_pair"], ".2f"), fmt(r["snp_pct"], ".1f"), r["commit"]] for r in rows]), ""]
+
+
 def _section_fig9(df) -> list[str]:
     rows = T.fig9(df)
     if not any(r["allpair_ms"] or r["allpair_status"] == "skipped" for r in rows):
@@ -280,7 +293,8 @@ def report_for(df, df_all, name: str, out: Path) -> Path:
              f"Runs: {len(df)} ({', '.join(f'{v} {k}' for k, v in sorted(counts.items()))}); commits: "
              f"{', '.join(commits)}. Every row below is from this machine (a table headed \"across machines\" names "
              "the other one); Table 4 names the commit of each row. Regenerate with `pcabench report`.", ""]
-    for section in (_sections_timing(df), _section_table6(df_all, pid), _section_fig9(df), _section_fig8(df),
+    for section in (_sections_timing(df), _section_speed(df), _section_table6(df_all, pid), _section_fig9(df),
+                    _section_fig8(df),
                     _section_front(df), _section_simplifications(df), _section_stability(df), _section_failed(df)):
         lines += section
     lines += ["## Figures", ""]

@@ -160,6 +160,25 @@ def table6_published() -> list[dict]:
     return sorted(rows, key=lambda r: (r["system"], r["N"]))
 
 
+# ---------------------------------------------------------------- speed per particle and per pair
+def speed(df) -> list[dict]:
+    """ns per particle-step and per neighbour pair for every solver, model and size of the paper's domain.
+
+    A neighbour pair counts once per sweep and direction: a Verlet step makes
+    two sweeps over N x mean-neighbour pairs (the GPU check's ps/pair likewise).
+    """
+    runs = default_numerics(latest(df[(df.status == "ok") & (df.domain == "full")]))
+    rows = []
+    keys = ["solver", "threads", "pair_loop", "precision", "model", "n_particles"]
+    for _, r in _newest_per(runs, keys).sort_values(keys).iterrows():
+        pairs = 2 * r.n_particles * r.mean_neighbours
+        rows.append({"config": label(r), "model": r.model, "N": int(r.n_particles), "commit": str(r.commit)[:7],
+                     "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
+                     "ns_per_pair": 1e9 * r.t_step / pairs if pairs > 0 else None,
+                     "snp_pct": 100 * r.t_snp / (r.t_snp + r.t_pi + r.t_su)})
+    return rows
+
+
 # ---------------------------------------------------------------- Fig. 9
 def fig9(df) -> list[dict]:
     """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL."""
