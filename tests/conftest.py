@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from benchmarks.common import gpu_available
+from pcabench import cli
 from pcabench.run import run
 from solvers import Scene
 
@@ -22,3 +23,13 @@ def run_fields(scene: Scene, solver: str, tmp_path, threads=1):
 def requires_gpu():
     if not gpu_available():
         pytest.skip("no CUDA GPU on this machine (the simulator tests cover the kernels)")
+
+
+def cli_main(*args, capsys):
+    """``pcabench ARGS`` in this process: (exit code, stdout, stderr)."""
+    try:
+        code = cli.main(list(args))
+    except SystemExit as exc:
+        code = exc.code
+    out, err = capsys.readouterr()
+    return code, out, err

@@ -8,18 +8,9 @@ import sys
 import numpy as np
 import pytest
 
-from pcabench import cli
 from solvers import Scene, SceneError
 
-
-def main_in_process(*args, capsys):
-    """``pcabench ARGS`` in this process: (exit code, stdout, stderr)."""
-    try:
-        code = cli.main(list(args))
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
+from .conftest import cli_main
 
 
 def pcabench(*args, timeout=600):
@@ -77,7 +68,7 @@ def test_unstable_run_reports_status_and_step_with_exit_1():
     (["--dx", "1", "--model", "eulerian"], ["model", "lagrangian"]),
 ])
 def test_bad_input_exits_2_with_a_clear_message(args, words, capsys):
-    code, out, err = main_in_process("run", "--solver", "linkedlist-cpu", *args, capsys=capsys)
+    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", *args, capsys=capsys)
     assert code == 2, (out, err)
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
     for word in words:
@@ -85,7 +76,7 @@ def test_bad_input_exits_2_with_a_clear_message(args, words, capsys):
 
 
 def test_unknown_solver_is_refused(capsys):
-    code, _, err = main_in_process("run", "--solver", "quantum-cpu", "--dx", "1", capsys=capsys)
+    code, _, err = cli_main("run", "--solver", "quantum-cpu", "--dx", "1", capsys=capsys)
     assert code == 2 and "solver" in err and "Traceback" not in err
 
 

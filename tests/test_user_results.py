@@ -13,16 +13,8 @@ from pcabench.spec import RunSpec
 from pcabench.sweep import sweep
 from solvers import Scene
 
+from .conftest import cli_main
 from .test_study import fixture_rows
-
-
-def main(*args, capsys):
-    try:
-        code = cli.main(list(args))
-    except SystemExit as exc:
-        code = exc.code
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 # ---------------------------------------------------------------- a user's runs are their own
@@ -99,13 +91,13 @@ def test_a_sweep_shows_the_run_in_progress_its_size_and_a_qualified_eta(tmp_path
 
 
 def test_a_bad_fields_path_is_refused_before_the_run(tmp_path, capsys):
-    code, out, err = main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--fields",
+    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--fields",
                           str(tmp_path / "no" / "such" / "f.npz"), capsys=capsys)
     assert code == 2 and "--fields" in err and "Traceback" not in err and "stage" not in out
 
 
 def test_json_is_standard_json_null_never_nan(capsys):
-    code, out, _ = main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
+    code, out, _ = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
                         "--model", "linear", "--json", "--quiet", capsys=capsys)
 
     def refuse(name):
@@ -125,11 +117,11 @@ def test_study_lists_take_several_values_as_documented():
 
 
 def test_usage_errors_are_one_line_and_version_is_there(capsys):
-    code, _, err = main("run", "--solver", "linkedlist-cpu", "--dx", capsys=capsys)
+    code, _, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", capsys=capsys)
     assert code == 2 and len(err.strip().splitlines()) == 1 and "--dx" in err
-    code, out, _ = main("--version", capsys=capsys)
+    code, out, _ = cli_main("--version", capsys=capsys)
     assert code == 0 and __version__ in out
-    code, out, _ = main("run", "--help", capsys=capsys)
+    code, out, _ = cli_main("run", "--help", capsys=capsys)
     for word in ("allpair-cpu", "lagrangian", "fixed", "linear", "verlet", "kdk1", "euler", "rk2", "gather"):
         assert word in out, word
 
