@@ -37,7 +37,7 @@ def resolve_pair_loop(name: str, scene: Scene, requested: str = "auto") -> str:
     return PAIR_LOOPS[name][0]
 
 
-def make_solver(name: str, threads: int | None = None, pair_loop: str = "auto") -> Solver:
+def make_solver(name: str, threads: int = 1, pair_loop: str = "auto") -> Solver:
     """The solver called ``name`` (one of SOLVERS) on ``threads`` CPU threads, with ``pair_loop``."""
     check_pair_loop(name, pair_loop)
     if name == "allpair-cpu":

@@ -17,11 +17,6 @@ def pulse_velocity(scene, x, t):
     return scene.c0 * scene.mach * np.exp(-xi * xi)
 
 
-def pulse_density(scene, x, t):
-    """Analytic density perturbation, kg/m^3."""
-    return scene.rho0 * pulse_velocity(scene, x, t) / scene.c0
-
-
 @dataclass(frozen=True)
 class Errors:
     """Relative RMS error (the paper's "MSE") and max error ME (m/s) of u."""

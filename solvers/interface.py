@@ -31,7 +31,6 @@ from .scene import Scene, SceneError
 STAGES = ("input", "init", "snp", "pi", "su", "output")
 STATE = ("lx", "ly", "sx", "sy", "u", "v", "drho")
 RATES = ("ax", "ay", "dd")
-COEFFS = ("mass", "vol", "pr")
 
 
 @dataclass
@@ -78,7 +77,6 @@ class Solver(abc.ABC):
         self.dtype = np.dtype(scene.precision)
         self.k = kernel.constants(scene, self.dtype)
         self.moving = scene.model == "lagrangian"
-        self.dt = self.dtype.type(scene.dt)
 
     def check_scene(self, scene: Scene) -> None:
         """Solver-specific limits; raise SceneError naming the parameter."""
@@ -117,13 +115,17 @@ class Solver(abc.ABC):
 
     def rates(self, continuity: bool, momentum: bool) -> None:
         """PI: fill dd (continuity) and/or ax, ay (momentum) from the current state."""
+        self.coefficients(continuity, momentum)
+        self._sweep(continuity, momentum)
+
+    def coefficients(self, continuity: bool, momentum: bool) -> None:
+        """Per-particle coefficients of the sweeps: vol = m / rho (continuity), pr = c0^2 drho / rho^2 (momentum)."""
         a, k = self.arrays, self.k
-        rho = k[5] + k[7] * a["drho"]  # rho0 + nonlin * drho
+        rho = k[kernel.RHO0] + k[kernel.NONLIN] * a["drho"]
         if continuity:
             self.xp.divide(a["mass"], rho, out=a["vol"])
         if momentum:
-            self.xp.divide(k[6] * a["drho"], rho * rho, out=a["pr"])
-        self._sweep(continuity, momentum)
+            self.xp.divide(k[kernel.C0SQ] * a["drho"], rho * rho, out=a["pr"])
 
     @abc.abstractmethod
     def _sweep(self, continuity: bool, momentum: bool) -> None:
@@ -213,5 +215,5 @@ def cell_grid(scene: Scene) -> tuple:
 def tiny_scene(scene: Scene) -> Scene:
     """A few hundred particles with the same model, integrator and precision (for JIT warm-up)."""
     return scene.replace(dx=1.0, x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0,
-                         strip_height=None, steps=2, t_end=None, h_factor=2.13,
+                         strip_height=None, steps=2, t_end=None, h_factor=scene.default("h_factor"),
                          cutoff_factor=min(scene.cutoff_factor, 3.0))

@@ -20,7 +20,6 @@ the list where it fits in memory and the gather loop where it does not.
 """
 from __future__ import annotations
 
-import time
 from functools import lru_cache
 
 import numba
@@ -28,7 +27,7 @@ import numpy as np
 
 from . import pairlist
 from .backend import cpu_pairs
-from .interface import Solver, cell_grid, tiny_scene
+from .celllist import CellListSolver
 from .scene import SceneError
 
 
@@ -80,13 +79,13 @@ def sweeps(precision: str, parallel: bool) -> dict:
 counting_sort = numba.njit(cache=True, nogil=True)(_counting_sort)
 
 
-class LinkedListCPU(Solver):
-    """Uniform cell list on the CPU, serial or multi-threaded (``threads``)."""
+class LinkedListCPU(CellListSolver):
+    """Uniform cell list on the CPU, serial or multi-threaded (``threads``), with the pair list or the gather loop."""
 
     name = "linkedlist-cpu"
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
-        super().__init__(threads=threads)
+        super().__init__(threads=threads or 1)
         self.requested_pair_loop = pair_loop
 
     def input(self, scene) -> None:
@@ -102,80 +101,50 @@ class LinkedListCPU(Solver):
         return "list" if fits else "gather"
 
     def check_scene(self, scene) -> None:
-        if self.threads is not None:
-            if not isinstance(self.threads, int) or self.threads < 1:
-                raise SceneError(f"threads must be an integer >= 1 (got {self.threads!r})")
-            if self.threads > numba.config.NUMBA_NUM_THREADS:
-                raise SceneError(f"threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} "
-                                 f"on this machine (got {self.threads})")
+        if not isinstance(self.threads, int) or not 1 <= self.threads <= numba.config.NUMBA_NUM_THREADS:
+            raise SceneError(f"threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} "
+                             f"on this machine (got {self.threads!r})")
 
-    @property
-    def kernels(self):
-        return sweeps(self.scene.precision, (self.threads or 1) > 1)
+    def probe(self) -> "LinkedListCPU":
+        return type(self)(threads=self.threads, pair_loop=self.pair_loop)
 
-    def _threads(self):
-        if (self.threads or 1) > 1:
-            numba.set_num_threads(self.threads)
-
-    def after_init(self) -> None:
-        s = self.scene
-        self.cw, self.ch, self.ncx, self.ncy = cell_grid(s)
-        n, ncells = s.n_particles, self.ncx * self.ncy
+    def allocate_cells(self) -> None:
+        n = self.scene.n_particles
         self.cell = np.empty(n, np.int32)
         self.sorted_cell = np.empty(n, np.int32)
         self.order = np.empty(n, np.int64)
         # unsigned cell bounds: numba then skips negative-index wraparound on every
         # neighbour load (measured 20-25 % faster sweeps)
-        self.begin = np.zeros(ncells + 1, np.uint32)
-        self.cells_valid = False
-        self.pairs = pairlist.PairList(s, self.threads or 1) if self.pair_loop == "list" else None
+        self.begin = np.zeros(self.ncells + 1, np.uint32)
+        self.pairs = pairlist.PairList(self.scene, self.threads) if self.pair_loop == "list" else None
 
-    def snp(self) -> None:
-        """Cell list for the current positions: once for fixed particles, every step if moving."""
-        if self.cells_valid and not self.moving:
-            return
-        self._threads()
-        s, a = self.scene, self.arrays
-        self.kernels["cell_ids"](a["lx"], a["ly"], a["sx"], a["sy"], self.cell, s.dx, -self.cw,
-                                 s.height, self.cw, self.ch, self.ncx, self.ncy)
-        counting_sort(self.cell, self.ncx * self.ncy, self.begin, self.order, self.sorted_cell)
+    def launch(self, name: str, *args):
+        if self.threads > 1:
+            numba.set_num_threads(self.threads)
+        return sweeps(self.scene.precision, self.threads > 1)[name](*args)
+
+    def sort_cells(self) -> None:
+        """Counting sort by cell (x-sorted within each cell for the pair list), then the pair list if used."""
+        a = self.arrays
+        self.cell_ids()
+        counting_sort(self.cell, self.ncells, self.begin, self.order, self.sorted_cell)
         if self.pairs is not None:  # the list scans x-sorted stencil rows
-            pairlist.sort_cells_by_x(self.order, self.begin, a["lx"], a["sx"], s.dx)
+            pairlist.sort_cells_by_x(self.order, self.begin, a["lx"], a["sx"], self.scene.dx)
         self.permute(self.order)
         self.cell, self.sorted_cell = self.sorted_cell, self.cell
         if self.pairs is not None:
-            self.pairs.build(self.cell, self.begin, self.ncx, self.ncy, a["lx"], a["ly"], a["sx"], a["sy"], self.k)
-        self.cells_valid = True
+            self.pairs.build(*self.geometry(), self.k)
 
     def _sweep(self, continuity: bool, momentum: bool) -> None:
-        self._threads()
-        a, kk = self.arrays, self.kernels
-        if self.pairs is not None:
-            if continuity:
-                self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
-            if momentum:
-                self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
-            return
-        geo = (self.cell, self.begin, self.ncx, self.ncy, a["lx"], a["ly"], a["sx"], a["sy"])
-        if continuity:
-            kk["continuity"](*geo, a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
-        if momentum:
-            kk["momentum"](*geo, a["mass"], a["pr"], a["ax"], a["ay"], self.k)
-
-    def mean_neighbours(self) -> float:
-        self.cells_valid = False
-        self.snp()
+        if self.pairs is None:
+            return super()._sweep(continuity, momentum)
+        if self.threads > 1:
+            numba.set_num_threads(self.threads)
         a = self.arrays
-        total = self.kernels["neighbours"](self.cell, self.begin, self.ncx, self.ncy,
-                                           a["lx"], a["ly"], a["sx"], a["sy"], self.k)
-        return total / self.scene.n_particles
+        if continuity:
+            self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+        if momentum:
+            self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
 
-    def warmup(self) -> float:
-        t0 = time.perf_counter()
-        probe = type(self)(threads=self.threads, pair_loop=self.pair_loop)
-        probe.input(tiny_scene(self.scene))
-        probe.init()
-        probe.snp()
-        probe.rates(True, True)
-        probe.mean_neighbours()
-        return time.perf_counter() - t0
+    def count_neighbours(self) -> int:
+        return self.launch("neighbours", *self.geometry(), self.k)

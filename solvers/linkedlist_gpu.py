@@ -10,6 +10,9 @@ cells gives cellBegin (cellBegin[c+1] is cell c's end); every per-particle
 array is gathered into cell order, so the three cells of a stencil row are
 one contiguous, coalesced range of memory.
 
+The system update (kick, advance) and the sweeps' coefficients are one
+fused kernel each, so a Verlet step is a handful of launches besides SNP.
+
 Without a GPU, ``NUMBA_ENABLE_CUDASIM=1`` runs the same kernels in numba's
 CUDA simulator with NumPy in place of CuPy (small scenes only): that is how
 CI checks the GPU code. Without either, the solver says there is no GPU.
@@ -17,16 +20,15 @@ CI checks the GPU code. Without either, the solver says there is no GPU.
 from __future__ import annotations
 
 import os
-import time
 from functools import lru_cache
 
 import numpy as np
 
-from .interface import Solver, SolverUnavailable, cell_grid, tiny_scene
+from .celllist import CellListSolver
+from .interface import SolverUnavailable
 from .scene import SceneError
 
 THREADS_PER_BLOCK = 256
-cuda = None  # numba.cuda, bound on first use; a module global so that the simulator can swap it
 
 
 def simulated() -> bool:
@@ -34,13 +36,17 @@ def simulated() -> bool:
     return os.environ.get("NUMBA_ENABLE_CUDASIM", "0") == "1"
 
 
+def _compat_numba_cuda() -> None:
+    """Let numba-cuda <= 0.30 run on NumPy 2.5: it registers an overload for ``np.row_stack``, which
+    NumPy 2.5 removed, and its first kernel compilation fails without this alias."""
+    if not hasattr(np, "row_stack"):
+        np.row_stack = np.vstack
+
+
 @lru_cache(maxsize=None)
 def device_backend():
     """(cuda, cupy or None): numba-cuda and, on a real GPU, CuPy. Raises SolverUnavailable."""
-    if not hasattr(np, "row_stack"):
-        # numba-cuda <= 0.30 registers an overload for np.row_stack, which NumPy 2.5
-        # removed; without this alias its first kernel compilation fails.
-        np.row_stack = np.vstack
+    _compat_numba_cuda()
     try:
         from numba import cuda
     except ImportError as exc:  # pragma: no cover - numba without CUDA support
@@ -61,12 +67,16 @@ def device_backend():
         raise SolverUnavailable(
             f"linkedlist-gpu: no CUDA GPU on this machine ({exc}); use linkedlist-cpu, or set "
             "NUMBA_ENABLE_CUDASIM=1 to run its kernels in the simulator") from exc
-    # All work goes to one stream, so numba need not synchronise on every CuPy
-    # array it is handed (the CUDA Array Interface's default).
+    _one_stream()
+    return cuda, cupy
+
+
+def _one_stream() -> None:
+    """All work goes to one stream, so numba need not synchronise on every CuPy array it is handed
+    (the CUDA Array Interface's default)."""
     from numba import config
 
     config.CUDA_ARRAY_INTERFACE_SYNC = False
-    return cuda, cupy
 
 
 @lru_cache(maxsize=None)
@@ -76,13 +86,12 @@ def kernels(precision: str):
     float32 kernels use fastmath (the hardware's approximate expf, ~2 ulp);
     float64 kernels use the accurate libdevice exp.
     """
-    from .backend import compile_pairs
-    from .kernel import exp_neg_math
+    from .kernel import C0SQ, NONLIN, RHO0, exp_neg_math
+    from .pairs import make_pairs
 
-    global cuda
     cuda, _ = device_backend()
     fast = precision == "float32"
-    P = compile_pairs(cuda.jit(device=True, fastmath=fast), exp_neg_math, f"cuda_{precision}")
+    P = make_pairs(cuda.jit(device=True, fastmath=fast), exp_neg_math)
     jit = cuda.jit(fastmath=fast)
 
     @jit
@@ -111,24 +120,50 @@ def kernels(precision: str):
         if i < lx.shape[0]:
             counts[i] = P.neighbours_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k)
 
+    # the system update and the coefficients, each one launch instead of a chain of array operations
+    @jit
+    def coefficients(drho, mass, vol, pr, continuity, momentum, k):
+        i = cuda.grid(1)
+        if i < drho.shape[0]:
+            rho = k[RHO0] + k[NONLIN] * drho[i]
+            if continuity:
+                vol[i] = mass[i] / rho
+            if momentum:
+                pr[i] = k[C0SQ] * drho[i] / (rho * rho)
+
+    @jit
+    def kick(u, v, ax, ay, c):
+        i = cuda.grid(1)
+        if i < u.shape[0]:
+            u[i] += c * ax[i]
+            v[i] += c * ay[i]
+
+    @jit
+    def advance(drho, dd, sx, sy, u, v, c, moving):
+        i = cuda.grid(1)
+        if i < drho.shape[0]:
+            drho[i] += c * dd[i]
+            if moving:
+                sx[i] += c * u[i]
+                sy[i] += c * v[i]
+
     return {"cell_ids": cell_ids, "continuity": continuity, "momentum": momentum,
-            "neighbours": neighbours}
+            "neighbours": neighbours, "coefficients": coefficients, "kick": kick, "advance": advance}
 
 
-class LinkedListGPU(Solver):
-    """Uniform cell list on a CUDA GPU (or numba's CUDA simulator)."""
+class LinkedListGPU(CellListSolver):
+    """Uniform cell list on a CUDA GPU (or numba's CUDA simulator), one thread per particle."""
 
     name = "linkedlist-gpu"
     device = "gpu"
 
-    def __init__(self, threads: int | None = None):
-        super().__init__(threads=None)
+    def __init__(self, threads: int = 1):
         if threads not in (None, 1):
             raise SceneError(f"threads: linkedlist-gpu runs one GPU thread per particle (got --threads {threads})")
+        super().__init__(threads=1)
         self.cuda, self.cupy = device_backend()
         self.xp = self.cupy if self.cupy is not None else np
 
-    # ------------------------------------------------------------ stages
     def check_scene(self, scene) -> None:
         if self.cupy is None:
             return
@@ -140,53 +175,46 @@ class LinkedListGPU(Solver):
                 f"on the GPU, more than its {free / 2**30:.3g} GiB free; the smallest dx that fits is "
                 f"about {scene.smallest_dx_fitting(free):.3g} m")
 
-    def after_init(self) -> None:
-        s, xp = self.scene, self.xp
-        self.cw, self.ch, self.ncx, self.ncy = cell_grid(s)
-        self.ncells = self.ncx * self.ncy
-        self.cell = xp.empty(s.n_particles, xp.int32)
+    def allocate_cells(self) -> None:
+        xp, n = self.xp, self.scene.n_particles
+        self.cell = xp.empty(n, xp.int32)
         self.cell_range = xp.arange(self.ncells + 1, dtype=xp.int32)
         self.begin = None
         # the simulator runs every thread of a block as a Python thread: keep blocks small there
         self.threads_per_block = 32 if self.cupy is None else THREADS_PER_BLOCK
-        self.blocks = (s.n_particles + self.threads_per_block - 1) // self.threads_per_block
-        self.cells_valid = False
+        self.blocks = (n + self.threads_per_block - 1) // self.threads_per_block
 
     def launch(self, name, *args):
         kernels(self.scene.precision)[name][self.blocks, self.threads_per_block](*args)
 
-    def snp(self) -> None:
-        if self.cells_valid and not self.moving:
-            return
-        s, a, xp = self.scene, self.arrays, self.xp
-        self.launch("cell_ids", a["lx"], a["ly"], a["sx"], a["sy"], self.cell, s.dx, -self.cw,
-                    s.height, self.cw, self.ch, self.ncx, self.ncy)
-        if self.cupy is not None:
-            order = xp.argsort(self.cell)  # CUB radix sort: stable
-        else:
-            order = np.argsort(self.cell, kind="stable")
+    def sort_cells(self) -> None:
+        """Cell ids on the device, CuPy's radix argsort (stable), cellBegin by binary search, then the gather."""
+        xp = self.xp
+        self.cell_ids()
+        order = xp.argsort(self.cell) if self.cupy is not None else np.argsort(self.cell, kind="stable")
         self.cell = xp.take(self.cell, order)
         # unsigned cell bounds: no negative-index wraparound on each neighbour load
         self.begin = xp.searchsorted(self.cell, self.cell_range).astype(xp.uint32)
         self.permute(order)
-        self.cells_valid = True
 
-    def _sweep(self, continuity: bool, momentum: bool) -> None:
+    def coefficients(self, continuity: bool, momentum: bool) -> None:
         a = self.arrays
-        geo = (self.cell, self.begin, self.ncx, self.ncy, a["lx"], a["ly"], a["sx"], a["sy"])
-        if continuity:
-            self.launch("continuity", *geo, a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
-        if momentum:
-            self.launch("momentum", *geo, a["mass"], a["pr"], a["ax"], a["ay"], self.k)
+        self.launch("coefficients", a["drho"], a["mass"], a["vol"], a["pr"], continuity, momentum, self.k)
 
-    def mean_neighbours(self) -> float:
-        self.cells_valid = False
-        self.snp()
+    def kick(self, f: float) -> None:
         a = self.arrays
+        self.launch("kick", a["u"], a["v"], a["ax"], a["ay"], self.dtype.type(f * self.scene.dt))
+
+    def advance(self, f: float) -> None:
+        a = self.arrays
+        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"], self.dtype.type(f * self.scene.dt),
+                    self.moving)
+        self.t += f * self.scene.dt
+
+    def count_neighbours(self) -> int:
         counts = self.xp.zeros(self.scene.n_particles, self.xp.int32)
-        self.launch("neighbours", self.cell, self.begin, self.ncx, self.ncy, a["lx"], a["ly"],
-                    a["sx"], a["sy"], counts, self.k)
-        return float(counts.astype(self.xp.float64).mean())
+        self.launch("neighbours", *self.geometry(), counts, self.k)
+        return int(counts.astype(self.xp.int64).sum())
 
     def to_host(self, arr) -> np.ndarray:
         return self.cupy.asnumpy(arr) if self.cupy is not None else np.asarray(arr)
@@ -194,19 +222,3 @@ class LinkedListGPU(Solver):
     def synchronize(self) -> None:
         if self.cupy is not None:
             self.cupy.cuda.runtime.deviceSynchronize()
-
-    def warmup(self) -> float:
-        """Compile the kernels and make the first launches on a tiny scene, outside the timing."""
-        t0 = time.perf_counter()
-        probe = type(self)()
-        probe.input(tiny_scene(self.scene))
-        probe.init()
-        probe.snp()
-        probe.rates(True, True)
-        probe.kick(0.5)
-        probe.advance(1.0)
-        probe.amplitude()
-        probe.output()
-        probe.mean_neighbours()
-        probe.synchronize()
-        return time.perf_counter() - t0
