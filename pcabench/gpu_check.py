@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from solvers import MODELS, PRECISIONS, Scene
-from solvers.linkedlist_gpu import device_backend
+from solvers.gpu_device import device_backend
 
 from .record import STEP_STAGES, step_seconds
 from .run import run

@@ -261,6 +261,9 @@ def load(paths):
         flat.append(r)
     df = pd.DataFrame(flat)
     if not df.empty:
+        for col in ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end"):  # null (NaN stored) -> NaN
+            if col in df:
+                df[col] = pd.to_numeric(df[col], errors="coerce")
         if "host" not in df:
             df["host"] = ""
         df["host"] = df["host"].fillna("")

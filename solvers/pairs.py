@@ -22,13 +22,17 @@ with grad_i W_ij = G_ij r_ij (solvers/kernel.py). ``k`` is the constant tuple
 of :func:`solvers.kernel.constants`, read by its named slots.
 """
 import math
-from types import SimpleNamespace
+from types import ModuleType
 
 from .kernel import GRAD0, INV_H2, NONLIN, NY, RC2, RHO0, SPACING, ZERO
 
 
-def make_pairs(jit, exp_neg) -> SimpleNamespace:
-    """The pair functions compiled with ``jit``, using ``exp_neg(x) = exp(-x)`` (itself compiled here)."""
+def make_pairs(jit, exp_neg) -> ModuleType:
+    """The pair functions compiled with ``jit``, using ``exp_neg(x) = exp(-x)`` (itself compiled here).
+
+    They come back as attributes of a module object, which numba resolves inside the jitted sweeps
+    that call them (it cannot type a plain namespace).
+    """
     exp_neg = jit(exp_neg)
 
     @jit
@@ -182,9 +186,11 @@ def make_pairs(jit, exp_neg) -> SimpleNamespace:
             count += neighbours_range(j, j + 1, lx[i], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
-    return SimpleNamespace(
+    pairs = ModuleType(f"{__name__}.compiled", "The pair functions for one backend (see make_pairs).")
+    pairs.__dict__.update(
         continuity_range=continuity_range, momentum_range=momentum_range, neighbours_range=neighbours_range,
         cell_index=cell_index, stencil_row=stencil_row, continuity_cells=continuity_cells,
         momentum_cells=momentum_cells, neighbours_cells=neighbours_cells, minimum_image_row=minimum_image_row,
         continuity_allpair=continuity_allpair, momentum_allpair=momentum_allpair,
         neighbours_allpair=neighbours_allpair)
+    return pairs

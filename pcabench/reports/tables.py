@@ -174,7 +174,7 @@ def speed(df) -> list[dict]:
         pairs = 2 * r.n_particles * r.mean_neighbours
         rows.append({"config": label(r), "model": r.model, "N": int(r.n_particles), "commit": str(r.commit)[:7],
                      "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
-                     "ns_per_pair": 1e9 * r.t_step / pairs if pairs > 0 else None,
+                     "ns_per_pair": 1e9 * r.t_step / pairs if pairs > 0 else None,  # NaN neighbours: None
                      "snp_pct": 100 * r.t_snp / (r.t_snp + r.t_pi + r.t_su)})
     return rows
 
