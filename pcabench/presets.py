@@ -20,7 +20,7 @@ RUN_BUDGET = {"quick": 120.0, "paper": 900.0, "stability": 120.0, "matrix": 900.
 # (exactly the linear wave equation, so growth is the integrator's, not the physics').
 STABILITY_DX = 0.25
 STABILITY_CFL = (0.1, 0.2, 0.5, 1.0, 2.0, 2.5, 3.0, 4.0, 4.5, 5.0, 5.5, 6.0, 7.0)
-STABILITY_H = (1.0, 1.3)  # h/dx beside the default 2.13
+STABILITY_H = (1.0, 1.3)  # h/dx beside Scene's default
 # Above this relative RMS error a run that stayed bounded is classed inaccurate: twice the
 # error of Verlet at CFL 0.2 on the stability scene (10 % at dx = 0.25, t = 10 s).
 INACCURATE_ABOVE = 0.20
