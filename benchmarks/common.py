@@ -84,17 +84,23 @@ class Unsupported(Exception):
 class Prepared:
     """One solver at steady state on the paper's scene (or ``scene`` overrides)."""
 
-    def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=1, **scene):
+    def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=1, pair_loop=None,
+                 **scene):
         self.scene = Scene(dx=dx, precision=precision, **{"steps": 100, **scene})
         if solver == "linkedlist-gpu" and not gpu_available():
             raise Unsupported("no CUDA GPU here")
         if solver == "allpair-cpu" and self.scene.n_particles > ALLPAIR_MAX_N:
             raise Unsupported(f"all-pair past {ALLPAIR_MAX_N:,} particles")
         self.name = solver
-        self.solver = make_solver(solver, threads=threads)
+        # pair_loop: commits before the pair list have none (Unsupported there)
+        options = {"threads": threads} if pair_loop is None else {"threads": threads, "pair_loop": pair_loop}
+        try:
+            self.solver = make_solver(solver, **options)
+        except TypeError as exc:
+            raise Unsupported(f"this commit's solvers take no pair_loop ({exc})") from None
         self.solver.input(self.scene)
         self.jit_seconds = self.solver.warmup()
-        self.solver = make_solver(solver, threads=threads)
+        self.solver = make_solver(solver, **options)
         self.solver.input(self.scene)
         self.solver.init()
         self.program = step_program(self.scene.integrator, self.solver, first=False)
