@@ -25,10 +25,10 @@ import sys
 
 from importlib import import_module
 
-try:
-    import solvers
-except ImportError:  # commits before the layout change
+try:  # commits before the layout change had the solvers inside the harness
     from pcabench import solvers
+except ImportError:
+    import solvers
 
 Scene, make_solver = solvers.Scene, solvers.make_solver
 analytic_errors = import_module(f"{solvers.__name__}.analytic").errors
