@@ -25,10 +25,22 @@ import sys
 
 from importlib import import_module
 
-try:  # commits before the layout change had the solvers inside the harness
-    from pcabench import solvers
-except ImportError:
-    import solvers
+
+
+def _solver_package():
+    """``solvers``, or ``pcabench.solvers`` in commits before the layout change (a leftover folder of one
+    layout can make the other name importable as an empty namespace: the one with Scene is the one)."""
+    for name in ("solvers", "pcabench.solvers"):
+        try:
+            package = import_module(name)
+        except ImportError:
+            continue
+        if hasattr(package, "Scene"):
+            return package
+    raise ImportError("no solver package: neither solvers nor pcabench.solvers has Scene")
+
+
+solvers = _solver_package()
 
 Scene, make_solver = solvers.Scene, solvers.make_solver
 analytic_errors = import_module(f"{solvers.__name__}.analytic").errors
