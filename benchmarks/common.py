@@ -22,9 +22,7 @@ import functools
 import os
 import subprocess
 import sys
-
 from importlib import import_module
-
 
 
 def _solver_package():
@@ -45,6 +43,7 @@ solvers = _solver_package()
 Scene, make_solver = solvers.Scene, solvers.make_solver
 analytic_errors = import_module(f"{solvers.__name__}.analytic").errors
 step_program = import_module(f"{solvers.__name__}.integrators").step_program
+
 
 def thinnest_strip(dx: float) -> float:
     """The thinnest y-periodic strip Scene accepts at ``dx``, m (older commits: the harness's presets)."""

@@ -108,7 +108,7 @@ def fig8(df, out: Path, pid: str):
                 ax.plot(s["dx"], s["mse"], color=MODEL_COLOUR.get(s["model"], "k"),
                         marker=PRECISION_MARKER[s["precision"]], ms=9 if f32 else 5, mfc="none" if f32 else None,
                         ls="-" if s["domain"] == "strip" else ":", lw=1.2,
-                        label=f"{s['model']} {s['precision']} {s['domain']} ({how})")
+                        label=f"{protocol}: {s['model']} {s['precision']} {s['domain']} ({how})")
                 dxs += list(s["dx"])
             if protocol == "100 steps":
                 ax.plot([0.004], [T.published()["text"]["fig8_mse_100_steps_dx_0.004"]], marker="^", ms=8,
