@@ -193,7 +193,7 @@ def check_specs(specs: list[RunSpec]) -> list[RunSpec]:
 def cmd_study(args) -> int:
     from . import profiles
     from .presets import RUN_BUDGET
-    from .reports import write_reports
+    from .reports import summary, write_reports
     from .store import check_writable, store_name
     from .sweep import sweep
 
@@ -223,8 +223,16 @@ def cmd_study(args) -> int:
         sweep(specs, store_path, run_budget, args.sweep_budget, retry_failed=args.retry_failed)
     if args.no_report:
         return 0
-    for p in write_reports(Path(args.results), Path(args.reports)):
+    written = write_reports(Path(args.results), Path(args.reports))
+    for p in written:
         print(f"wrote {p}", file=sys.stderr)
+    if not args.cluster:
+        table = summary(Path(args.results), profile["id"])
+        if table:
+            print(table)
+        report = next((p for p in written if p.name == "report.md" and p.parent.name.startswith(profile["id"])), None)
+        if report:
+            print(f"\nReport with every table and figure: {report}")
     return 0
 
 

@@ -7,6 +7,6 @@ and ``reports/README.md`` as the index.
 """
 from __future__ import annotations
 
-from .build import write_reports
+from .build import summary, write_reports
 
-__all__ = ["write_reports"]
+__all__ = ["summary", "write_reports"]

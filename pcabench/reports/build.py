@@ -365,6 +365,18 @@ def cards_page(df_all, reports_dir: Path) -> list[Path]:
     return [path, *figs]
 
 
+def summary(results_dir: Path, profile: str) -> str:
+    """A study's closing table for the terminal: this machine's step times (Table 4's SNP / PI / SU columns)."""
+    df = store.load(results_dir)
+    rows = T.table4(df[df.profile_id == profile]) if not df.empty else []
+    if not rows:
+        return ""
+    return "Step times on this machine, ms per step (the paper's scene; the report has every table):\n" + md_table(
+        ["config", "N", "SNP", "PI", "SU", "step"],
+        [[r["config"], f"{r['N']:,}", fmt(r["snp"], ".3f"), fmt(r["pi"], ".3f"), fmt(r["su"], ".3f"),
+          fmt(r["snp"] + r["pi"] + r["su"], ".3f")] for r in rows])
+
+
 def write_reports(results_dir: Path, reports_dir: Path) -> list[Path]:
     df_all = store.load(results_dir)
     if df_all.empty:
