@@ -133,6 +133,7 @@ def cmd_run(args) -> int:
 
     scene = scene_from_args(args)
     spec = RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto").resolved()
+    check_specs([spec])  # the solver can run here (a GPU for linkedlist-gpu), before anything is printed
     if args.fields:
         check_output_path(args.fields, "--fields")
     if not args.json:

@@ -28,14 +28,15 @@ def device_backend():
     try:
         from numba import cuda
     except ImportError as exc:  # pragma: no cover - numba without CUDA support
-        raise SolverUnavailable("linkedlist-gpu needs numba-cuda: pip install 'pcabench[gpu]'") from exc
+        raise SolverUnavailable("linkedlist-gpu needs numba-cuda: pip install -e \".[gpu-cuda13]\" "
+                                "(or .[gpu] for CUDA 12)") from exc
     if simulated():
         return cuda, None
     try:
         import cupy
     except ImportError as exc:
         raise SolverUnavailable(
-            "linkedlist-gpu needs CuPy and a CUDA GPU: pip install 'pcabench[gpu]' on a machine "
+            "linkedlist-gpu needs CuPy and a CUDA GPU: pip install -e \".[gpu-cuda13]\" (or .[gpu] for CUDA 12) on a machine "
             "with an NVIDIA GPU (or set NUMBA_ENABLE_CUDASIM=1 to run its kernels in the simulator)"
         ) from exc
     try:
