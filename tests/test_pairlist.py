@@ -1,11 +1,12 @@
 """The CPU pair list: the same physics as the paper's gather loop, each pair once, and a fallback that fits."""
 from __future__ import annotations
 
+import numba
 import numpy as np
 import pytest
 
 from solvers import Scene, make_solver, resolve_pair_loop
-from solvers import pairlist
+from solvers import denormals, pairlist
 from solvers.integrators import step_program
 
 from .conftest import strip_for
@@ -50,22 +51,21 @@ def test_each_pair_listed_once_with_its_kernel_factor():
     inside = (r2 < scene.cutoff**2) & ~np.eye(n, dtype=bool)
     listed = np.zeros((n, n), int)
     for i in range(n):
-        for m in range(pl.count[i]):
-            j = pl.nbr[i, m]
+        for j, fx, fy in zip(*pl.row(i)):
             listed[i, j] += 1
             listed[j, i] += 1
             g = -2 / (np.pi * scene.h**4) * np.exp(-r2[i, j] / scene.h**2)
-            assert pl.fx[i, m] == pytest.approx(g * dx_[i, j], rel=1e-12, abs=1e-18)
-            assert pl.fy[i, m] == pytest.approx(g * dy_[i, j], rel=1e-12, abs=1e-18)
+            assert fx == pytest.approx(g * dx_[i, j], rel=1e-12, abs=1e-18)
+            assert fy == pytest.approx(g * dy_[i, j], rel=1e-12, abs=1e-18)
     assert np.array_equal(listed, inside.astype(int))  # each pair once, from one side, and no other
 
 
-def test_rows_grow_when_a_particle_has_more_pairs_than_room(monkeypatch):
+def test_list_grows_when_a_stretch_has_more_pairs_than_room(monkeypatch):
     scene = Scene(dx=0.5, x_min=-10, x_max=10, steps=12, strip_height=strip_for(0.5))
     reference = stepped(scene, "list").output()
     monkeypatch.setattr(pairlist, "capacity", lambda scene: 4)  # far too few: the first build overflows
     small = stepped(scene, "list")
-    assert small.pairs.nbr.shape[1] > 4
+    assert small.pairs.budget > 4
     assert max_rel(small.output().u, reference.u) < 1e-14
 
 
@@ -87,3 +87,29 @@ def test_auto_falls_back_to_gather_where_the_list_does_not_fit():
     assert resolve_pair_loop("linkedlist-cpu", tight) == "gather"  # the largest scene still runs
     assert resolve_pair_loop("linkedlist-cpu", tight, "list") == "list"  # asked for explicitly
     assert resolve_pair_loop("allpair-cpu", scene) == "all-pairs"
+
+
+@pytest.mark.skipif(not denormals.X86, reason="flush-to-zero is set only on x86")
+def test_float32_loops_flush_subnormals_inside_and_leave_the_process_as_it_was():
+    @numba.njit
+    def halve(x, flush):
+        saved = denormals.flush_on() if flush else numba.uint32(0)
+        y = x * np.float32(0.5)
+        if flush:
+            denormals.flush_off(saved)
+        return y
+
+    tiny = np.float32(1e-39)  # subnormal in float32
+    assert halve(tiny, True) == 0  # flushed inside a loop
+    assert halve(tiny, False) > 0
+    scene = Scene(dx=0.5, x_min=-10, x_max=10, steps=3, precision="float32", strip_height=strip_for(0.5))
+    stepped(scene, "list", threads=2)
+    assert tiny * np.float32(0.5) > 0  # numpy, after the float32 loops, still keeps subnormals
+    assert halve(tiny, False) > 0
+
+
+def test_float32_list_agrees_with_float64_to_float32_roundoff():
+    scene = Scene(dx=0.25, x_min=-10, x_max=20, steps=30, strip_height=strip_for(0.25))
+    f64 = stepped(scene, "list").output()
+    f32 = stepped(scene.replace(precision="float32"), "list", threads=2).output()
+    assert max_rel(f32.u, f64.u) < 1e-4
