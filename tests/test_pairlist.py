@@ -92,20 +92,22 @@ def test_auto_falls_back_to_gather_where_the_list_does_not_fit():
 @pytest.mark.skipif(not denormals.X86, reason="flush-to-zero is set only on x86")
 def test_float32_loops_flush_subnormals_inside_and_leave_the_process_as_it_was():
     @numba.njit
-    def halve(x, flush):
+    def halve(x, flush):  # as the pair loops do it: the flag set around a loop
         saved = denormals.flush_on() if flush else numba.uint32(0)
-        y = x * np.float32(0.5)
+        out = np.empty_like(x)
+        for i in range(x.shape[0]):
+            out[i] = x[i] * np.float32(0.5)
         if flush:
             denormals.flush_off(saved)
-        return y
+        return out
 
-    tiny = np.float32(1e-39)  # subnormal in float32
-    assert halve(tiny, True) == 0  # flushed inside a loop
-    assert halve(tiny, False) > 0
+    tiny = np.full(64, 1e-39, np.float32)  # subnormal in float32
+    assert np.all(halve(tiny, True) == 0)  # flushed inside the loop
+    assert np.all(halve(tiny, False) > 0)
     scene = Scene(dx=0.5, x_min=-10, x_max=10, steps=3, precision="float32", strip_height=strip_for(0.5))
     stepped(scene, "list", threads=2)
-    assert tiny * np.float32(0.5) > 0  # numpy, after the float32 loops, still keeps subnormals
-    assert halve(tiny, False) > 0
+    assert np.all(tiny * np.float32(0.5) > 0)  # numpy, after the float32 loops, still keeps subnormals
+    assert np.all(halve(tiny, False) > 0)
 
 
 def test_float32_list_agrees_with_float64_to_float32_roundoff():
