@@ -129,9 +129,10 @@ def fig9(df, out: Path, pid: str):
     colours = {"all-pair": "tab:red", "linked list": "tab:blue"}
     with figure(path, f"Fig. 9: all-pair against linked list, serial CPU, float64 ({pid})", "particles N", "",
                 ncols=2, logx=True, logy=True, size=(13, 4.4)) as (a, b):
-        for key, name in (("allpair_ms", "all-pair"), ("linkedlist_ms", "linked list")):
+        for key, name, label in (("allpair_ms", "all-pair", "all-pair (measured)"),
+                                 ("linkedlist_ms", "linked list", "linked list, the paper's gather loop (measured)")):
             pts = [(r["N"], r[key]) for r in rows if r[key]]
-            a.plot(*zip(*pts), marker="o", color=colours[name], label=f"{name} (measured)")
+            a.plot(*zip(*pts), marker="o", color=colours[name], label=label)
         for name, key, marker in (("all-pair", "fig9_allpair_s", "^"), ("linked list", "fig9_linkedlist_s", "v")):
             a.plot([int(n) for n in text[key]], [1e3 * v / 10 for v in text[key].values()], marker=marker,
                    **dict(PUBLISHED, color=colours[name]), label=f"paper {name}, run / 10 steps (published)")
