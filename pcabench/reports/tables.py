@@ -183,12 +183,16 @@ def speed(df) -> list[dict]:
 def fig9(df) -> list[dict]:
     """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL.
 
-    The linked list is the paper's gather loop ('' is a run from before the pair list, which had only
-    that loop), so that eta means what the paper's does; the pair list has its own speed table.
+    One pair loop throughout: the paper's gather loop where it was measured ('' is a run from before the
+    pair list, which had only that loop), so that eta means what the paper's does; else the pair list.
+    Each row names it (``linkedlist_loop``).
     """
     runs = paper_scene(df)
-    ll = _newest_per(runs[(runs.solver == "linkedlist-cpu") & (runs.threads == 1) & (runs.precision == "float64")
-                          & runs.pair_loop.isin(["gather", ""])], ["n_particles"]).set_index("n_particles")
+    serial = runs[(runs.solver == "linkedlist-cpu") & (runs.threads == 1) & (runs.precision == "float64")]
+    gather = serial.pair_loop.isin(["gather", ""])
+    loop = "gather" if gather.any() else "list"
+    ll = _newest_per(serial[gather] if gather.any() else serial[serial.pair_loop == "list"],
+                     ["n_particles"]).set_index("n_particles")
     ap_all = latest(default_numerics(df[(df.solver == "allpair-cpu") & (df.model == "lagrangian")
                                         & (df.domain == "full")]))
     rows = []
@@ -197,14 +201,14 @@ def fig9(df) -> list[dict]:
         r = (ok if not ok.empty else g).sort_values("timestamp").iloc[-1]
         row = {"N": int(n), "allpair_ms": 1e3 * r.t_step if r.status == "ok" else None,
                "allpair_status": r.status, "allpair_note": "" if r.status == "ok" else str(r.message)[:160],
-               "linkedlist_ms": 1e3 * ll.loc[n, "t_step"] if n in ll.index else None}
+               "linkedlist_ms": 1e3 * ll.loc[n, "t_step"] if n in ll.index else None, "linkedlist_loop": loop}
         row["eta"] = (row["allpair_ms"] / row["linkedlist_ms"]
                       if row["allpair_ms"] and row["linkedlist_ms"] else None)
         rows.append(row)
     for n in ll.index:
         if n not in {r["N"] for r in rows}:
             rows.append({"N": int(n), "allpair_ms": None, "allpair_status": "not run", "allpair_note": "",
-                         "linkedlist_ms": 1e3 * ll.loc[n, "t_step"], "eta": None})
+                         "linkedlist_ms": 1e3 * ll.loc[n, "t_step"], "eta": None, "linkedlist_loop": loop})
     return sorted(rows, key=lambda r: r["N"])
 
 
