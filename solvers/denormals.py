@@ -53,14 +53,17 @@ def _write_mxcsr(typingctx, word):
 
 
 @numba.njit(inline="always")
-def flush_on():
-    """Set flush-to-zero for this thread; returns the word to give :func:`flush_off`."""
+def flush_on(flush):
+    """Set flush-to-zero for this thread if ``flush`` (a compile-time constant in the loops that call
+    it); returns the word to give :func:`flush_off`."""
     saved = _read_mxcsr()
-    _write_mxcsr(saved | numba.uint32(FTZ_DAZ))
+    if flush:
+        _write_mxcsr(saved | numba.uint32(FTZ_DAZ))
     return saved
 
 
 @numba.njit(inline="always")
-def flush_off(saved):
-    """Restore this thread's floating-point control word."""
-    _write_mxcsr(saved)
+def flush_off(flush, saved):
+    """Restore this thread's floating-point control word after :func:`flush_on`."""
+    if flush:
+        _write_mxcsr(saved)

@@ -132,7 +132,7 @@ def kernels(precision: str, parallel: bool) -> dict:
         need = np.zeros(nt, np.uint64)
         for tt in prange(nt):
             t = U(tt)
-            saved = flush_on() if flush else U(0)
+            saved = flush_on(flush)
             js, cj = scratch[t, 0], scratch[t, 1]
             rxs, rys, r2s, crx, cry, cr2 = (fscratch[t, 0], fscratch[t, 1], fscratch[t, 2], fscratch[t, 3],
                                             fscratch[t, 4], fscratch[t, 5])
@@ -177,8 +177,7 @@ def kernels(precision: str, parallel: bool) -> dict:
                 at = min(at + m, end)
                 listed += m
             need[t] = (listed + hi - lo - U(1)) // max(hi - lo, U(1))
-            if flush:
-                flush_off(saved)
+            flush_off(flush, saved)
         return need.max()
 
     def continuity(nbr, fx, fy, start, count, u, v, vol, drho, out, buf, k):
@@ -186,7 +185,7 @@ def kernels(precision: str, parallel: bool) -> dict:
         n, nt = U(u.shape[0]), U(buf.shape[0])
         for tt in prange(nt):
             t = U(tt)
-            saved = flush_on() if flush else U(0)
+            saved = flush_on(flush)
             acc = buf[t]
             acc[:] = 0
             for i in range(t * n // nt, (t + U(1)) * n // nt):
@@ -198,8 +197,7 @@ def kernels(precision: str, parallel: bool) -> dict:
                     a += vol[j] * s
                     acc[j] += voli * s
                 acc[i] = a
-            if flush:
-                flush_off(saved)
+            flush_off(flush, saved)
         for i in prange(n):
             total = buf[0, i]
             for t in range(U(1), nt):
@@ -211,7 +209,7 @@ def kernels(precision: str, parallel: bool) -> dict:
         n, nt = U(mass.shape[0]), U(bufx.shape[0])
         for tt in prange(nt):
             t = U(tt)
-            saved = flush_on() if flush else U(0)
+            saved = flush_on(flush)
             accx, accy = bufx[t], bufy[t]
             accx[:] = 0
             accy[:] = 0
@@ -229,8 +227,7 @@ def kernels(precision: str, parallel: bool) -> dict:
                     accy[j] += mi * wy
                 accx[i] = bx
                 accy[i] = by
-            if flush:
-                flush_off(saved)
+            flush_off(flush, saved)
         for i in prange(n):
             sx_, sy_ = bufx[0, i], bufy[0, i]
             for t in range(U(1), nt):

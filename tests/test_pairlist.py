@@ -93,12 +93,11 @@ def test_auto_falls_back_to_gather_where_the_list_does_not_fit():
 def test_float32_loops_flush_subnormals_inside_and_leave_the_process_as_it_was():
     @numba.njit
     def halve(x, flush):  # as the pair loops do it: the flag set around a loop
-        saved = denormals.flush_on() if flush else numba.uint32(0)
+        saved = denormals.flush_on(flush)
         out = np.empty_like(x)
         for i in range(x.shape[0]):
             out[i] = x[i] * np.float32(0.5)
-        if flush:
-            denormals.flush_off(saved)
+        denormals.flush_off(flush, saved)
         return out
 
     tiny = np.full(64, 1e-39, np.float32)  # subnormal in float32

@@ -123,18 +123,15 @@ def _section_speed(df) -> list[str]:
                        fmt(r["ns_per_pair"], ".2f"), fmt(r["snp_pct"], ".1f"), r["commit"]] for r in rows]), ""]
 
 
-FIG9_LOOP = {"gather": "Linked list: the paper's gather loop.",
-             "list": "Linked list: the pair list (no gather-loop runs stored; `--pair-loop gather` measures the "
-                     "paper's)."}
-
-
 def _section_fig9(df) -> list[str]:
     rows = T.fig9(df)
     if not any(r["allpair_ms"] or r["allpair_status"] == "skipped" for r in rows):
         return []
     text = T.published()["text"]
     return ["## Fig. 9: all-pair against linked list (serial, float64, paper's scene)", "",
-            FIG9_LOOP[rows[0]["linkedlist_loop"]], "",
+            f"Linked list: {T.FIG9_LOOP_NAMES[rows[0]['linkedlist_loop']]}"
+            + ("." if rows[0]["linkedlist_loop"] == "gather"
+               else " (no gather-loop runs stored; `--pair-loop gather` measures the paper's)."), "",
             md_table(["N", "all-pair ms/step", "linked list ms/step", "eta = t_AP / t_LL", "all-pair status"],
                      [[f"{r['N']:,}", fmt(r["allpair_ms"], ".2f"), fmt(r["linkedlist_ms"], ".2f"),
                        fmt(r["eta"], ".1f"), r["allpair_status"] + (f": {r['allpair_note']}" if r["allpair_note"]

@@ -129,7 +129,7 @@ def fig9(df, out: Path, pid: str):
     colours = {"all-pair": "tab:red", "linked list": "tab:blue"}
     with figure(path, f"Fig. 9: all-pair against linked list, serial CPU, float64 ({pid})", "particles N", "",
                 ncols=2, logx=True, logy=True, size=(13, 4.4)) as (a, b):
-        loop = {"gather": "the paper's gather loop", "list": "pair list"}[rows[0]["linkedlist_loop"]]
+        loop = T.FIG9_LOOP_NAMES[rows[0]["linkedlist_loop"]]
         for key, name, label in (("allpair_ms", "all-pair", "all-pair (measured)"),
                                  ("linkedlist_ms", "linked list", f"linked list, {loop} (measured)")):
             pts = [(r["N"], r[key]) for r in rows if r[key]]

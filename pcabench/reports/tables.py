@@ -180,6 +180,9 @@ def speed(df) -> list[dict]:
 
 
 # ---------------------------------------------------------------- Fig. 9
+FIG9_LOOP_NAMES = {"gather": "the paper's gather loop", "list": "the pair list"}  # by ``linkedlist_loop``
+
+
 def fig9(df) -> list[dict]:
     """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL.
 
