@@ -37,7 +37,8 @@ class CellListSolver(Solver):
 
     @abc.abstractmethod
     def launch(self, name: str, *args):
-        """Run kernel ``name`` (cell_ids, continuity, momentum, neighbours) over every particle."""
+        """Run kernel ``name`` (cell_ids, continuity, momentum, neighbours, coefficients, kick, advance) over
+        every particle."""
 
     @abc.abstractmethod
     def count_neighbours(self) -> int:
@@ -67,6 +68,22 @@ class CellListSolver(Solver):
             self.launch("continuity", *self.geometry(), a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
         if momentum:
             self.launch("momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
+
+    # the coefficients and the system update: one kernel each over the particles (not numpy's chain of
+    # temporaries), on the same threads or device as the sweeps
+    def coefficients(self, continuity: bool, momentum: bool) -> None:
+        a = self.arrays
+        self.launch("coefficients", a["drho"], a["mass"], a["vol"], a["pr"], continuity, momentum, self.k)
+
+    def kick(self, f: float) -> None:
+        a = self.arrays
+        self.launch("kick", a["u"], a["v"], a["ax"], a["ay"], self.dtype.type(f * self.scene.dt))
+
+    def advance(self, f: float) -> None:
+        a = self.arrays
+        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"], self.dtype.type(f * self.scene.dt),
+                    self.moving)
+        self.t += f * self.scene.dt
 
     def mean_neighbours(self) -> float:
         self.cells_valid = False

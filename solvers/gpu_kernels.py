@@ -12,7 +12,7 @@ from functools import lru_cache
 
 from numba import cuda
 
-from .kernel import C0SQ, NONLIN, RHO0, exp_neg_math
+from .kernel import exp_neg_math
 from .gpu_device import device_backend
 from .pairs import make_pairs
 
@@ -60,27 +60,19 @@ def kernels(precision: str):
     def coefficients(drho, mass, vol, pr, continuity, momentum, k):
         i = cuda.grid(1)
         if i < drho.shape[0]:
-            rho = k[RHO0] + k[NONLIN] * drho[i]
-            if continuity:
-                vol[i] = mass[i] / rho
-            if momentum:
-                pr[i] = k[C0SQ] * drho[i] / (rho * rho)
+            P.coefficients_at(i, drho, mass, vol, pr, continuity, momentum, k)
 
     @jit
     def kick(u, v, ax, ay, c):
         i = cuda.grid(1)
         if i < u.shape[0]:
-            u[i] += c * ax[i]
-            v[i] += c * ay[i]
+            P.kick_at(i, u, v, ax, ay, c)
 
     @jit
     def advance(drho, dd, sx, sy, u, v, c, moving):
         i = cuda.grid(1)
         if i < drho.shape[0]:
-            drho[i] += c * dd[i]
-            if moving:
-                sx[i] += c * u[i]
-                sy[i] += c * v[i]
+            P.advance_at(i, drho, dd, sx, sy, u, v, c, moving)
 
     return {"cell_ids": cell_ids, "continuity": continuity, "momentum": momentum,
             "neighbours": neighbours, "coefficients": coefficients, "kick": kick, "advance": advance}

@@ -78,20 +78,6 @@ class LinkedListGPU(CellListSolver):
         self.begin = xp.searchsorted(self.cell, self.cell_range).astype(xp.uint32)
         self.permute(order)
 
-    def coefficients(self, continuity: bool, momentum: bool) -> None:
-        a = self.arrays
-        self.launch("coefficients", a["drho"], a["mass"], a["vol"], a["pr"], continuity, momentum, self.k)
-
-    def kick(self, f: float) -> None:
-        a = self.arrays
-        self.launch("kick", a["u"], a["v"], a["ax"], a["ay"], self.dtype.type(f * self.scene.dt))
-
-    def advance(self, f: float) -> None:
-        a = self.arrays
-        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"], self.dtype.type(f * self.scene.dt),
-                    self.moving)
-        self.t += f * self.scene.dt
-
     def count_neighbours(self) -> int:
         counts = self.xp.zeros(self.scene.n_particles, self.xp.int32)
         self.launch("neighbours", *self.geometry(), counts, self.k)

@@ -20,7 +20,8 @@ after the counting sort): a stencil row is then sorted by x, so binary
 searches bound each row to a cutoff either side of i, about 120 candidates
 per particle instead of 183. Their separations are computed in one
 branch-free pass the compiler vectorises, then compressed to the pairs in
-range, whose kernel factors are computed in a second vectorisable pass.
+range (solvers/compress.py: the vcompress instruction on cores with
+AVX-512), whose kernel factors are computed in a second vectorisable pass.
 
 Each thread lists its particles' pairs one after another in its own stretch
 of the list (a budget of pairs per particle, :func:`capacity`), so the
@@ -39,6 +40,7 @@ from functools import lru_cache
 import numba
 import numpy as np
 
+from .compress import PAD, compress_within
 from .denormals import flush_off, flush_on
 from .kernel import GRAD0, INV_H2, NONLIN, NY, RC2, RHO0, SPACING, make_exp_neg_table
 
@@ -159,14 +161,7 @@ def kernels(precision: str, parallel: bool) -> dict:
                 b0 = first_within(U(begin[up * ncx + x0]), e1, lxi, sxi, lx, sx, k)
                 b1 = first_beyond(b0, e1, lxi, sxi, lx, sx, k)
                 nq = distances(b0, b1, lxi, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
-                # keep those within the cutoff: every candidate written at slot m, m advances only for those in range
-                m = U(0)
-                for q in range(nq):
-                    cj[m] = js[q]
-                    crx[m] = rxs[q]
-                    cry[m] = rys[q]
-                    cr2[m] = r2s[q]
-                    m += U(r2s[q] < k[RC2])
+                m = compress_within(js, rxs, rys, r2s, cj, crx, cry, cr2, nq, k[RC2])  # those within the cutoff
                 start[i] = at
                 count[i] = m
                 for q in range(min(m, end - at)):  # the kernel factors of the pairs in range
@@ -284,7 +279,7 @@ class PairList:
         """Per-thread scratch rows long enough for any particle's candidates (two stencil rows of 3 cells)."""
         per_cell = np.diff(begin.astype(np.int64))
         rows = np.convolve(per_cell, np.ones(3, np.int64), mode="same")  # 3 consecutive cells (upper bound)
-        need = 2 * int(rows.max(initial=0)) + 1
+        need = 2 * int(rows.max(initial=0)) + 1 + PAD
         if self.scratch is None or self.scratch[0].shape[2] < need:
             self.scratch = (np.empty((self.threads, 2, need), np.uint32),
                             np.empty((self.threads, 6, need), self.fx.dtype))

@@ -24,7 +24,7 @@ of :func:`solvers.kernel.constants`, read by its named slots.
 import math
 from types import ModuleType
 
-from .kernel import GRAD0, INV_H2, NONLIN, NY, RC2, RHO0, SPACING, ZERO
+from .kernel import C0SQ, GRAD0, INV_H2, NONLIN, NY, RC2, RHO0, SPACING, ZERO
 
 
 def make_pairs(jit, exp_neg) -> ModuleType:
@@ -186,11 +186,37 @@ def make_pairs(jit, exp_neg) -> ModuleType:
             count += neighbours_range(j, j + 1, lx[i], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
+    # ---- per particle: the sweeps' coefficients (PI) and the system update (SU), one particle each, so that a
+    # device kernel or a CPU loop (parallel or not) makes each a single pass instead of a chain of array operations
+    @jit
+    def coefficients_at(i, drho, mass, vol, pr, continuity, momentum, k):
+        """vol_i = m_i / rho_i (continuity), pr_i = c0^2 drho_i / rho_i^2 (momentum)."""
+        rho = k[RHO0] + k[NONLIN] * drho[i]
+        if continuity:
+            vol[i] = mass[i] / rho
+        if momentum:
+            pr[i] = k[C0SQ] * drho[i] / (rho * rho)
+
+    @jit
+    def kick_at(i, u, v, ax, ay, c):
+        """u_i += c a_i (c = f dt, s)."""
+        u[i] += c * ax[i]
+        v[i] += c * ay[i]
+
+    @jit
+    def advance_at(i, drho, dd, sx, sy, u, v, c, moving):
+        """drho_i += c D_i and, for moving particles, x_i += c u_i (c = f dt, s)."""
+        drho[i] += c * dd[i]
+        if moving:
+            sx[i] += c * u[i]
+            sy[i] += c * v[i]
+
     pairs = ModuleType(f"{__name__}.compiled", "The pair functions for one backend (see make_pairs).")
     pairs.__dict__.update(
         continuity_range=continuity_range, momentum_range=momentum_range, neighbours_range=neighbours_range,
         cell_index=cell_index, stencil_row=stencil_row, continuity_cells=continuity_cells,
         momentum_cells=momentum_cells, neighbours_cells=neighbours_cells, minimum_image_row=minimum_image_row,
         continuity_allpair=continuity_allpair, momentum_allpair=momentum_allpair,
-        neighbours_allpair=neighbours_allpair)
+        neighbours_allpair=neighbours_allpair, coefficients_at=coefficients_at, kick_at=kick_at,
+        advance_at=advance_at)
     return pairs

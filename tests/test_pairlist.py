@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from solvers import Scene, make_solver, resolve_pair_loop
-from solvers import denormals, pairlist
+from solvers import compress, denormals, pairlist
 from solvers.integrators import step_program
 
 from .conftest import strip_for
@@ -114,3 +114,34 @@ def test_float32_list_agrees_with_float64_to_float32_roundoff():
     f64 = stepped(scene, "list").output()
     f32 = stepped(scene.replace(precision="float32"), "list", threads=2).output()
     assert max_rel(f32.u, f64.u) < 1e-4
+
+
+@numba.njit
+def _compress_both(js, rxs, rys, r2s, outs_v, outs_s, nq, limit):
+    cj, crx, cry, cr2 = outs_v
+    kept_v = compress.compress_vector(js, rxs, rys, r2s, cj, crx, cry, cr2, np.uint64(nq), limit)
+    cj, crx, cry, cr2 = outs_s
+    kept_s = compress.compress_scalar(js, rxs, rys, r2s, cj, crx, cry, cr2, np.uint64(nq), limit)
+    return kept_v, kept_s
+
+
+@pytest.mark.parametrize("precision", ["float64", "float32"])
+def test_vector_compress_keeps_exactly_the_scalar_loops_entries(precision):
+    """The build's vector compress (vcompress where the core has AVX-512, LLVM's expansion elsewhere)
+    keeps the same candidates in the same order as the scalar loop, for any count and any share kept."""
+    rng = np.random.default_rng(7)
+    dt = np.dtype(precision).type
+    length = 130 + compress.PAD
+    for nq in (0, 1, 7, 8, 15, 16, 17, 63, 121, 130):
+        for share in (0.0, 0.5, 1.0):
+            r2s = rng.random(length).astype(dt)
+            r2s[nq:] = -1  # past nq: would be kept if the count were ignored
+            rows = (np.arange(length, dtype=np.uint32), rng.random(length).astype(dt),
+                    rng.random(length).astype(dt), r2s)
+            outs_v = tuple(np.full(length, 99, r.dtype) for r in rows)
+            outs_s = tuple(np.full(length, 99, r.dtype) for r in rows)
+            kept_v, kept_s = _compress_both(*rows, outs_v, outs_s, nq, dt(share))
+            expected = int(np.sum(r2s[:nq] < dt(share)))
+            assert kept_v == kept_s == expected, (nq, share)
+            for v, s_ in zip(outs_v, outs_s):
+                np.testing.assert_array_equal(v[:expected], s_[:expected])
