@@ -7,11 +7,13 @@ in either precision, measured here), because each kept entry is a
 data-dependent store. On cores with AVX-512 the compiler's vector compress
 (``llvm.experimental.vector.compress``, the vcompress instruction) packs 8
 float64 or 16 float32 lanes per instruction: 33 ns in float64 and 15 ns in
-float32 for the same 121 candidates. A full vector is stored at the next
-free slot each time (zeros in the lanes past the kept ones) and the next
-store overwrites the lanes past the kept ones, so source and destination
-rows need :data:`PAD` spare entries.
-Elsewhere :func:`compress_within` is the scalar loop, with the same result.
+float32 for the same 121 candidates (the memory form,
+``llvm.masked.compressstore``, took 46-52 and 30 ns: microcoded on these
+cores). Each step stores a whole vector at the next free slot, zeros past
+the kept lanes, which the next step overwrites: source and destination
+rows need :data:`PAD` spare entries. Where the core has no AVX-512, or
+numba's LLVM predates the vector compress (LLVM 19),
+:func:`compress_within` is the scalar loop, with the same result.
 """
 from __future__ import annotations
 
@@ -26,6 +28,9 @@ VECTOR_BITS = 512
 PAD = 16  # spare entries each source and destination row needs: the widest vector's lanes
 
 
+LLVM_HAS_VECTOR_COMPRESS = binding.llvm_version_info >= (19,)
+
+
 def host_has_avx512() -> bool:
     """Whether numba compiles for a core with AVX-512 (the host, unless NUMBA_CPU_NAME says otherwise)."""
     if numba.config.CPU_NAME not in (None, "host"):
@@ -36,7 +41,7 @@ def host_has_avx512() -> bool:
         return False
 
 
-VECTOR_COMPRESS = host_has_avx512()
+VECTOR_COMPRESS = LLVM_HAS_VECTOR_COMPRESS and host_has_avx512()
 U = np.uint64
 
 

@@ -125,6 +125,7 @@ def _compress_both(js, rxs, rys, r2s, outs_v, outs_s, nq, limit):
     return kept_v, kept_s
 
 
+@pytest.mark.skipif(not compress.LLVM_HAS_VECTOR_COMPRESS, reason="numba's LLVM has no vector compress (< 19)")
 @pytest.mark.parametrize("precision", ["float64", "float32"])
 def test_vector_compress_keeps_exactly_the_scalar_loops_entries(precision):
     """The build's vector compress (vcompress where the core has AVX-512, LLVM's expansion elsewhere)
