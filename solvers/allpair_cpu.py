@@ -11,7 +11,7 @@ from functools import lru_cache
 
 import numba
 
-from .backend import cpu_pairs
+from .backend import cpu_pairs, cpu_updates
 from .interface import Solver, tiny_scene
 
 @lru_cache(maxsize=None)
@@ -37,7 +37,8 @@ def sweeps(precision: str) -> dict:
         return total
 
     jit = numba.njit(nogil=True)
-    return {"continuity": jit(continuity), "momentum": jit(momentum), "neighbours": jit(neighbours)}
+    return {"continuity": jit(continuity), "momentum": jit(momentum), "neighbours": jit(neighbours),
+            **cpu_updates(precision, False)}
 
 
 class AllPairCPU(Solver):
@@ -49,17 +50,20 @@ class AllPairCPU(Solver):
     def snp(self) -> None:
         """Nothing to build: the all-pair search happens inside the interaction loop."""
 
+    def launch(self, name: str, *args):
+        return sweeps(self.scene.precision)[name](*args)
+
     def _sweep(self, continuity: bool, momentum: bool) -> None:
-        a, kk = self.arrays, sweeps(self.scene.precision)
+        a = self.arrays
         pos = (a["lx"], a["ly"], a["sx"], a["sy"])
         if continuity:
-            kk["continuity"](*pos, a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+            self.launch("continuity", *pos, a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
         if momentum:
-            kk["momentum"](*pos, a["mass"], a["pr"], a["ax"], a["ay"], self.k)
+            self.launch("momentum", *pos, a["mass"], a["pr"], a["ax"], a["ay"], self.k)
 
     def mean_neighbours(self) -> float:
         a = self.arrays
-        return sweeps(self.scene.precision)["neighbours"](a["lx"], a["ly"], a["sx"], a["sy"], self.k) / self.scene.n_particles
+        return self.launch("neighbours", a["lx"], a["ly"], a["sx"], a["sy"], self.k) / self.scene.n_particles
 
     def warmup(self) -> float:
         t0 = time.perf_counter()
@@ -67,5 +71,7 @@ class AllPairCPU(Solver):
         probe.input(tiny_scene(self.scene))
         probe.init()
         probe.rates(True, True)
+        probe.kick(0.5)
+        probe.advance(1.0)
         probe.mean_neighbours()
         return time.perf_counter() - t0

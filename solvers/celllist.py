@@ -8,7 +8,8 @@ per-particle array into cell order, so the three cells of a stencil row are
 one contiguous range. Particles that never move are searched once.
 
 A subclass says only how cells are sorted (:meth:`sort_cells`) and how a
-kernel is launched (:meth:`launch`).
+kernel is launched (:meth:`launch`: cell_ids, continuity, momentum and
+neighbours here, besides the base's coefficients, kick and advance).
 """
 from __future__ import annotations
 
@@ -34,11 +35,6 @@ class CellListSolver(Solver):
     @abc.abstractmethod
     def sort_cells(self) -> None:
         """particleIndex, cellParticleOrder and cellBegin for the current positions; arrays into cell order."""
-
-    @abc.abstractmethod
-    def launch(self, name: str, *args):
-        """Run kernel ``name`` (cell_ids, continuity, momentum, neighbours, coefficients, kick, advance) over
-        every particle."""
 
     @abc.abstractmethod
     def count_neighbours(self) -> int:
@@ -68,22 +64,6 @@ class CellListSolver(Solver):
             self.launch("continuity", *self.geometry(), a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
         if momentum:
             self.launch("momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
-
-    # the coefficients and the system update: one kernel each over the particles (not numpy's chain of
-    # temporaries), on the same threads or device as the sweeps
-    def coefficients(self, continuity: bool, momentum: bool) -> None:
-        a = self.arrays
-        self.launch("coefficients", a["drho"], a["mass"], a["vol"], a["pr"], continuity, momentum, self.k)
-
-    def kick(self, f: float) -> None:
-        a = self.arrays
-        self.launch("kick", a["u"], a["v"], a["ax"], a["ay"], self.dtype.type(f * self.scene.dt))
-
-    def advance(self, f: float) -> None:
-        a = self.arrays
-        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"], self.dtype.type(f * self.scene.dt),
-                    self.moving)
-        self.t += f * self.scene.dt
 
     def mean_neighbours(self) -> float:
         self.cells_valid = False

@@ -13,7 +13,9 @@ operation from outside, the same way for every solver:
     output  ``output()``          copy back, in particle-id order
 
 The state lives in arrays of the array module ``xp`` (NumPy on the CPU,
-CuPy on the GPU), so the system update is written once for every solver.
+CuPy on the GPU). The system update and the sweeps' coefficients are
+per-particle functions written once (solvers/pairs.py), which each solver
+launches (:meth:`Solver.launch`) on its own device and threads.
 All per-particle arrays sit in ``self.arrays`` so that a neighbour search
 that reorders particles can permute all of them together.
 """
@@ -53,7 +55,7 @@ class SolverUnavailable(RuntimeError):
 
 
 class Solver(abc.ABC):
-    """Base class: state, system update, output. Subclasses: ``snp`` and ``_sweep``."""
+    """Base class: state, system update, output. Subclasses: ``snp``, ``_sweep`` and ``launch``."""
 
     name: str = "abstract"
     device: str = "cpu"
@@ -120,12 +122,13 @@ class Solver(abc.ABC):
 
     def coefficients(self, continuity: bool, momentum: bool) -> None:
         """Per-particle coefficients of the sweeps: vol = m / rho (continuity), pr = c0^2 drho / rho^2 (momentum)."""
-        a, k = self.arrays, self.k
-        rho = k[kernel.RHO0] + k[kernel.NONLIN] * a["drho"]
-        if continuity:
-            self.xp.divide(a["mass"], rho, out=a["vol"])
-        if momentum:
-            self.xp.divide(k[kernel.C0SQ] * a["drho"], rho * rho, out=a["pr"])
+        a = self.arrays
+        self.launch("coefficients", a["drho"], a["mass"], a["vol"], a["pr"], continuity, momentum, self.k)
+
+    @abc.abstractmethod
+    def launch(self, name: str, *args):
+        """Run kernel ``name`` over every particle on this solver's device and threads: at least the
+        per-particle ones of solvers/pairs.py (coefficients, kick, advance)."""
 
     @abc.abstractmethod
     def _sweep(self, continuity: bool, momentum: bool) -> None:
@@ -134,17 +137,14 @@ class Solver(abc.ABC):
     # ------------------------------------------------------------ system update
     def kick(self, f: float) -> None:
         """u += f dt a."""
-        a, c = self.arrays, self.dtype.type(f * self.scene.dt)
-        a["u"] += c * a["ax"]
-        a["v"] += c * a["ay"]
+        a = self.arrays
+        self.launch("kick", a["u"], a["v"], a["ax"], a["ay"], self.dtype.type(f * self.scene.dt))
 
     def advance(self, f: float) -> None:
         """drho += f dt D and, for moving particles, x += f dt u; time += f dt."""
-        a, c = self.arrays, self.dtype.type(f * self.scene.dt)
-        a["drho"] += c * a["dd"]
-        if self.moving:
-            a["sx"] += c * a["u"]
-            a["sy"] += c * a["v"]
+        a = self.arrays
+        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"], self.dtype.type(f * self.scene.dt),
+                    self.moving)
         self.t += f * self.scene.dt
 
     def save(self) -> None:
@@ -162,10 +162,13 @@ class Solver(abc.ABC):
 
     def permute(self, order) -> None:
         """Reorder every per-particle array (state, rates, saved copies) by ``order``."""
-        xp = self.xp
         for store in (self.arrays, self.saved):
             for name, arr in store.items():
-                store[name] = xp.take(arr, order)
+                store[name] = self.gathered(arr, order)
+
+    def gathered(self, arr, order):
+        """``arr`` in the order ``order`` (a new array; a solver may reuse its own buffers)."""
+        return self.xp.take(arr, order)
 
     # ------------------------------------------------------------ output and checks
     def output(self) -> Fields:

@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from . import pairlist
-from .backend import cpu_pairs
+from .backend import cpu_pairs, cpu_updates
 from .celllist import CellListSolver
 from .scene import SceneError
 
@@ -45,14 +45,6 @@ def _counting_sort(cell, ncells, begin, order, sorted_cell):
         order[fill[c]] = i
         sorted_cell[fill[c]] = c
         fill[c] += 1
-
-
-@numba.njit(nogil=True, cache=True)
-def gather_range(src, order, out, lo, hi):
-    """out[i] = src[order[i]] for lo <= i < hi. Compiled on its own: written inline in a parallel loop's
-    body, numba compiled this loop 2.5 times slower (measured here)."""
-    for i in range(lo, hi):
-        out[i] = src[order[i]]
 
 
 @lru_cache(maxsize=None)
@@ -79,28 +71,9 @@ def sweeps(precision: str, parallel: bool) -> dict:
         for i in prange(lx.shape[0]):
             cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, height, cw, ch, ncx, ncy)
 
-    def coefficients(drho, mass, vol, pr, continuity, momentum, k):
-        for i in prange(drho.shape[0]):
-            P.coefficients_at(i, drho, mass, vol, pr, continuity, momentum, k)
-
-    def kick(u, v, ax, ay, c):
-        for i in prange(u.shape[0]):
-            P.kick_at(i, u, v, ax, ay, c)
-
-    def advance(drho, dd, sx, sy, u, v, c, moving):
-        for i in prange(drho.shape[0]):
-            P.advance_at(i, drho, dd, sx, sy, u, v, c, moving)
-
-    def gather(src, order, out, parts):
-        n = order.shape[0]
-        for t in prange(parts):
-            gather_range(src, order, out, t * n // parts, (t + 1) * n // parts)
-
     jit = numba.njit(nogil=True, parallel=parallel)
-    return {name: jit(fn) for name, fn in (("continuity", continuity), ("momentum", momentum),
-                                           ("neighbours", neighbours), ("cell_ids", cell_ids),
-                                           ("coefficients", coefficients), ("kick", kick), ("advance", advance),
-                                           ("gather", gather))}
+    return {"continuity": jit(continuity), "momentum": jit(momentum), "neighbours": jit(neighbours),
+            "cell_ids": jit(cell_ids), **cpu_updates(precision, parallel)}
 
 
 counting_sort = numba.njit(cache=True, nogil=True)(_counting_sort)
@@ -144,7 +117,7 @@ class LinkedListCPU(CellListSolver):
         # neighbour load (measured 20-25 % faster sweeps)
         self.begin = np.zeros(self.ncells + 1, np.uint32)
         self.pairs = pairlist.PairList(self.scene, self.threads) if self.pair_loop == "list" else None
-        self.spare = None  # the permute's target array
+        self.spare = None  # the next gather's target array
 
     def launch(self, name: str, *args):
         if self.threads > 1:
@@ -163,16 +136,16 @@ class LinkedListCPU(CellListSolver):
         if self.pairs is not None:
             self.pairs.build(*self.geometry(), self.k)
 
-    def permute(self, order) -> None:
-        """Reorder every per-particle array by ``order`` on the solver's threads. Each array is gathered
-        into a spare one, which takes its place while the old array becomes the spare: one extra array in
-        all, and no fresh pages to fault in every step (a new array per gather cost 40 ns per particle)."""
-        for store in (self.arrays, self.saved):
-            for name, arr in store.items():
-                if self.spare is None or self.spare.shape != arr.shape or self.spare.dtype != arr.dtype:
-                    self.spare = np.empty_like(arr)
-                self.launch("gather", arr, order, self.spare, self.threads)
-                store[name], self.spare = self.spare, arr
+    def gathered(self, arr, order):
+        """``arr`` reordered on the solver's threads, into the spare array; ``arr`` becomes the spare.
+        One extra array in all, and no fresh pages to fault in every step (a new array per gather cost
+        40 ns per particle here)."""
+        out = self.spare
+        if out is None or out.shape != arr.shape or out.dtype != arr.dtype:
+            out = np.empty_like(arr)
+        self.launch("gather", arr, order, out, self.threads)
+        self.spare = arr
+        return out
 
     def _sweep(self, continuity: bool, momentum: bool) -> None:
         if self.pairs is None:
