@@ -17,14 +17,18 @@ from .spec import RunSpec
 from .store import to_row
 
 
-def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    spec = RunSpec.from_json(argv[0]).resolved()
+def run_spec(spec: RunSpec) -> dict:
+    """Run one resolved spec with step progress on stderr; its record as a store row."""
     progress = Progress(f"    {spec.solver} N={spec.scene.n_particles:,}", every=5.0)
     record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id(), pair_loop=spec.pair_loop,
                  progress=progress)
     record.preset = spec.preset
-    print(json.dumps(to_row(record), sort_keys=True), flush=True)
+    return to_row(record)
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    print(json.dumps(run_spec(RunSpec.from_json(argv[0]).resolved()), sort_keys=True), flush=True)
     return 0
 
 

@@ -1,46 +1,120 @@
-"""One command that does all the GPU work on a GPU machine.
+"""All of the GPU work in one command, within one time budget, rehearsed where there is no GPU.
 
-    pcabench gpu-check --out DIR
+    pcabench gpu-check --out DIR [--budget SECONDS]      # on a GPU machine
+    pcabench gpu-check --rehearse --out DIR              # anywhere: the same script in numba's simulator
 
-1. captures the hardware profile and measures the card's ceilings (device
-   copy bandwidth, FP32 and FP64 FMA rate);
-2. runs the GPU tests (pytest -m gpu);
-3. compares linkedlist-gpu with linkedlist-cpu on a small scene for every
-   model and precision (max relative difference of u and drho);
-4. times linkedlist-gpu across dx = 0.1 ... 0.004 for both precisions and the
-   three models (the paper's full domain, 100 steps by default);
-5. times linkedlist-cpu on the same machine, one thread (the paper's CPU
-   code) and every core, at dx = 0.1 ... 0.025 for a few steps: Table 6's
-   CPU column, so that the speedup compares one machine's CPU and GPU;
+A GPU machine is lent rarely and briefly, so the first real run has to work
+and bring everything back from one call. The check runs these stages in
+order of value, each given what is left of the budget, and stops cleanly
+when the budget is spent, keeping what it has:
 
-The sweeps of 4 and 5 are ordinary sweeps (``sweep.py``): their runs go to
-the results store like a study's, under preset ``gpu``, and the reports are
-regenerated. DIR gets profile.json, gpu_check.md (tables) and pytest_gpu.log.
+1. ``profile``: the hardware profile, with the card's measured ceilings
+   (device copy bandwidth, FP32 and FP64 FMA rates, the SM clock);
+2. ``compare``: linkedlist-gpu against linkedlist-cpu, every model and precision;
+3. ``sweep``: linkedlist-gpu, lagrangian Verlet, both precisions, 100K to 62.5M
+   particles on the paper's domain, steps sized to the budget; runs go to the
+   results store (preset ``gpu``) through the ordinary sweep, in this process
+   so that kernels compile once;
+4. ``graph``: the step captured as a CUDA graph against plain launches, in the
+   same process, alternating, best of several rounds, and their fields compared;
+5. ``cpu``: linkedlist-cpu on this host (one thread and every core): Table 6's
+   same-machine CPU column;
+6. ``pytest-gpu``: the GPU tests; ``bench``: the pytest-benchmark suite's JSON;
+7. ``asv``: asv's GPU benchmarks at HEAD and at the H100's commit, when asv
+   and the history were brought along (pcabench/device_payload.py);
+8. ``ncu``: Nsight Compute's speed-of-light section of one step's kernels;
+9. the reports, regenerated from the store.
+
+Everything to bring back ends up in DIR: ``gpu_check.md`` (tables),
+``gpu_check.log`` is the caller's, and ``gpu_check.tar.gz`` (store, profile,
+reports, JSON and logs), at most a few files of a few MiB.
+
+The full plan was sized from the H100 run at bf587a5 (one lagrangian step at
+62.5M particles: 98 ms float32, 170 ms float64; 5-8 s to copy the fields back
+and sort them on the host at that size; about 20 s of compilation per
+process) to take about 6 minutes of an H200, leaving a default budget of
+8 minutes some slack. The rehearsal runs every stage end to end at a few
+hundred particles in the simulator (the graph and the ceilings need a GPU
+and say so), which is what CI runs so that the script cannot rot.
 """
 from __future__ import annotations
 
 import json
+import os
+import shutil
 import subprocess
 import sys
+import tarfile
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from solvers import MODELS, PRECISIONS, Scene
-from solvers.gpu_device import device_backend
+from solvers import MODELS, PRECISIONS, Scene, make_solver
+from solvers.gpu_device import device_backend, simulated
+from solvers.integrators import step_program
 
 from .record import STEP_STAGES, step_seconds
 from .run import run
 from .spec import ALL_CORES, SERIAL, RunSpec
 from .store import store_name
 
-GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles
+H100_COMMIT = "bf587a5"  # the commit the H100 was measured at: asv compares the cards there
+GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
 CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
-CPU_STEPS = 5
+RESERVE_S = 25.0  # kept back from every stage for the reports and the tarball
 
 
+@dataclass(frozen=True)
+class Plan:
+    """What the check runs and at what size."""
+
+    gpu_dx: tuple = GPU_DX
+    models: tuple = ("lagrangian",)
+    min_steps: int = 10  # steps of the biggest runs; smaller runs take up to 100 (see gpu_steps)
+    compare_dx: float = 0.5
+    compare_steps: int = 20
+    graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
+    graph_steps: int = 50
+    graph_rounds: int = 5
+    cpu_dx: tuple = CPU_DX
+    cpu_steps: int = 5
+    scene: dict = field(default_factory=dict)  # Scene overrides (the rehearsal's small domain)
+    asv_bench: str = "TimeGPUStep"
+    ncu_dx: float = 0.01
+
+    def gpu_steps(self, dx: float) -> int:
+        """100 steps up to 1.6M particles, fewer above, down to ``min_steps`` at 40M and more."""
+        n = Scene(dx=dx, **self.scene).n_particles
+        return max(self.min_steps, min(100, int(2e8 // max(n, 1))))
+
+
+FULL = Plan()
+REHEARSAL = Plan(gpu_dx=(1.0, 0.5), min_steps=2, compare_dx=1.0, compare_steps=3, graph_dx=(1.0,),
+                 graph_steps=2, graph_rounds=1, cpu_dx=(1.0,), cpu_steps=2,
+                 scene={"x_min": -8.0, "x_max": 8.0}, asv_bench="TimeGPUStep", ncu_dx=1.0)
+
+
+class Budget:
+    """Seconds left of the check's budget, with progress lines that say where it stands."""
+
+    def __init__(self, seconds: float):
+        self.seconds, self.t0 = seconds, time.perf_counter()
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.t0
+
+    def left(self) -> float:
+        return self.seconds - self.elapsed() - RESERVE_S
+
+    def say(self, text: str) -> None:
+        print(f"[gpu-check {self.elapsed():6.1f} s of {self.seconds:.0f}] {text}", file=sys.stderr, flush=True)
+
+
+# ---------------------------------------------------------------- 1. the card's ceilings
 def measure_ceilings(cupy) -> dict:
-    """Device-to-device copy bandwidth (bytes read + written) and FP32/FP64 FMA rates."""
+    """Device-to-device copy bandwidth (bytes read + written), FP32/FP64 FMA rates, and the SM clock."""
     cuda, _ = device_backend()
     out = {}
     n = 512 * 2**20 // 4  # 512 MiB per buffer
@@ -59,7 +133,7 @@ def measure_ceilings(cupy) -> dict:
     out["copy_bandwidth_tbs"] = round(2 * a.nbytes / float(np.median(times)) / 1e12, 3)
     del a, b
 
-    def fma_kernel(dtype):
+    def fma_kernel():
         @cuda.jit
         def k(x, iters, m, c):
             i = cuda.grid(1)
@@ -86,7 +160,7 @@ def measure_ceilings(cupy) -> dict:
     for dtype, key in ((np.float32, "fp32_fma_tflops"), (np.float64, "fp64_fma_tflops")):
         threads, iters = 132 * 2048 * 4, 2048
         x = cupy.ones(threads, dtype=dtype)
-        k = fma_kernel(dtype)
+        k = fma_kernel()
         m, c = dtype(0.999), dtype(0.001)  # typed constants keep the chain in dtype
         k[threads // 256, 256](x, iters, m, c)
         cupy.cuda.runtime.deviceSynchronize()
@@ -96,46 +170,155 @@ def measure_ceilings(cupy) -> dict:
         end.synchronize()
         seconds = cupy.cuda.get_elapsed_time(start, end) / 1e3
         out[key] = round(2 * 8 * iters * threads / seconds / 1e12, 2)
-    out["note"] = "measured by pcabench gpu-check (median of 10 copies; one FMA-chain kernel)"
+    out["sm_clock_mhz_under_load"] = _smi_clock()
+    out["note"] = "measured by pcabench gpu-check (median of 10 copies; one FMA-chain kernel each)"
     return out
 
 
-def compare_with_cpu(dx: float = 0.5, steps: int = 20) -> list[dict]:
+def _smi_clock():
+    """The SM clock nvidia-smi reports right after the FMA kernels, MHz (None without nvidia-smi)."""
+    try:
+        text = subprocess.run(["nvidia-smi", "--query-gpu=clocks.sm,clocks.max.sm", "--format=csv,noheader,nounits"],
+                              capture_output=True, text=True, timeout=20).stdout.strip().splitlines()[0]
+        now, most = (int(v) for v in text.split(","))
+        return {"now": now, "max": most}
+    except (OSError, ValueError, IndexError, subprocess.SubprocessError):
+        return None
+
+
+# ---------------------------------------------------------------- 2. GPU against CPU
+def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
     """Max relative difference GPU vs CPU of the final u and drho, every model and precision."""
     rows = []
     for precision in PRECISIONS:
         for model in MODELS:
-            scene = Scene(dx=dx, steps=steps, model=model, precision=precision)
+            scene = Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision,
+                          **plan.scene)
             fields = {}
             for solver in ("linkedlist-cpu", "linkedlist-gpu"):
-                path = Path(f"/tmp/pcabench_cmp_{solver}.npz")
+                path = out / f"compare_{solver}.npz"
                 rec = run(scene, solver, fields_path=path)
                 if rec.status != "ok":
                     raise RuntimeError(f"{solver} {model} {precision}: {rec.status} {rec.message}")
-                fields[solver] = np.load(path)
-            diff = {}
-            for name in ("u", "drho"):
-                c, g = fields["linkedlist-cpu"][name], fields["linkedlist-gpu"][name]
-                diff[name] = float(np.max(np.abs(g - c)) / np.max(np.abs(c)))
-            rows.append({"precision": precision, "model": model, "dx": dx, "steps": steps,
+                fields[solver] = dict(np.load(path))
+                path.unlink()
+            diff = {name: float(np.max(np.abs(fields["linkedlist-gpu"][name] - fields["linkedlist-cpu"][name]))
+                                / np.max(np.abs(fields["linkedlist-cpu"][name]))) for name in ("u", "drho")}
+            rows.append({"precision": precision, "model": model, "dx": plan.compare_dx, "steps": plan.compare_steps,
                          "max_rel_diff_u": diff["u"], "max_rel_diff_drho": diff["drho"]})
-            print(f"compare {precision} {model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}", flush=True)
+            print(f"compare {precision} {model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}", file=sys.stderr,
+                  flush=True)
     return rows
 
 
-def gpu_specs(sizes, steps: int, models=MODELS) -> list[RunSpec]:
+# ---------------------------------------------------------------- 3 and 5. the sweeps
+def gpu_specs(plan: Plan) -> list[RunSpec]:
     """The GPU timing sweep: linkedlist-gpu on the paper's full domain, every size, precision and model."""
-    return [RunSpec("linkedlist-gpu", Scene(dx=dx, steps=steps, model=model, precision=precision,
-                                            memory_limit_bytes=2**40), preset="gpu")  # the GPU checks its own memory
-            for dx in sizes for precision in PRECISIONS for model in models]
+    return [RunSpec("linkedlist-gpu", Scene(dx=dx, steps=plan.gpu_steps(dx), model=model, precision=precision,
+                                            memory_limit_bytes=2**40, **plan.scene), preset="gpu")
+            for dx in plan.gpu_dx for precision in PRECISIONS for model in plan.models]  # the GPU checks its memory
 
 
-def cpu_peer_specs() -> list[RunSpec]:
+def cpu_peer_specs(plan: Plan) -> list[RunSpec]:
     """linkedlist-cpu, lagrangian float64, one thread and every core, on this GPU's host: Table 6's CPU column."""
-    return [RunSpec("linkedlist-cpu", Scene(dx=dx, steps=CPU_STEPS), threads, preset="gpu")
-            for dx in CPU_DX for threads in (SERIAL, ALL_CORES)]
+    return [RunSpec("linkedlist-cpu", Scene(dx=dx, steps=plan.cpu_steps, **plan.scene), threads, preset="gpu")
+            for dx in plan.cpu_dx for threads in (SERIAL, ALL_CORES)]
 
 
+def run_and_release(spec, timeout, commit, stream=sys.stderr) -> dict:
+    """One run in this process, then CuPy's cached blocks back to the card (the next run's fit check reads
+    the card's free memory)."""
+    from .sweep import run_here
+
+    try:
+        return run_here(spec, timeout, commit, stream)
+    finally:
+        _cuda, cupy = device_backend() if spec.solver == "linkedlist-gpu" else (None, None)
+        if cupy is not None:
+            cupy.get_default_memory_pool().free_all_blocks()
+
+
+# ---------------------------------------------------------------- 4. the graph path
+def graph_vs_plain(dx: float, precision: str, steps: int, rounds: int, scene_overrides: dict) -> dict:
+    """ms per lagrangian Verlet step, plain launches against the captured graph, alternating in one process
+    (best round of each), and the largest relative difference of u after ``steps`` steps of each from one state."""
+    from solvers.gpu_graph import CapturedSteps
+
+    scene = Scene(dx=dx, precision=precision, model="lagrangian", memory_limit_bytes=2**40, **scene_overrides)
+    solver = make_solver("linkedlist-gpu")
+    solver.input(scene)
+    solver.warmup()
+    solver.init()
+    for _stage, op in step_program("verlet", solver, first=True):
+        op()
+    plain_step = step_program("verlet", solver, first=False)
+    graph = CapturedSteps(solver, "verlet")
+    cupy, stream = solver.cupy, solver.stream
+
+    def timed(one_step) -> float:
+        start, end = cupy.cuda.Event(), cupy.cuda.Event()
+        start.record(stream)
+        for _ in range(steps):
+            one_step()
+        end.record(stream)
+        end.synchronize()
+        return cupy.cuda.get_elapsed_time(start, end) / steps
+
+    def plain():
+        for _stage, op in plain_step:
+            op()
+
+    best = {"plain": float("inf"), "graph": float("inf")}
+    for _ in range(rounds):
+        for name, one_step in (("plain", plain), ("graph", graph.step)):
+            best[name] = min(best[name], timed(one_step))
+    # the same steps from one state by each path: the state is the current block, its cells and cellBegin
+    current = solver.state()
+    block, cells = (a.copy() for a in solver.blocks_of[current])
+    begin, t0 = solver.begin.copy(), solver.t
+    u = {}
+    for name, one_step in (("plain", plain), ("graph", graph.step)):
+        solver.set_state(current)
+        solver.blocks_of[current][0][...] = block
+        solver.blocks_of[current][1][...] = cells
+        solver.begin[...] = begin
+        solver.t = t0
+        for _ in range(steps):
+            one_step()
+        u[name] = solver.output().u  # particle-id order
+    diff = float(np.max(np.abs(u["graph"] - u["plain"])) / np.max(np.abs(u["plain"])))
+    return {"dx": dx, "N": scene.n_particles, "precision": precision, "steps": steps, "rounds": rounds,
+            "plain_ms": best["plain"], "graph_ms": best["graph"], "speedup": best["plain"] / best["graph"],
+            "max_rel_diff_u": diff}
+
+
+# ---------------------------------------------------------------- 6-8. subprocess stages
+def run_logged(cmd: list[str], log: Path, timeout: float, env=None) -> dict:
+    """``cmd`` with its output in ``log``; its exit code (124 past ``timeout``) and seconds."""
+    t0 = time.perf_counter()
+    with open(log, "w") as f:
+        try:
+            rc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, timeout=max(timeout, 1.0),
+                                env=env).returncode
+        except subprocess.TimeoutExpired:
+            rc = 124
+            f.write(f"\n[gpu-check: stopped at the stage's share of the budget, {timeout:.0f} s]\n")
+        except OSError as exc:
+            rc = 127
+            f.write(f"\n[gpu-check: could not start {cmd[0]}: {exc}]\n")
+    return {"command": " ".join(cmd), "exit": rc, "seconds": round(time.perf_counter() - t0, 1), "log": log.name}
+
+
+def ncu_command(plan: Plan, out: Path) -> list[str]:
+    """Nsight Compute on one short lagrangian run: the speed-of-light and memory sections of each kernel once."""
+    return ["ncu", "--clock-control", "none", "--section", "SpeedOfLight", "--section", "MemoryWorkloadAnalysis",
+            "--kernel-name", "regex:kick|continuity|advance|cell_count|cell_begin|scatter|momentum",
+            "--launch-skip", "40", "--launch-count", "8", "-o", str(out / "ncu_step"), "-f",
+            sys.executable, "-m", "pcabench.cli", "run", "--solver", "linkedlist-gpu", "--dx", str(plan.ncu_dx),
+            "--precision", "float32", "--steps", "8", "--quiet"]
+
+
+# ---------------------------------------------------------------- the tables
 def timing_row(row: dict) -> dict:
     """One stored GPU run as the check's table row: step time, stage shares, ns per particle-step, ps per pair."""
     st, steps, n = row["stages"], max(row["steps"] or 0, 1), row["n_particles"]
@@ -144,77 +327,207 @@ def timing_row(row: dict) -> dict:
     pairs = 2 * n * (row.get("mean_neighbours") or 0)  # both sweeps of a Verlet step
     share = {s: 100 * st[s] / loop if loop else float("nan") for s in STEP_STAGES}
     return {"dx": row["dx"], "N": n, "precision": row["precision"], "model": row["model"], "status": row["status"],
-            "step_ms": 1e3 * step, **{f"{s}_pct": share[s] for s in STEP_STAGES},
+            "steps": steps, "step_ms": 1e3 * step, **{f"{s}_pct": share[s] for s in STEP_STAGES},
             "ns_per_particle_step": 1e9 * step / n, "ps_per_pair": 1e12 * step / pairs if pairs else float("nan"),
             "neighbours": row.get("mean_neighbours") or float("nan"),
             "mse": row.get("mse") if row.get("mse") is not None else float("nan"),
             "init_ms": 1e3 * st["init"], "output_ms": 1e3 * st["output"]}
 
 
-def markdown(profile, compare_rows, gpu_rows, steps, cpu_rows=()) -> str:
+def markdown(profile: dict, results: dict) -> str:
+    """The check's tables: stages run, ceilings, agreement, sweep, graph path, CPU peers."""
     g = profile.get("gpu") or {}
-    timing_rows = [timing_row(r) for r in gpu_rows]
-    lines = [f"# GPU check: {g.get('name', '?')} ({profile['id']})", "",
-             f"Measured ceilings: {json.dumps(profile.get('measured', {}))}", "",
-             "## GPU vs linkedlist-cpu (max relative difference after the steps shown)", "",
-             "| precision | model | dx | steps | u | drho |", "|---|---|---|---|---|---|"]
-    for r in compare_rows:
-        lines.append(f"| {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | "
-                     f"{r['max_rel_diff_u']:.2e} | {r['max_rel_diff_drho']:.2e} |")
-    lines += ["", f"## Timing, full paper domain, {steps} steps, Verlet, cutoff 3h", "",
-              "| dx | N | precision | model | status | step (ms) | SNP % | PI % | SU % | ns/particle-step "
-              "| ps/pair | neighbours | MSE | init (ms) | output (ms) |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in timing_rows:
-        lines.append(
-            f"| {r['dx']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['status']} | {r['step_ms']:.3f} | "
-            f"{r['snp_pct']:.1f} | {r['pi_pct']:.1f} | {r['su_pct']:.1f} | {r['ns_per_particle_step']:.3f} | "
-            f"{r['ps_per_pair']:.2f} | {r['neighbours']:.1f} | {r['mse']:.3g} | {r['init_ms']:.1f} | "
-            f"{r['output_ms']:.1f} |")
-    lines += ["", "ps/pair counts both sweeps of a Verlet step (2 x N x mean neighbours pairs)."]
-    if cpu_rows:
+    lines = [f"# GPU check: {g.get('name', 'no GPU (rehearsal)')} ({profile['id']})", "",
+             f"Commit {results.get('commit', '?')}; budget {results['budget_s']:.0f} s, used "
+             f"{results['elapsed_s']:.0f} s.", "", "| stage | status | seconds |", "|---|---|---|"]
+    lines += [f"| {s['stage']} | {s['status']} | {s['seconds']:.1f} |" for s in results["stages"]]
+    lines += ["", f"Measured ceilings: {json.dumps(profile.get('measured', {}))}", ""]
+    if results.get("compare"):
+        lines += ["## GPU vs linkedlist-cpu (max relative difference after the steps shown)", "",
+                  "| precision | model | dx | steps | u | drho |", "|---|---|---|---|---|---|"]
+        lines += [f"| {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | {r['max_rel_diff_u']:.2e} | "
+                  f"{r['max_rel_diff_drho']:.2e} |" for r in results["compare"]]
+    if results.get("gpu_rows"):
+        lines += ["", "## linkedlist-gpu, paper domain, Verlet, cutoff 3h (stage clock: events around each "
+                  "operation)", "",
+                  "| dx | N | precision | model | status | steps | step (ms) | SNP % | PI % | SU % | ns/particle-step "
+                  "| ps/pair | neighbours | MSE | init (ms) | output (ms) |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in map(timing_row, results["gpu_rows"]):
+            lines.append(
+                f"| {r['dx']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['status']} | {r['steps']} | "
+                f"{r['step_ms']:.3f} | {r['snp_pct']:.1f} | {r['pi_pct']:.1f} | {r['su_pct']:.1f} | "
+                f"{r['ns_per_particle_step']:.3f} | {r['ps_per_pair']:.2f} | {r['neighbours']:.1f} | "
+                f"{r['mse']:.3g} | {r['init_ms']:.1f} | {r['output_ms']:.1f} |")
+        lines += ["", "ps/pair counts both sweeps of a Verlet step (2 x N x mean neighbours pairs)."]
+    if results.get("graph"):
+        lines += ["", "## The step as a CUDA graph against plain launches (same process, alternating, best round)",
+                  "", "| dx | N | precision | steps x rounds | plain (ms/step) | graph (ms/step) | plain / graph | "
+                  "u: graph vs plain |", "|---|---|---|---|---|---|---|---|"]
+        lines += [f"| {r['dx']} | {r['N']:,} | {r['precision']} | {r['steps']} x {r['rounds']} | {r['plain_ms']:.4f} "
+                  f"| {r['graph_ms']:.4f} | {r['speedup']:.2f} | {r['max_rel_diff_u']:.1e} |"
+                  for r in results["graph"] if "plain_ms" in r]
+        lines += [f"- dx {r['dx']} {r['precision']}: {r['error']}" for r in results["graph"] if "error" in r]
+    if results.get("cpu_rows"):
         lines += ["", "## linkedlist-cpu on this host (lagrangian, float64)", "",
-                  "| dx | N | threads | status | step (ms) |", "|---|---|---|---|---|"]
-        lines += [f"| {r['dx']} | {r['n_particles']:,} | {r['threads']} | {r['status']} | "
-                  f"{1e3 * step_seconds(r['stages'], r['steps']):.1f} |" for r in cpu_rows]
+                  "| dx | N | threads | status | steps | step (ms) |", "|---|---|---|---|---|---|"]
+        lines += [f"| {r['dx']} | {r['n_particles']:,} | {r['threads']} | {r['status']} | {r['steps']} | "
+                  f"{1e3 * step_seconds(r['stages'], r['steps']):.1f} |" for r in results["cpu_rows"]]
+    for key in ("pytest_gpu", "bench", "asv", "ncu"):
+        if results.get(key):
+            lines += ["", f"## {key}", "", "```", json.dumps(results[key], indent=1, default=str), "```"]
     return "\n".join(lines) + "\n"
 
 
-def gpu_check(out: Path, results: Path, reports: Path, sizes=GPU_DX, steps: int = 100, models=MODELS,
-              run_tests: bool = True, compare: bool = True, cpu_peer: bool = True, only_ceilings: bool = False,
-              run_budget: float = 900.0) -> int:
-    """Profile and ceilings, GPU tests, GPU-vs-CPU comparison, then the GPU (and CPU-peer) sweep and reports.
+# ---------------------------------------------------------------- the check
+def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, rehearse: bool = False,
+              plan: Plan | None = None) -> int:
+    """Every stage within ``budget_s`` seconds; 0 when every stage that ran passed, else 1.
 
-    The sweep is an ordinary sweep (one child process per run, the same store,
-    resume and report code as ``pcabench study``); its runs carry preset ``gpu``.
+    With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
+    if rehearse:
+        os.environ["NUMBA_ENABLE_CUDASIM"] = "1"
+    plan = plan or (REHEARSAL if rehearse else FULL)
     from . import profiles
+    from .provenance import git_commit
     from .reports import write_reports
     from .sweep import sweep
 
+    out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    _cuda, cupy = device_backend()  # raises SolverUnavailable with a clear message
+    budget = Budget(budget_s)
+    _cuda, cupy = device_backend()  # raises SolverUnavailable with a clear message (no GPU, no simulator)
+    state = {"budget_s": budget_s, "commit": git_commit(), "rehearsal": rehearse or simulated(), "stages": []}
     profile = profiles.capture()
-    if cupy is not None:
-        profile["measured"] = measure_ceilings(cupy)
-    profiles.save(profile)
-    (out / "profile.json").write_text(json.dumps(profile, indent=2) + "\n")
-    print(json.dumps(profile, indent=1), flush=True)
-    if only_ceilings:
-        return 0
-    rc = 0
-    if run_tests:
-        with open(out / "pytest_gpu.log", "w") as log:
-            rc = subprocess.run([sys.executable, "-m", "pytest", "-m", "gpu", "-q", "tests"],
-                                stdout=log, stderr=subprocess.STDOUT).returncode
-        print(f"pytest -m gpu: exit {rc} (log in {out / 'pytest_gpu.log'})", flush=True)
-    compare_rows = compare_with_cpu() if compare else []
-    store_path = results / store_name(profile["id"])
-    gpu_rows = sweep(gpu_specs(sizes, steps, models), store_path, run_budget, sweep_budget=24 * 3600.0)
-    cpu_rows = sweep(cpu_peer_specs(), store_path, run_budget, sweep_budget=24 * 3600.0) if cpu_peer else []
-    text = markdown(profile, compare_rows, gpu_rows, steps, cpu_rows)
+    store_path = Path(results) / store_name(profile["id"])
+
+    def stage(name: str, need_s: float, work):
+        """Run one stage if ``need_s`` seconds are left; record its status and keep going on failure."""
+        t0 = time.perf_counter()
+        if budget.left() < need_s:
+            status = f"not run: {budget.left():.0f} s left, needs about {need_s:.0f}"
+        else:
+            budget.say(f"{name} ...")
+            try:
+                value = work()
+                status = "ok" if value is not False else "failed"
+            except Exception as exc:  # noqa: BLE001 - one stage's failure must not lose the others' results
+                status = f"failed: {type(exc).__name__}: {str(exc)[:300]}"
+        state["stages"].append({"stage": name, "status": status, "seconds": time.perf_counter() - t0})
+        budget.say(f"{name}: {status}")
+
+    def ceilings():
+        if cupy is None:
+            profile["measured"] = {"note": "rehearsal: no GPU, no ceilings"}
+        else:
+            profile["measured"] = measure_ceilings(cupy)
+        profiles.save(profile)
+        (out / "profile.json").write_text(json.dumps(profile, indent=2) + "\n")
+
+    def compare():
+        state["compare"] = compare_with_cpu(plan, out)
+        tol = {"float64": 1e-12, "float32": 1e-4}
+        return all(r["max_rel_diff_u"] < tol[r["precision"]] for r in state["compare"])
+
+    def gpu_sweep():
+        state["gpu_rows"] = sweep(gpu_specs(plan), store_path, run_budget=budget.left(),
+                                  sweep_budget=budget.left() - 60, runner=run_and_release)
+        return all(r["status"] == "ok" for r in state["gpu_rows"])
+
+    def graph():
+        if cupy is None:
+            state["graph"] = [{"dx": dx, "precision": p, "error": "needs a real GPU (no streams in the simulator)"}
+                              for dx in plan.graph_dx for p in PRECISIONS]
+            return True
+        state["graph"] = []
+        for dx in plan.graph_dx:
+            for precision in PRECISIONS:
+                if budget.left() < 30:
+                    break
+                try:
+                    row = graph_vs_plain(dx, precision, plan.graph_steps, plan.graph_rounds, plan.scene)
+                except Exception as exc:  # noqa: BLE001
+                    row = {"dx": dx, "precision": precision, "error": f"{type(exc).__name__}: {str(exc)[:300]}"}
+                state["graph"].append(row)
+                budget.say(f"graph dx {dx} {precision}: {row}")
+                cupy.get_default_memory_pool().free_all_blocks()
+        return all("error" not in r for r in state["graph"])
+
+    def cpu_peers():
+        state["cpu_rows"] = sweep(cpu_peer_specs(plan), store_path, run_budget=budget.left(),
+                                  sweep_budget=budget.left() - 30, runner=run_and_release)
+        return all(r["status"] == "ok" for r in state["cpu_rows"])
+
+    env = dict(os.environ, PCABENCH_COMMIT=state["commit"])
+
+    def pytest_gpu():
+        state["pytest_gpu"] = run_logged([sys.executable, "-m", "pytest", "-m", "gpu", "-q", "-p", "no:cacheprovider",
+                                          "tests"], out / "pytest_gpu.log", min(240, budget.left()), env)
+        return state["pytest_gpu"]["exit"] in (0, 5)  # 5: every GPU test deselected or skipped (rehearsal)
+
+    def bench():
+        json_path = out / f"pytest-benchmark_{profile['id']}.json"
+        cmd = [sys.executable, "-m", "pytest", "-o", "addopts=", "-p", "no:cacheprovider", "tests/benchmarks",
+               "--benchmark-only", f"--benchmark-json={json_path}", "-q"]
+        if rehearse:
+            cmd += ["-k", "linkedlist and 1.0"]
+        state["bench"] = run_logged(cmd, out / "pytest_benchmark.log", min(180, budget.left()), env)
+        return state["bench"]["exit"] == 0
+
+    def asv():
+        from .device_payload import run_asv_gpu
+
+        state["asv"] = run_asv_gpu(out, commits=("HEAD", H100_COMMIT), budget_s=min(150, budget.left()),
+                                   bench=plan.asv_bench)
+        return all(r.get("returncode") == 0 for r in state["asv"])
+
+    def ncu():
+        if shutil.which("ncu") is None or cupy is None:
+            state["ncu"] = {"status": "no ncu or no GPU here"}
+            return True
+        state["ncu"] = run_logged(ncu_command(plan, out), out / "ncu.log", min(90, budget.left()), env)
+        return state["ncu"]["exit"] == 0
+
+    stage("profile", 0, ceilings)
+    stage("compare", 40, compare)
+    stage("sweep", 60, gpu_sweep)
+    stage("graph", 40, graph)
+    stage("cpu", 40, cpu_peers)
+    stage("pytest-gpu", 40, pytest_gpu)
+    stage("bench", 60, bench)
+    stage("asv", 60, asv)
+    stage("ncu", 45, ncu)
+
+    state["elapsed_s"] = budget.elapsed()
+    text = markdown(profile, state)
     (out / "gpu_check.md").write_text(text)
+    (out / "gpu_check.json").write_text(json.dumps(state, indent=1, default=str) + "\n")
     print(text, flush=True)
-    for p in write_reports(results, reports):
-        print(f"wrote {p}", file=sys.stderr)
-    return rc
+    try:
+        for p in write_reports(Path(results), Path(reports)):
+            print(f"wrote {p}", file=sys.stderr)
+    except (Exception, SystemExit) as exc:  # noqa: BLE001 - the tarball must still be written
+        state["stages"].append({"stage": "reports", "status": f"failed: {exc}", "seconds": 0.0})
+    bundle(out, Path(results), Path(reports), profile["id"])
+    budget.say(f"done; bring back {out / 'gpu_check.tar.gz'}")
+    return 0 if all(s["status"] == "ok" or s["status"].startswith("not run") for s in state["stages"]) else 1
+
+
+def bundle(out: Path, results: Path, reports: Path, machine: str) -> Path:
+    """One tarball of what to bring back: the check's files, this machine's store and profile, the reports."""
+    from . import paths
+
+    path = out / "gpu_check.tar.gz"
+    with tarfile.open(path, "w:gz") as tar:
+        for f in sorted(out.iterdir()):
+            if f.name != path.name and (f.is_file() or f.is_dir()):
+                tar.add(f, arcname=f"check/{f.name}")
+        for f in sorted(results.glob(f"{machine}--*.jsonl")):
+            tar.add(f, arcname=f"store/{f.name}")
+        profile = paths.user_profiles() / f"{machine}.json"
+        if profile.exists():
+            tar.add(profile, arcname=f"profiles/{profile.name}")
+        if reports.is_dir():
+            tar.add(reports, arcname="reports")
+    return path

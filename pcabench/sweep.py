@@ -117,6 +117,14 @@ def run_child(spec: RunSpec, timeout: float, commit: str, stream=sys.stderr) -> 
     return store.to_row(failed_record(spec, status, what + (f": {stderr}" if stderr else ""), this_profile_id()))
 
 
+def run_here(spec: RunSpec, timeout: float, commit: str, stream=sys.stderr) -> dict:
+    """Run ``spec`` in this process: no crash isolation and no per-run time limit (``timeout`` is not
+    enforced), but compiled kernels are kept from run to run. For the GPU check, whose budget is minutes."""
+    from .child import run_spec
+
+    return run_spec(spec)
+
+
 def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None,
              whose: str = "this host's") -> str:
     """The sweep's ETA and how sure it is: runs predicted from ``whose`` timings, the rest at the mean so far."""
@@ -134,8 +142,8 @@ def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float 
 
 
 def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budget: float,
-          stream=sys.stderr, retry_failed: bool = False) -> list[dict]:
-    """Run ``specs`` (skipping those already stored), one child process each; the rows stored.
+          stream=sys.stderr, retry_failed: bool = False, runner=run_child) -> list[dict]:
+    """Run ``specs`` (skipping those already stored), one child process each (``runner``); the rows stored.
 
     Before each run its time is predicted from this host's finished runs
     (``predict.py``); a run predicted past ``run_budget`` is stored as
@@ -143,10 +151,10 @@ def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budge
     """
     store.check_writable(store_path)
     with store.SweepLock(store_path):
-        return _sweep(specs, Path(store_path), run_budget, sweep_budget, stream, retry_failed)
+        return _sweep(specs, Path(store_path), run_budget, sweep_budget, stream, retry_failed, runner)
 
 
-def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed) -> list[dict]:
+def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed, runner) -> list[dict]:
     profile, commit, host = this_profile_id(), git_commit(), host_id()
     rows = store.read_rows(store_path) if store_path.exists() else []
     done = {row_identity(r) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
@@ -173,7 +181,7 @@ def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed) ->
               file=stream, flush=True)
         t0 = time.perf_counter()
         try:
-            row = run_child(spec, min(run_budget, left), commit, stream)
+            row = runner(spec, min(run_budget, left), commit, stream)
         except subprocess.TimeoutExpired:
             if left < run_budget:  # the sweep's budget ran out, not the run's: nothing to record
                 print(f"{label}: sweep budget spent during the run, not stored (rerun to resume)",

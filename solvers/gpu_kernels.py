@@ -10,11 +10,13 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from numba import cuda
+from numba import cuda, int32
 
 from .kernel import exp_neg_math
-from .gpu_device import device_backend
+from .gpu_device import device_backend, simulated
 from .pairs import make_pairs
+
+SCAN_ITEMS = 4  # cells per thread in one pass of the cellBegin scan
 
 
 @lru_cache(maxsize=None)
@@ -28,12 +30,69 @@ def kernels(precision: str):
     fast = precision == "float32"
     P = make_pairs(cuda.jit(device=True, fastmath=fast), exp_neg_math)
     jit = cuda.jit(fastmath=fast)
+    scan_threads = scan_block()  # a compile-time constant of cell_begin (its shared-memory tile)
 
+    # ---- SNP as three launches and no host round trip: a counting sort by cell (DualSPHysics' cell list
+    # without the radix sort). cell_count: particleIndex and each particle's rank in its cell (atomics);
+    # cell_begin: cellBegin by an exclusive scan of the counts (one block), which also zeroes the counts for
+    # the next search; scatter: every per-particle array into cell order in one pass.
     @jit
-    def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, height, cw, ch, ncx, ncy):
+    def cell_count(lx, ly, sx, sy, cell, rank, counts, dx, x_grid, height, cw, ch, ncx, ncy):
         i = cuda.grid(1)
         if i < lx.shape[0]:
-            cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, height, cw, ch, ncx, ncy)
+            c = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, height, cw, ch, ncx, ncy)
+            cell[i] = c
+            rank[i] = cuda.atomic.add(counts, c, 1)
+
+    @jit
+    def cell_begin(counts, begin):
+        """begin[c] = counts[0] + ... + counts[c-1], begin[ncells] = N; counts set back to 0. One block."""
+        tid = cuda.threadIdx.x
+        tile = cuda.shared.array(scan_threads, int32)
+        carry = cuda.shared.array(1, int32)
+        ncells = counts.shape[0]
+        if tid == 0:
+            carry[0] = 0
+        cuda.syncthreads()
+        for base in range(0, ncells, scan_threads * SCAN_ITEMS):
+            first = base + tid * SCAN_ITEMS
+            own = 0
+            for q in range(SCAN_ITEMS):
+                if first + q < ncells:
+                    own += counts[first + q]
+            tile[tid] = own
+            cuda.syncthreads()
+            offset = 1
+            while offset < scan_threads:  # Hillis-Steele inclusive scan of the threads' sums
+                before = tile[tid - offset] if tid >= offset else 0
+                cuda.syncthreads()
+                tile[tid] += before
+                cuda.syncthreads()
+                offset *= 2
+            start = carry[0] + tile[tid] - own
+            for q in range(SCAN_ITEMS):
+                if first + q < ncells:
+                    begin[first + q] = start
+                    start += counts[first + q]
+                    counts[first + q] = 0
+            cuda.syncthreads()
+            if tid == scan_threads - 1:
+                carry[0] += tile[tid]
+            cuda.syncthreads()
+        if tid == 0:
+            begin[ncells] = carry[0]
+
+    @jit
+    def scatter(cell, rank, begin, src, dst, cell_out, order):
+        """Row r of ``src`` (one per-particle array per row) into cell order in ``dst``; order[d] = i."""
+        i = cuda.grid(1)
+        if i < cell.shape[0]:
+            c = cell[i]
+            d = begin[c] + rank[i]
+            cell_out[d] = c
+            order[d] = i
+            for r in range(src.shape[0]):
+                dst[r, d] = src[r, i]
 
     @jit
     def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
@@ -69,10 +128,18 @@ def kernels(precision: str):
             P.kick_at(i, u, v, ax, ay, c)
 
     @jit
-    def advance(drho, dd, sx, sy, u, v, c, moving):
+    def advance(drho, dd, sx, sy, u, v, c, moving, mass, vol, pr, k):
+        """The update, then both coefficients from the new drho: no coefficients launch before a sweep."""
         i = cuda.grid(1)
         if i < drho.shape[0]:
             P.advance_at(i, drho, dd, sx, sy, u, v, c, moving)
+            P.coefficients_at(i, drho, mass, vol, pr, True, True, k)
 
-    return {"cell_ids": cell_ids, "continuity": continuity, "momentum": momentum,
-            "neighbours": neighbours, "coefficients": coefficients, "kick": kick, "advance": advance}
+    return {"cell_count": cell_count, "cell_begin": cell_begin, "scatter": scatter, "continuity": continuity,
+            "momentum": momentum, "neighbours": neighbours, "coefficients": coefficients, "kick": kick,
+            "advance": advance}
+
+
+def scan_block() -> int:
+    """Threads of the one cell_begin block: 1024 on a GPU, 32 in the simulator (a Python thread each)."""
+    return 32 if simulated() else 1024

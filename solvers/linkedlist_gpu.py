@@ -1,17 +1,21 @@
 """Linked-list GPU solver: every stage on the device, float32 or float64 from one source.
 
 Device arrays are CuPy's; the kernels are numba-cuda, built from the same
-pair physics as the CPU solvers (solvers/pairs.py). One thread per particle.
+pair physics as the CPU solvers (solvers/pairs.py). One thread per particle,
+every launch on the solver's own stream.
 
-SNP on the device, every step for moving particles and once otherwise:
-a kernel computes each particle's cell (particleIndex); CuPy's radix argsort
-orders particles by cell (cellParticleOrder); a binary search of the sorted
-cells gives cellBegin (cellBegin[c+1] is cell c's end); every per-particle
-array is gathered into cell order, so the three cells of a stencil row are
-one contiguous, coalesced range of memory.
-
-The system update (kick, advance) and the sweeps' coefficients are one
-fused kernel each, so a Verlet step is a handful of launches besides SNP.
+The per-particle arrays are the rows of one 2D block (and a spare block of
+the same shape), so that SNP moves all of them in one launch. SNP, every step
+for moving particles and once otherwise, is three launches with no host round
+trip, a counting sort by cell: ``cell_count`` (particleIndex and each
+particle's rank within its cell, by atomics), ``cell_begin`` (cellBegin by a
+one-block scan of the counts), ``scatter`` (the whole block into cell order
+in the spare block, which then becomes the current one). Within a cell the
+order is that of the atomics, so sums may differ from run to run in the last
+bits. The system update writes the sweeps' coefficients as it updates drho,
+so a lagrangian Verlet step is 8 launches: kick, continuity, advance, the
+three of SNP, momentum, kick. Nothing is allocated inside a step, so a step
+can be captured once as a CUDA graph and replayed (solvers/gpu_graph.py).
 
 Without a GPU, ``NUMBA_ENABLE_CUDASIM=1`` runs the same kernels in numba's
 CUDA simulator with NumPy in place of CuPy (small scenes only): that is how
@@ -42,6 +46,7 @@ class LinkedListGPU(CellListSolver):
         super().__init__(threads=1)
         self.cuda, self.cupy = device_backend()
         self.xp = self.cupy if self.cupy is not None else np
+        self.stream = None
 
     def check_scene(self, scene) -> None:
         if self.cupy is None:
@@ -54,29 +59,85 @@ class LinkedListGPU(CellListSolver):
                 f"on the GPU, more than its {free / 2**30:.3g} GiB free; the smallest dx that fits is "
                 f"about {scene.smallest_dx_fitting(free):.3g} m")
 
+    def input(self, scene) -> None:
+        super().input(scene)
+        if self.cupy is not None:
+            self.stream = self.cupy.cuda.Stream()  # blocking: ordered with CuPy's work on the legacy stream
+            self.stream.use()  # CuPy's operations (init, output, checks) go to the same stream
+            self.launch_stream = self.cuda.external_stream(self.stream.ptr)
+        else:
+            self.stream = None
+            self.launch_stream = self.cuda.default_stream()
+
     def allocate_cells(self) -> None:
-        xp, n = self.xp, self.scene.n_particles
-        self.cell = xp.empty(n, xp.int32)
-        self.cell_range = xp.arange(self.ncells + 1, dtype=xp.int32)
-        self.begin = None
+        """Both particle blocks, the cell arrays and the launch shapes: everything a step needs."""
+        xp, n, a = self.xp, self.scene.n_particles, self.arrays
+        self.names = tuple(a)
+        block = xp.empty((len(self.names), n), self.dtype)
+        for row, name in enumerate(self.names):
+            block[row] = a[name]
+        self.blocks_of = [(block, xp.empty(n, xp.int32)), (xp.empty_like(block), xp.empty(n, xp.int32))]
+        self.views = [{name: blk[row] for row, name in enumerate(self.names)} for blk, _cell in self.blocks_of]
+        self.current = 0
+        self.arrays = self.views[0]
+        self.cell = self.blocks_of[0][1]
+        self.rank = xp.empty(n, xp.int32)
+        self.order = xp.empty(n, xp.int32)
+        self.counts = xp.zeros(self.ncells, xp.int32)  # cell_begin leaves them at zero again
+        self.begin = xp.empty(self.ncells + 1, xp.uint32)  # unsigned: no negative-index wraparound per load
+        self.coefficients_fresh = False
         # the simulator runs every thread of a block as a Python thread: keep blocks small there
         self.threads_per_block = 32 if self.cupy is None else THREADS_PER_BLOCK
         self.blocks = (n + self.threads_per_block - 1) // self.threads_per_block
 
-    def launch(self, name, *args):
+    def launch(self, name, *args, grid=None):
+        """Kernel ``name`` on the solver's stream: one thread per particle, or ``grid`` = (blocks, threads)."""
         from .gpu_kernels import kernels  # numba.cuda only once a device (or the simulator) is known
 
-        kernels(self.scene.precision)[name][self.blocks, self.threads_per_block](*args)
+        blocks, threads = grid or (self.blocks, self.threads_per_block)
+        kernels(self.scene.precision)[name][blocks, threads, self.launch_stream](*args)
 
     def sort_cells(self) -> None:
-        """Cell ids on the device, CuPy's radix argsort (stable), cellBegin by binary search, then the gather."""
-        xp = self.xp
-        self.cell_ids()
-        order = xp.argsort(self.cell) if self.cupy is not None else np.argsort(self.cell, kind="stable")
-        self.cell = xp.take(self.cell, order)
-        # unsigned cell bounds: no negative-index wraparound on each neighbour load
-        self.begin = xp.searchsorted(self.cell, self.cell_range).astype(xp.uint32)
-        self.permute(order)
+        """Counting sort by cell in three launches; the spare block becomes the current one."""
+        from .gpu_kernels import scan_block
+
+        s, a = self.scene, self.arrays
+        self.launch("cell_count", a["lx"], a["ly"], a["sx"], a["sy"], self.cell, self.rank, self.counts, s.dx,
+                    -self.cw, s.height, self.cw, self.ch, self.ncx, self.ncy)
+        self.launch("cell_begin", self.counts, self.begin, grid=(1, scan_block()))
+        (src, cell), (dst, cell_out) = self.blocks_of[self.current], self.blocks_of[1 - self.current]
+        self.launch("scatter", self.cell, self.rank, self.begin, src, dst, cell_out, self.order)
+        self.set_state(1 - self.current)
+        for name, arr in self.saved.items():  # two-stage integrators' copies (not in a Verlet step)
+            self.saved[name] = self.gathered(arr, self.order)
+
+    def state(self) -> int:
+        """Which particle block is current (a step that searches flips it)."""
+        return self.current
+
+    def set_state(self, current: int) -> None:
+        self.current = current
+        self.arrays = self.views[current]
+        self.cell = self.blocks_of[current][1]
+
+    def rates(self, continuity: bool, momentum: bool) -> None:
+        """PI; the coefficients only when drho changed since the system update last wrote them."""
+        if not self.coefficients_fresh:
+            self.coefficients(True, True)
+            self.coefficients_fresh = True
+        self._sweep(continuity, momentum)
+
+    def advance(self, f: float) -> None:
+        """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""
+        a = self.arrays
+        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"],
+                    self.dtype.type(f * self.scene.dt), self.moving, a["mass"], a["vol"], a["pr"], self.k)
+        self.t += f * self.scene.dt
+        self.coefficients_fresh = True
+
+    def restore(self, names) -> None:
+        super().restore(names)
+        self.coefficients_fresh = self.coefficients_fresh and "drho" not in names
 
     def count_neighbours(self) -> int:
         counts = self.xp.zeros(self.scene.n_particles, self.xp.int32)
@@ -87,5 +148,5 @@ class LinkedListGPU(CellListSolver):
         return self.cupy.asnumpy(arr) if self.cupy is not None else np.asarray(arr)
 
     def synchronize(self) -> None:
-        if self.cupy is not None:
-            self.cupy.cuda.runtime.deviceSynchronize()
+        if self.stream is not None:
+            self.stream.synchronize()

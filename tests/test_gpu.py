@@ -24,8 +24,8 @@ import json, sys, tempfile, numpy as np
 from pathlib import Path
 from pcabench.run import run
 from solvers import Scene
-precision, model, steps = sys.argv[1], sys.argv[2], int(sys.argv[3])
-scene = Scene(dx=1.0, x_min=-8.0, x_max=8.0, steps=steps, model=model, precision=precision)
+precision, model, steps, integrator = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
+scene = Scene(dx=1.0, x_min=-8.0, x_max=8.0, steps=steps, model=model, precision=precision, integrator=integrator)
 out = {}
 with tempfile.TemporaryDirectory() as d:
     for solver in ("linkedlist-cpu", "linkedlist-gpu"):
@@ -38,9 +38,9 @@ print(json.dumps(out))
 """
 
 
-def _simulate(precision, model, steps):
+def _simulate(precision, model, steps, integrator="verlet"):
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps)],
+    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps), integrator],
                           capture_output=True, text=True, env=env, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
@@ -116,3 +116,79 @@ def test_gpu_refuses_scene_larger_than_card(requires_gpu):
     scene = Scene(dx=0.001, memory_limit_bytes=2**50)  # 1e9 particles, ~240 GB
     with pytest.raises(SceneError, match="smallest dx that fits"):
         solver.input(scene)
+
+
+# ------------------------------------------------------------ launches per step (simulator)
+LAUNCH_SCRIPT = r"""
+import json, numpy as np
+from numba.cuda.simulator.kernel import FakeCUDAKernel
+from solvers import Scene, make_solver
+from solvers.integrators import step_program
+from solvers.gpu_kernels import kernels, scan_block
+
+launches = []
+plain_call = FakeCUDAKernel.__call__
+def counted(self, *args):
+    if not self._device:
+        launches.append(self.fn.__name__)
+    return plain_call(self, *args)
+FakeCUDAKernel.__call__ = counted
+
+class Untouchable:
+    "Stands for the array module during a step: any use would be a launch or a host round trip."
+    def __init__(self, used): self.used = used
+    def __getattr__(self, name):
+        self.used.append(name)
+        raise AssertionError(f"xp.{name} inside a step")
+
+out = {}
+for integrator in ("verlet", "kdk1", "euler"):
+    solver = make_solver("linkedlist-gpu")
+    solver.input(Scene(dx=1.0, x_min=-8.0, x_max=8.0, model="lagrangian", integrator=integrator))
+    solver.init()
+    for _stage, op in step_program(integrator, solver, first=True):
+        op()
+    used, syncs = [], []
+    xp, solver.xp = solver.xp, Untouchable(used)
+    solver.synchronize = lambda: syncs.append(1)
+    launches.clear()
+    for _stage, op in step_program(integrator, solver, first=False):
+        op()
+    solver.xp = xp
+    out[integrator] = {"launches": list(launches), "xp": used, "syncs": len(syncs)}
+
+# cellBegin over many tiles of the one-block scan, against NumPy
+rng = np.random.default_rng(1)
+counts = rng.integers(0, 9, size=7 * scan_block() * 4 + 5).astype(np.int32)
+begin = np.zeros(counts.size + 1, np.uint32)
+expected = np.concatenate([[0], np.cumsum(counts)])
+kernels("float64")["cell_begin"][1, scan_block()](counts, begin)
+out["scan"] = {"ok": bool(np.array_equal(begin, expected)), "zeroed": bool(not counts.any())}
+print(json.dumps(out))
+"""
+
+
+def test_simulated_step_launches_and_host_round_trips():
+    """A lagrangian Verlet step is at most 8 kernel launches, touches no array-module operation (each would be
+    a CuPy launch or a host round trip on a GPU) and never synchronises; the one-block cellBegin scan is exact."""
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    proc = subprocess.run([sys.executable, "-c", LAUNCH_SCRIPT], capture_output=True, text=True, env=env,
+                          timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    verlet = out["verlet"]
+    assert len(verlet["launches"]) <= 8, verlet["launches"]
+    assert {"cell_count", "cell_begin", "scatter", "continuity", "momentum"} <= set(verlet["launches"])
+    for integrator in ("verlet", "kdk1", "euler"):
+        assert out[integrator]["xp"] == [] and out[integrator]["syncs"] == 0, out[integrator]
+    assert out["scan"] == {"ok": True, "zeroed": True}
+
+
+@pytest.mark.parametrize("integrator", ["rk2", "kdk1"])
+def test_simulated_gpu_integrators_match_cpu(integrator):
+    """The counting sort carries the two-stage integrator's saved copies along (rk2) and the one-sweep step."""
+    out = _simulate("float64", "lagrangian", 6, integrator)
+    cpu, gpu = out["linkedlist-cpu"], out["linkedlist-gpu"]
+    assert cpu["status"] == "ok" and gpu["status"] == "ok", (cpu["message"], gpu["message"])
+    for name in ("u", "drho", "x"):
+        assert _max_rel(gpu["fields"][name], cpu["fields"][name]) < 1e-12, name
