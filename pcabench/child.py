@@ -3,14 +3,16 @@
     python -m pcabench.child '<RunSpec JSON>'
 
 The child never writes the store: the sweep (its parent) is the only writer,
-so a progress line always reports the record this child made.
+so a progress line always reports the record this child made. Its record
+carries the sweep's machine id and commit (``PCABENCH_MACHINE_ID``
+and ``PCABENCH_COMMIT``, set by the parent).
 """
 from __future__ import annotations
 
 import json
 import sys
 
-from .profiles import profile_id
+from .profiles import machine_id
 from .progress import Progress
 from .run import run
 from .spec import RunSpec
@@ -21,7 +23,7 @@ def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     spec = RunSpec.from_json(argv[0]).resolved()
     progress = Progress(f"    {spec.solver} N={spec.scene.n_particles:,}", every=5.0)
-    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id(), pair_loop=spec.pair_loop,
+    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=machine_id(), pair_loop=spec.pair_loop,
                  progress=progress)
     record.preset = spec.preset
     print(json.dumps(to_row(record), sort_keys=True), flush=True)

@@ -127,7 +127,7 @@ def check_output_path(path, option: str) -> None:
 
 # ---------------------------------------------------------------- commands
 def cmd_run(args) -> int:
-    from .profiles import profile_id
+    from .profiles import machine_id
     from .run import run
     from .store import to_row
 
@@ -140,7 +140,7 @@ def cmd_run(args) -> int:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
     record = run(scene, spec.solver, threads=spec.threads, fields_path=args.fields, progress=progress,
-                 profile_id=profile_id(), pair_loop=spec.pair_loop)
+                 profile_id=machine_id(), pair_loop=spec.pair_loop)
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
