@@ -3,14 +3,16 @@
     python -m pcabench.child '<RunSpec JSON>'
 
 The child never writes the store: the sweep (its parent) is the only writer,
-so a progress line always reports the record this child made.
+so a progress line always reports the record this child made. Its record
+carries the sweep's machine id and commit (``PCABENCH_MACHINE_ID``
+and ``PCABENCH_COMMIT``, set by the parent).
 """
 from __future__ import annotations
 
 import json
 import sys
 
-from .profiles import profile_id
+from .profiles import machine_id
 from .progress import Progress
 from .run import run
 from .spec import RunSpec
@@ -20,7 +22,7 @@ from .store import to_row
 def run_spec(spec: RunSpec) -> dict:
     """Run one resolved spec with step progress on stderr; its record as a store row."""
     progress = Progress(f"    {spec.solver} N={spec.scene.n_particles:,}", every=5.0)
-    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=profile_id(), pair_loop=spec.pair_loop,
+    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=machine_id(), pair_loop=spec.pair_loop,
                  progress=progress)
     record.preset = spec.preset
     return to_row(record)

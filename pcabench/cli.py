@@ -62,7 +62,7 @@ def positive_int(name):
     return parse
 
 
-def number(name):
+def number(name, low: float | None = None):
     def parse(text):
         try:
             value = float(text)
@@ -70,6 +70,8 @@ def number(name):
             raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
         if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
+        if low is not None and value < low:
+            raise argparse.ArgumentTypeError(f"{name} must be at least {low:g} (got {text!r})")
         return value
     return parse
 
@@ -127,7 +129,7 @@ def check_output_path(path, option: str) -> None:
 
 # ---------------------------------------------------------------- commands
 def cmd_run(args) -> int:
-    from .profiles import profile_id
+    from .profiles import machine_id
     from .run import run
     from .store import to_row
 
@@ -140,7 +142,7 @@ def cmd_run(args) -> int:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
     record = run(scene, spec.solver, threads=spec.threads, fields_path=args.fields, progress=progress,
-                 profile_id=profile_id(), pair_loop=spec.pair_loop)
+                 profile_id=machine_id(), pair_loop=spec.pair_loop)
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
@@ -297,9 +299,8 @@ def cmd_profile(args) -> int:
 def cmd_gpu_check(args) -> int:
     from .gpu_check import gpu_check
 
-    return gpu_check(Path(args.out), Path(args.results), Path(args.reports), sizes=args.sizes, steps=args.steps,
-                     models=args.models, run_tests=not args.skip_tests, compare=not args.skip_compare,
-                     cpu_peer=not args.skip_cpu, only_ceilings=args.only_ceilings, run_budget=args.run_budget)
+    return gpu_check(Path(args.out), Path(args.results), Path(args.reports), budget_s=args.budget,
+                     rehearse=args.rehearse)
 
 
 # ---------------------------------------------------------------- the parser
@@ -375,21 +376,17 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write this machine's entry into ~/.asv-machine.json and print its name (for --machine)")
     p.set_defaults(func=cmd_profile)
 
-    from .gpu_check import CPU_DX, GPU_DX, MODELS
-
-    p = sub.add_parser("gpu-check", help="on a GPU machine: GPU tests, CPU comparison, timing sweep, profile")
-    p.add_argument("--out", default="gpu_check_out", help="folder for the check's own files (tables, logs)")
+    p = sub.add_parser("gpu-check", help="on a GPU machine: all of the GPU work in one call, within a budget",
+                       description="Profile and ceilings, GPU vs CPU, the GPU sweep, the graph path, the host's "
+                                   "CPU, GPU tests, pytest-benchmark, asv and Nsight Compute, in that order, "
+                                   "within --budget seconds; everything to bring back in OUT/gpu_check.tar.gz.")
+    p.add_argument("--out", default="gpu_check_out", help="folder for the check's own files (tables, logs, tarball)")
     p.add_argument("--results", default=str(paths.user_results()), help=results_help)
     p.add_argument("--reports", default=str(paths.user_reports()), help=reports_help)
-    p.add_argument("--sizes", type=number("--sizes"), nargs="+", default=list(GPU_DX), help="dx of the GPU sweep")
-    p.add_argument("--steps", type=positive_int("--steps"), default=100)
-    p.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
-    p.add_argument("--run-budget", type=number("--run-budget"), default=900.0, help="seconds per run")
-    p.add_argument("--skip-tests", action="store_true")
-    p.add_argument("--skip-compare", action="store_true")
-    p.add_argument("--skip-cpu", action="store_true",
-                   help=f"no linkedlist-cpu timings on this host (dx {', '.join(map(str, CPU_DX))})")
-    p.add_argument("--only-ceilings", action="store_true", help="profile and measured ceilings only")
+    p.add_argument("--budget", type=number("--budget", low=60.0), default=480.0,
+                   help="seconds for the whole check (default 480: the full plan takes about 6 min on an H200)")
+    p.add_argument("--rehearse", action="store_true",
+                   help="the same script in numba's CUDA simulator at a few hundred particles (no GPU needed)")
     p.set_defaults(func=cmd_gpu_check)
     return parser
 

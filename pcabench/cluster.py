@@ -25,7 +25,7 @@ from pathlib import Path
 
 from . import store
 from .predict import predicted_seconds
-from .profiles import profile_id as client_profile_id
+from .profiles import machine_id
 from .provenance import git_commit, host_id
 from .record import step_seconds
 from .spec import OptionError, RunSpec, identity
@@ -76,14 +76,12 @@ def task_resources(spec: RunSpec) -> dict:
 
 
 def run_on_worker(spec_json: str, timeout: float, commit: str) -> dict:
-    """On a worker: run the spec in a child process; its record (with the worker's profile and host)."""
-    from .profiles import profile_id
-
-    spec = RunSpec.from_json(spec_json)
+    """On a worker: run the spec in a child process; its record (with the worker's machine id and host)."""
+    spec, machine = RunSpec.from_json(spec_json), machine_id()
     try:
-        return run_child(spec, timeout, commit, stream=None)
+        return run_child(spec, timeout, commit, machine, stream=None)
     except subprocess.TimeoutExpired:
-        return store.to_row(failed_record(spec, "timeout", f"past the run budget of {timeout:.0f} s", profile_id(),
+        return store.to_row(failed_record(spec, "timeout", f"past the run budget of {timeout:.0f} s", machine,
                                           timeout))
 
 
@@ -119,7 +117,7 @@ def cluster_sweep(specs: list[RunSpec], results: Path, run_budget: float, addres
             seconds, why = predicted_seconds(spec, finished)
             if seconds is not None and seconds > run_budget:
                 row = store.to_row(failed_record(spec, "skipped", f"{why} > run budget {run_budget:.0f} s",
-                                                 client_profile_id()))
+                                                 machine_id()))
                 stored.append(stores.append(row))
                 print(f"{spec.label}: skipped, {why}", file=stream, flush=True)
                 continue
@@ -133,7 +131,7 @@ def cluster_sweep(specs: list[RunSpec], results: Path, run_budget: float, addres
                 row = future.result()
             except Exception as exc:  # noqa: BLE001 - the task never returned: its workers died (KilledWorker)
                 row = store.to_row(failed_record(spec, "error", f"lost: {type(exc).__name__}: {exc}",
-                                                 client_profile_id()))
+                                                 machine_id()))
             stored.append(stores.append(row))
             left.remove(spec)
             failed += row["status"] != "ok"

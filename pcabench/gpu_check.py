@@ -225,13 +225,13 @@ def cpu_peer_specs(plan: Plan) -> list[RunSpec]:
             for dx in plan.cpu_dx for threads in (SERIAL, ALL_CORES)]
 
 
-def run_and_release(spec, timeout, commit, stream=sys.stderr) -> dict:
+def run_and_release(spec, timeout, commit, machine, stream=sys.stderr) -> dict:
     """One run in this process, then CuPy's cached blocks back to the card (the next run's fit check reads
     the card's free memory)."""
     from .sweep import run_here
 
     try:
-        return run_here(spec, timeout, commit, stream)
+        return run_here(spec, timeout, commit, machine, stream)
     finally:
         _cuda, cupy = device_backend() if spec.solver == "linkedlist-gpu" else (None, None)
         if cupy is not None:

@@ -10,6 +10,15 @@ GPU details come from CuPy's runtime API when CuPy and a device are present
 (name, memory, compute capability, SM count, clocks, driver and runtime
 versions) and from the datasheet table below for peak rates, which are
 marked as datasheet values, not measurements.
+
+A machine has one id, :func:`machine_id` (GPU name and CPU model): the name
+of its store and profile and the ``profile_id`` of every record it makes,
+CPU runs included. Two environment variables bear on it:
+
+- ``PCABENCH_MACHINE_ID``: the id to use, set by a sweep for its children so
+  that no child computes another one;
+- ``PCABENCH_FAKE_GPU``: a test hook; a card name that :func:`gpu_info`
+  reports as this machine's GPU.
 """
 from __future__ import annotations
 
@@ -21,6 +30,9 @@ import re
 from pathlib import Path
 
 from . import paths
+
+MACHINE_ID_ENV = "PCABENCH_MACHINE_ID"  # the id a sweep gives its children
+FAKE_GPU_ENV = "PCABENCH_FAKE_GPU"  # test hook: a card name gpu_info() reports
 
 # Datasheet peaks for cards we know (FP32/FP64 TFLOP/s without tensor cores, TB/s).
 DATASHEET = {
@@ -54,9 +66,22 @@ def _slug(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")[:40] or "unknown"
 
 
-@functools.lru_cache(maxsize=None)
 def gpu_info() -> dict | None:
-    """The first CUDA device as seen by CuPy, or None without CuPy or a device."""
+    """The first CUDA device as seen by CuPy, or None without CuPy or a device.
+
+    Test hook: with ``PCABENCH_FAKE_GPU`` set to a card name, that card (its
+    name only) is the GPU here, in this process and its children. It changes
+    the machine's id and profile, never the solvers: linkedlist-gpu asks
+    ``solvers/gpu_device.py`` for a device, not this function.
+    """
+    fake = os.environ.get(FAKE_GPU_ENV)
+    if fake:
+        return {"name": fake, "note": f"faked by {FAKE_GPU_ENV} (a test hook), not a device"}
+    return _cuda_gpu_info()
+
+
+@functools.lru_cache(maxsize=None)
+def _cuda_gpu_info() -> dict | None:
     if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
         return None
     try:
@@ -99,22 +124,29 @@ def gpu_info() -> dict | None:
         return None
 
 
-def profile_id(cpu: str | None = None, gpu: dict | None = None) -> str:
-    """A short stable id: the GPU name (if any) and the CPU model."""
-    cpu = cpu or _cpu_model()
+def profile_id(cpu: str, gpu: dict | None = None) -> str:
+    """A short stable id from a CPU model and a GPU (``gpu_info()``'s dict, or None): ``gpu__cpu`` or ``cpu``."""
     parts = [_slug(gpu["name"])] if gpu else []
     parts.append(_slug(cpu))
     return "__".join(parts)
 
 
+@functools.lru_cache(maxsize=None)
+def machine_id() -> str:
+    """This machine's id, computed once per process: ``PCABENCH_MACHINE_ID`` if set (a sweep's child is
+    given its parent's), else the GPU (when one is visible) and the CPU model, as in :func:`capture`."""
+    return os.environ.get(MACHINE_ID_ENV) or profile_id(_cpu_model(), gpu_info())
+
+
 def capture(with_gpu: bool = True) -> dict:
-    """This machine's profile as a dict (source: measured)."""
+    """This machine's profile as a dict (source: measured); its id is :func:`machine_id` (the CPU's alone
+    without the GPU)."""
     import numba
 
     cpu = _cpu_model()
     gpu = gpu_info() if with_gpu else None
     profile = {
-        "id": profile_id(cpu, gpu),
+        "id": machine_id() if with_gpu else profile_id(cpu),
         "source": "measured",
         "cpu": {
             "model": cpu,

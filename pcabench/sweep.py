@@ -26,7 +26,7 @@ from pathlib import Path
 
 from . import store
 from .predict import predicted_seconds
-from .profiles import profile_id as this_profile_id
+from .profiles import MACHINE_ID_ENV, machine_id
 from .provenance import git_commit, host_id
 from .record import RunRecord, step_seconds
 from .spec import RunSpec, identity, row_identity
@@ -76,13 +76,15 @@ def exit_status(returncode: int, oom_before: int | None, oom_after: int | None) 
     return "error", f"exit code {returncode}"
 
 
-def run_child(spec: RunSpec, timeout: float, commit: str, stream=sys.stderr) -> dict:
+def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:
     """Run ``spec`` in a child process, relaying its progress to ``stream``; its record as a row.
+
+    The child's record carries ``commit`` and ``machine`` (the parent's :func:`~pcabench.profiles.machine_id`).
 
     Raises subprocess.TimeoutExpired (the child is killed first) past ``timeout`` seconds.
     """
     cmd = [sys.executable, "-m", "pcabench.child", spec.to_json()]
-    env = dict(os.environ, PCABENCH_COMMIT=commit)  # every run of a sweep carries the sweep's commit
+    env = {**os.environ, "PCABENCH_COMMIT": commit, MACHINE_ID_ENV: machine}  # every run carries the sweep's
     oom_before = oom_kills()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
                             preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
@@ -114,10 +116,10 @@ def run_child(spec: RunSpec, timeout: float, commit: str, stream=sys.stderr) -> 
         return json.loads(lines[-1])
     status, what = exit_status(proc.returncode, oom_before, oom_kills())
     stderr = "".join(tail).strip()[-400:]
-    return store.to_row(failed_record(spec, status, what + (f": {stderr}" if stderr else ""), this_profile_id()))
+    return store.to_row(failed_record(spec, status, what + (f": {stderr}" if stderr else ""), machine))
 
 
-def run_here(spec: RunSpec, timeout: float, commit: str, stream=sys.stderr) -> dict:
+def run_here(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:
     """Run ``spec`` in this process: no crash isolation and no per-run time limit (``timeout`` is not
     enforced), but compiled kernels are kept from run to run. For the GPU check, whose budget is minutes."""
     from .child import run_spec
@@ -155,7 +157,7 @@ def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budge
 
 
 def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed, runner) -> list[dict]:
-    profile, commit, host = this_profile_id(), git_commit(), host_id()
+    profile, commit, host = machine_id(), git_commit(), host_id()
     rows = store.read_rows(store_path) if store_path.exists() else []
     done = {row_identity(r) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
     mine = [r for r in rows if r.get("profile_id") == profile and r.get("host") == host]
@@ -181,7 +183,7 @@ def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed, ru
               file=stream, flush=True)
         t0 = time.perf_counter()
         try:
-            row = runner(spec, min(run_budget, left), commit, stream)
+            row = runner(spec, min(run_budget, left), commit, profile, stream)
         except subprocess.TimeoutExpired:
             if left < run_budget:  # the sweep's budget ran out, not the run's: nothing to record
                 print(f"{label}: sweep budget spent during the run, not stored (rerun to resume)",

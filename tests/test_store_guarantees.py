@@ -13,6 +13,7 @@ import warnings
 import pytest
 
 from pcabench import cli, store, sweep as sweep_module
+from pcabench.profiles import machine_id
 from pcabench.record import RunRecord
 from pcabench.spec import RunSpec
 from pcabench.sweep import exit_status, sweep
@@ -180,14 +181,14 @@ def test_retry_failed_runs_timeouts_skips_and_errors_again(tmp_path, monkeypatch
     spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2)).resolved()
     made = []
 
-    def fake_child(spec, timeout, commit, stream=None):
+    def fake_child(spec, timeout, commit, machine, stream=None):
         made.append(spec)
-        rec = sweep_module.failed_record(spec, "ok", "", sweep_module.this_profile_id())
+        rec = sweep_module.failed_record(spec, "ok", "", machine)
         rec.steps = 2
         return store.to_row(rec)
 
     monkeypatch.setattr(sweep_module, "run_child", fake_child)
-    store.append(sweep_module.failed_record(spec, "timeout", "past the run budget", sweep_module.this_profile_id()),
+    store.append(sweep_module.failed_record(spec, "timeout", "past the run budget", machine_id()),
                  path)
     sweep([spec], path, run_budget=60, sweep_budget=60)
     assert made == []  # stored (as a timeout): a plain rerun skips it

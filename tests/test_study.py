@@ -183,14 +183,14 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
 
 
 def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):
-    from pcabench.profiles import profile_id
+    from pcabench.profiles import machine_id
     from pcabench.provenance import host_id
     from pcabench.spec import RunSpec
     from pcabench.sweep import sweep
 
     path = tmp_path / "s.jsonl"
     for dx, ms in ((1.0, 10.0), (0.5, 160.0)):  # all-pair: 16x per 4x particles, on this host
-        rec = row(profile=profile_id(), solver="allpair-cpu", step_ms=(ms, 0, 0), dx=dx, steps=10)
+        rec = row(profile=machine_id(), solver="allpair-cpu", step_ms=(ms, 0, 0), dx=dx, steps=10)
         rec.host = host_id()
         store.append(rec, path)
     spec = RunSpec("allpair-cpu", Scene(dx=0.125, steps=10))

@@ -14,7 +14,7 @@ from __future__ import annotations
 import pytest
 
 from benchmarks.common import Prepared, Unsupported
-from pcabench.profiles import profile_id
+from pcabench.profiles import machine_id
 
 SOLVERS = ("allpair-cpu", "linkedlist-cpu", "linkedlist-gpu")
 SIZES = (1.0, 0.5)  # 1,000 and 4,000 particles
@@ -44,5 +44,5 @@ def test_stage(benchmark, solver, precision, dx, stage):
         benchmark.pedantic(lambda: p.stage(stage), rounds=ROUNDS, iterations=1, warmup_rounds=1)
     benchmark.extra_info.update({"solver": solver, "precision": precision, "n_particles": p.n_particles,
                                  "stage": stage, "mse": err.mse, "me": err.me, "jit_seconds": p.jit_seconds,
-                                 "profile_id": profile_id()})
+                                 "profile_id": machine_id()})
     assert err.mse < 0.3  # the timed state is still the pulse (0.18 after 10 steps at N = 1,000)
