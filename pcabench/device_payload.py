@@ -244,3 +244,36 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
                 shutil.rmtree(tmp, ignore_errors=True)
     return rows
 
+
+
+# -- the one command --------------------------------------------------------------------------------------
+
+
+def device_command(commit: str, budget_s: float = 450.0) -> str:
+    """The whole device call: asv from the wheels, then ``pcabench gpu-check`` within ``budget_s`` seconds;
+    what to bring back (the check's tarball, its tables and the log) lands in ``$OUT``."""
+    install, path = DEVICE_PREFIX.split(" && ")
+    return (f"set -o pipefail; {install} || echo 'gpu-check: the wheels did not install: no asv'; {path}; "
+            f"export PCABENCH_HOME=/tmp/pcabench PCABENCH_COMMIT={commit} PYTHONUNBUFFERED=1; "
+            "nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,memory.total --format=csv; "
+            f"python3 -m pcabench.cli gpu-check --out /tmp/check --budget {budget_s:.0f} 2>&1 | tee $OUT/gpu_check.log; "
+            "rc=$?; cp /tmp/check/gpu_check.tar.gz /tmp/check/gpu_check.md $OUT/; exit $rc")
+
+
+def main(argv=None) -> int:
+    """``python -m pcabench.device_payload [BUDGET_S]``: prepare the payload here and print the device call."""
+    argv = sys.argv[1:] if argv is None else argv
+    root = Path(__file__).resolve().parent.parent
+    if _git(root, "status", "--porcelain", "--untracked-files=no", text=True).stdout.strip():
+        print("commit first: the bundle and the results carry HEAD's commit", file=sys.stderr)
+        return 2
+    sizes = prepare(root)
+    commit = _git(root, "rev-parse", "HEAD", text=True).stdout.strip()
+    print(f"payload {sizes['payload'] / 2**20:.1f} MiB of {LIMIT_BYTES / 2**20:.0f} (carry .whl and .gl)",
+          file=sys.stderr)
+    print(device_command(commit, float(argv[0]) if argv else 450.0))
+    return 0 if sizes["payload"] <= LIMIT_BYTES else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -19,9 +19,9 @@ when the budget is spent, keeping what it has:
    same process, alternating, best of several rounds, and their fields compared;
 5. ``cpu``: linkedlist-cpu on this host (one thread and every core): Table 6's
    same-machine CPU column;
-6. ``pytest-gpu``: the GPU tests; ``bench``: the pytest-benchmark suite's JSON;
-7. ``asv``: asv's GPU benchmarks at HEAD and at the H100's commit, when asv
+6. ``asv``: asv's GPU benchmarks at HEAD and at the H100's commit, when asv
    and the history were brought along (pcabench/device_payload.py);
+7. ``bench``: the pytest-benchmark suite's JSON; ``pytest-gpu``: the GPU tests;
 8. ``ncu``: Nsight Compute's speed-of-light section of one step's kernels;
 9. the reports, regenerated from the store.
 
@@ -72,7 +72,8 @@ class Plan:
 
     gpu_dx: tuple = GPU_DX
     models: tuple = ("lagrangian",)
-    min_steps: int = 10  # steps of the biggest runs; smaller runs take up to 100 (see gpu_steps)
+    min_steps: int = 10  # steps of the biggest runs; smaller ones take up to max_steps (see gpu_steps)
+    max_steps: int = 100
     compare_dx: float = 0.5
     compare_steps: int = 20
     graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
@@ -85,13 +86,13 @@ class Plan:
     ncu_dx: float = 0.01
 
     def gpu_steps(self, dx: float) -> int:
-        """100 steps up to 1.6M particles, fewer above, down to ``min_steps`` at 40M and more."""
+        """100 steps up to 2M particles, then 2e8 particle-steps per run, but at least ``min_steps``."""
         n = Scene(dx=dx, **self.scene).n_particles
-        return max(self.min_steps, min(100, int(2e8 // max(n, 1))))
+        return max(self.min_steps, min(self.max_steps, int(2e8 // max(n, 1))))
 
 
 FULL = Plan()
-REHEARSAL = Plan(gpu_dx=(1.0, 0.5), min_steps=2, compare_dx=1.0, compare_steps=3, graph_dx=(1.0,),
+REHEARSAL = Plan(gpu_dx=(1.0, 0.5), min_steps=2, max_steps=2, compare_dx=1.0, compare_steps=3, graph_dx=(1.0,),
                  graph_steps=2, graph_rounds=1, cpu_dx=(1.0,), cpu_steps=2,
                  scene={"x_min": -8.0, "x_max": 8.0}, asv_bench="TimeGPUStep", ncu_dx=1.0)
 
@@ -463,7 +464,7 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
 
     def pytest_gpu():
         state["pytest_gpu"] = run_logged([sys.executable, "-m", "pytest", "-m", "gpu", "-q", "-p", "no:cacheprovider",
-                                          "tests"], out / "pytest_gpu.log", min(240, budget.left()), env)
+                                          "tests"], out / "pytest_gpu.log", min(150, budget.left()), env)
         return state["pytest_gpu"]["exit"] in (0, 5)  # 5: every GPU test deselected or skipped (rehearsal)
 
     def bench():
@@ -471,15 +472,15 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
         cmd = [sys.executable, "-m", "pytest", "-o", "addopts=", "-p", "no:cacheprovider", "tests/benchmarks",
                "--benchmark-only", f"--benchmark-json={json_path}", "-q"]
         if rehearse:
-            cmd += ["-k", "linkedlist and 1.0"]
-        state["bench"] = run_logged(cmd, out / "pytest_benchmark.log", min(180, budget.left()), env)
+            cmd += ["-k", "linkedlist and step"]
+        state["bench"] = run_logged(cmd, out / "pytest_benchmark.log", min(120, budget.left()), env)
         return state["bench"]["exit"] == 0
 
     def asv():
         from .device_payload import run_asv_gpu
 
-        state["asv"] = run_asv_gpu(out, commits=("HEAD", H100_COMMIT), budget_s=min(150, budget.left()),
-                                   bench=plan.asv_bench)
+        state["asv"] = run_asv_gpu(out / "asv", commits=("HEAD", H100_COMMIT), budget_s=min(150, budget.left()),
+                                   bench=plan.asv_bench, asv_args=("--quick",))
         return all(r.get("returncode") == 0 for r in state["asv"])
 
     def ncu():
@@ -494,9 +495,9 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
     stage("sweep", 60, gpu_sweep)
     stage("graph", 40, graph)
     stage("cpu", 40, cpu_peers)
-    stage("pytest-gpu", 40, pytest_gpu)
-    stage("bench", 60, bench)
     stage("asv", 60, asv)
+    stage("bench", 60, bench)
+    stage("pytest-gpu", 40, pytest_gpu)
     stage("ncu", 45, ncu)
 
     state["elapsed_s"] = budget.elapsed()

@@ -69,6 +69,12 @@ class LinkedListGPU(CellListSolver):
             self.stream = None
             self.launch_stream = self.cuda.default_stream()
 
+    def warmup(self) -> float:
+        seconds = super().warmup()
+        if self.stream is not None:
+            self.stream.use()  # the probe made its own stream CuPy's current one
+        return seconds
+
     def allocate_cells(self) -> None:
         """Both particle blocks, the cell arrays and the launch shapes: everything a step needs."""
         xp, n, a = self.xp, self.scene.n_particles, self.arrays
