@@ -192,3 +192,14 @@ def test_simulated_gpu_integrators_match_cpu(integrator):
     assert cpu["status"] == "ok" and gpu["status"] == "ok", (cpu["message"], gpu["message"])
     for name in ("u", "drho", "x"):
         assert _max_rel(gpu["fields"][name], cpu["fields"][name]) < 1e-12, name
+
+
+@pytest.mark.gpu
+@pytest.mark.parametrize("precision,tol", [("float64", 1e-12), ("float32", 1e-4)])
+def test_gpu_graph_replays_the_plain_step(requires_gpu, precision, tol):
+    """The captured step (CUDA graph) advances the state as the plain launches do, from one state."""
+    from pcabench.gpu_check import graph_vs_plain
+
+    row = graph_vs_plain(0.25, precision, steps=10, rounds=1, scene_overrides={})
+    assert row["max_rel_diff_u"] < tol, row
+    assert row["graph_ms"] > 0 and row["plain_ms"] > 0
