@@ -144,7 +144,7 @@ def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float 
 
 
 def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budget: float,
-          stream=sys.stderr, retry_failed: bool = False, runner=run_child) -> list[dict]:
+          stream=sys.stderr, retry_failed: bool = False, runner=None) -> list[dict]:
     """Run ``specs`` (skipping those already stored), one child process each (``runner``); the rows stored.
 
     Before each run its time is predicted from this host's finished runs
@@ -153,7 +153,7 @@ def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budge
     """
     store.check_writable(store_path)
     with store.SweepLock(store_path):
-        return _sweep(specs, Path(store_path), run_budget, sweep_budget, stream, retry_failed, runner)
+        return _sweep(specs, Path(store_path), run_budget, sweep_budget, stream, retry_failed, runner or run_child)
 
 
 def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed, runner) -> list[dict]:
