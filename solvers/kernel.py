@@ -47,6 +47,45 @@ def constants(scene, dtype) -> tuple:
     return tuple(t(values[i]) for i in range(SLOTS))
 
 
+# ---------------------------------------------------------------- reference forms (NumPy), for every kernel
+KERNELS = ("gaussian", "wendland-c2", "wendland-c4")
+SUPPORT = {"wendland-c2": 2.0, "wendland-c4": 2.0}  # compact support / h; the Gaussian is truncated instead
+WENDLAND_NORM = {"wendland-c2": 7.0, "wendland-c4": 9.0}  # W = NORM / (4 pi h^2) f(q) in 2D
+
+
+def value(kernel: str, r, h: float):
+    """W(r) in 2D, 1/m^2 (NumPy; the Gaussian untruncated: the caller applies its cutoff)."""
+    r = np.asarray(r, dtype=np.float64)
+    if kernel == "gaussian":
+        return np.exp(-(r / h) ** 2) / (math.pi * h * h)
+    q = np.minimum(r / h, 2.0)
+    s = 1.0 - 0.5 * q
+    norm = WENDLAND_NORM[kernel] / (4.0 * math.pi * h * h)
+    if kernel == "wendland-c2":
+        return norm * s**4 * (2.0 * q + 1.0)
+    if kernel == "wendland-c4":
+        return norm * s**6 * (35.0 / 12.0 * q * q + 3.0 * q + 1.0)
+    raise ValueError(f"kernel must be one of {', '.join(KERNELS)} (got {kernel!r})")
+
+
+def gradient_factor(kernel: str, r, h: float):
+    """G(r) = W'(r) / r, so that grad_i W_ij = G(r_ij) (x_i - x_j), 1/m^4 (NumPy).
+
+    Wendland C2: G = -35/(4 pi h^4) (1 - q/2)^3; C4: G = -21/(4 pi h^4) (1 - q/2)^5 (5q + 2), q = r/h <= 2:
+    no exp and no division by r.
+    """
+    r = np.asarray(r, dtype=np.float64)
+    if kernel == "gaussian":
+        return -2.0 * np.exp(-(r / h) ** 2) / (math.pi * h**4)
+    q = np.minimum(r / h, 2.0)
+    s = 1.0 - 0.5 * q
+    if kernel == "wendland-c2":
+        return -35.0 / (4.0 * math.pi * h**4) * s**3
+    if kernel == "wendland-c4":
+        return -21.0 / (4.0 * math.pi * h**4) * s**5 * (5.0 * q + 2.0)
+    raise ValueError(f"kernel must be one of {', '.join(KERNELS)} (got {kernel!r})")
+
+
 def exp_neg_math(x):
     """exp(-x) through the math library (the GPU's fast hardware path)."""
     return math.exp(-x)
