@@ -20,6 +20,7 @@ import sys
 from pathlib import Path
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
+from solvers.kernel import KERNELS
 
 from . import __version__, paths
 from .progress import Progress
@@ -107,6 +108,8 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
                         "where it fits in memory")
 
 
+ACCURACY_OPTIONS = {"kernel": "kernel", "integrator": "integrator", "cutoff": "cutoff_factor", "h_factor": "h_factor",
+                    "cfl": "cfl"}
 SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
                  "h_factor": "h_factor", "cfl": "cfl"}
 
@@ -281,6 +284,25 @@ def cmd_runs(args) -> int:
     return 0
 
 
+def cmd_accuracy(args) -> int:
+    from solvers.dispersion import predict
+
+    given = {key: getattr(args, opt) for opt, key in ACCURACY_OPTIONS.items() if getattr(args, opt) is not None}
+    scene = Scene(dx=args.dx, t_end=args.t_end, model="linear", memory_limit_bytes=2**62, **given)
+    p = predict(scene)
+    if args.json:
+        print(json.dumps({"scene": scene.as_dict(), **p.as_dict()}, sort_keys=True))
+        return 0
+    print(f"{scene.describe()}\n"
+          f"predicted relative RMS error of u at t = {p.t_end:.4g} s: {p.predicted_error:.4g} (max error "
+          f"{p.predicted_me:.3g} m/s)\n"
+          f"largest stable CFL (dt c0 / dx) for {scene.integrator}: {p.stable_cfl:.4g}"
+          f"{' (grows at any step)' if p.stable_cfl == 0 else ''}\n"
+          f"phase speed error at k = 1/w: lattice {100 * p.lattice_phase_error:+.3f} %, with the step "
+          f"{100 * p.step_phase_error:+.3f} %")
+    return 0
+
+
 def cmd_profile(args) -> int:
     from . import profiles
 
@@ -367,6 +389,21 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the runs both A and B made (machines, or commit prefixes): step times, ratio, errors")
     p.add_argument("--limit", type=positive_int("--limit"), default=200, help="the newest rows to print at most")
     p.set_defaults(func=cmd_runs)
+
+    p = sub.add_parser("accuracy", help="predict a run's error and largest stable CFL from the dispersion relation",
+                       description="The relative RMS error of u at --t-end and the largest stable CFL of the "
+                                   "`linear` model, from the lattice's SPH operator and the integrator's step, "
+                                   "with no simulation (for fixed and lagrangian: their linear part).")
+    p.add_argument("--dx", type=number("--dx"), required=True, help="lattice spacing, m")
+    p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical end time, s (default 10)")
+    p.add_argument("--kernel", choices=KERNELS, help="default gaussian")
+    p.add_argument("--h-factor", type=number("--h-factor"), help=f"h / dx (default {Scene.default('h_factor'):g})")
+    p.add_argument("--cutoff", type=number("--cutoff"),
+                   help=f"Gaussian cutoff in units of h (default {Scene.default('cutoff_factor'):g})")
+    p.add_argument("--cfl", type=number("--cfl"), help=f"dt * c0 / dx (default {Scene.default('cfl'):g})")
+    p.add_argument("--integrator", choices=INTEGRATORS, help=f"default {Scene.default('integrator')}")
+    p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")
+    p.set_defaults(func=cmd_accuracy)
 
     p = sub.add_parser("profile", help="capture this machine's hardware profile")
     p.add_argument("--save", action="store_true", help="store it among the user's profiles")

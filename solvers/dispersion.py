@@ -1,0 +1,201 @@
+"""The error of a run predicted from the discrete operator's dispersion relation, with no simulation.
+
+On the square lattice the SPH sums of the `linear` model act on a plane wave
+exp(i k.x) as i D(k), with
+
+    D(k) = -sum_j V sin(k.x_ij) x_ij G(r_ij)        (V = dx^2, G = W'(r)/r, r_ij < cutoff)
+
+over the lattice neighbours: d(drho)/dt = -i rho0 D.u and du/dt = -i (c0^2/rho0) D drho.
+D(k) -> k as k dx -> 0; its departure from k is the lattice's phase error
+(the truncated or smoothed kernel gives a phase speed c0 |D|/|k| below c0).
+Each wavenumber then evolves by the integrator's own step program
+(solvers/integrators.py) run on one complex amplitude per wavenumber
+(:class:`ModeSolver`), so the leapfrog's phase lead and any growth come out of
+the same code the solvers run. The pulse's lattice spectrum (an FFT of the
+sampled initial fields) evolved to t and transformed back gives u on the
+lattice, scored exactly as a run is (solvers/analytic.py). This is exact
+linear algebra of the same discrete operator on an unbounded lattice: for
+`linear` it matches a run up to the pulse's contact with the domain's ends.
+For `fixed` and `lagrangian` it is their linear part only.
+
+The largest |D(k)| over the Brillouin zone bounds the step: a mode is stable
+while the integrator's amplification over one step has spectral radius <= 1,
+which depends only on z = c0 |D| dt; :func:`stable_cfl` turns the largest
+stable z into the largest stable CFL = dt c0 / dx.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import kernel
+from .analytic import errors as analytic_errors
+from .integrators import step_program
+
+STABLE_GROWTH = 1e-9  # spectral radius above 1 + this is unstable
+Z_SCAN = np.linspace(1e-3, 8.0, 8000)  # c0 |D| dt: where stability is looked for
+
+
+def lattice_offsets(scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(a, b, G): the lattice neighbours' offsets in units of dx (x_ij = (a, b) dx) within the cutoff,
+    and G(r) of the scene's kernel at each, 1/m^4. The particle itself is left out."""
+    reach = int(math.ceil(scene.cutoff / scene.dx))
+    a, b = np.meshgrid(np.arange(-reach, reach + 1), np.arange(-reach, reach + 1), indexing="ij")
+    r = np.hypot(a, b) * scene.dx
+    keep = (r < scene.cutoff) & (r > 0)
+    name = getattr(scene, "kernel", "gaussian")
+    return a[keep].astype(float), b[keep].astype(float), kernel.gradient_factor(name, r[keep], scene.h)
+
+
+def symbol(scene, kx, ky=0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(D_x, D_y) at wavenumbers (kx, ky), 1/m (arrays broadcast together)."""
+    a, b, g = lattice_offsets(scene)
+    kx, ky = np.broadcast_arrays(np.asarray(kx, float), np.asarray(ky, float))
+    phase = np.multiply.outer(kx, a * scene.dx) + np.multiply.outer(ky, b * scene.dx)
+    weight = -scene.dx**2 * np.sin(phase) * g
+    return weight @ (a * scene.dx), weight @ (b * scene.dx)
+
+
+def largest_symbol(scene, points: int = 161) -> float:
+    """max |D(k)| over the Brillouin zone [0, pi/dx]^2 (the lattice's symmetry covers the rest), 1/m."""
+    k = np.linspace(0.0, math.pi / scene.dx, points)
+    kx, ky = np.meshgrid(k, k, indexing="ij")
+    dx_, dy_ = symbol(scene, kx.ravel(), ky.ravel())
+    return float(np.sqrt(dx_**2 + dy_**2).max())
+
+
+class ModeSolver:
+    """The solver primitives on one complex amplitude per wavenumber (linear model, waves along x).
+
+    Enough of the solver interface for :func:`step_program`: ``drho`` and ``u`` are the modes' amplitudes,
+    ``ax`` and ``dd`` their rates, ``d`` the symbol D_x(k) (1/m) of each mode.
+    """
+
+    def __init__(self, d, drho, u, rho0: float, c0: float, dt: float):
+        self.d, self.rho0, self.c0, self.dt = np.asarray(d, float), rho0, c0, dt
+        self.drho, self.u = np.array(drho, complex), np.array(u, complex)
+        self.ax, self.dd = np.zeros_like(self.u), np.zeros_like(self.u)
+        self.saved, self.t = {}, 0.0
+
+    def snp(self) -> None:
+        """Particles on the lattice: nothing to search."""
+
+    def rates(self, continuity: bool, momentum: bool) -> None:
+        if continuity:
+            self.dd = -1j * self.rho0 * self.d * self.u
+        if momentum:
+            self.ax = -1j * (self.c0**2 / self.rho0) * self.d * self.drho
+
+    def kick(self, f: float) -> None:
+        self.u = self.u + f * self.dt * self.ax
+
+    def advance(self, f: float) -> None:
+        self.drho = self.drho + f * self.dt * self.dd
+        self.t += f * self.dt
+
+    def save(self) -> None:
+        self.saved = {"u": self.u.copy(), "drho": self.drho.copy(), "t": self.t}
+
+    def restore(self, names) -> None:
+        if "u" in names:
+            self.u = self.saved["u"].copy()
+        if "drho" in names:
+            self.drho, self.t = self.saved["drho"].copy(), self.saved["t"]
+
+    def state(self) -> np.ndarray:
+        return np.stack([self.drho, self.u, self.ax, self.dd])
+
+    def set_state(self, s) -> None:
+        self.drho, self.u, self.ax, self.dd = (np.array(row, complex) for row in s)
+
+
+def evolve(solver: ModeSolver, integrator: str, steps: int) -> ModeSolver:
+    """``steps`` steps of ``integrator``'s program, the first one primed as a run's is."""
+    for step in range(1, steps + 1):
+        for _stage, op in step_program(integrator, solver, first=(step == 1)):
+            op()
+    return solver
+
+
+def predicted_velocity(scene) -> tuple[np.ndarray, np.ndarray, float]:
+    """(x, u, t): u on one lattice row at the run's final time, predicted mode by mode."""
+    nx = scene.nx
+    x = scene.x_lo + (np.arange(nx) + 0.5) * scene.dx
+    xi = (x - scene.pulse_center) / scene.pulse_width
+    u0 = scene.c0 * scene.mach * np.exp(-xi * xi)
+    k = 2.0 * math.pi * np.fft.fftfreq(nx, d=scene.dx)
+    d, _ = symbol(scene, k)
+    modes = ModeSolver(d, np.fft.fft(scene.rho0 * u0 / scene.c0), np.fft.fft(u0), scene.rho0, scene.c0, scene.dt)
+    evolve(modes, scene.integrator, scene.n_steps)
+    return x, np.fft.ifft(modes.u).real, modes.t
+
+
+def amplification_radius(integrator: str, z) -> np.ndarray:
+    """Spectral radius of one step (after the first) of ``integrator`` for c0 |D| dt = z (rho0 = c0 = dt = 1)."""
+    z = np.asarray(z, float)
+    solver = ModeSolver(z, np.zeros_like(z), np.zeros_like(z), 1.0, 1.0, 1.0)
+    columns = []
+    for e in np.eye(4):
+        solver.set_state(np.multiply.outer(e, np.ones_like(z)))
+        for _stage, op in step_program(integrator, solver, first=False):
+            op()
+        columns.append(solver.state())
+    matrices = np.moveaxis(np.stack(columns, axis=1), -1, 0)  # (len(z), 4, 4): column j = step of basis e_j
+    return np.abs(np.linalg.eigvals(matrices)).max(axis=1)
+
+
+def largest_stable_z(integrator: str) -> float:
+    """The largest c0 |D| dt up to which one step never grows (0 where it grows at any step: euler, kdk1,
+    and rk2, whose growth 1 + z^4/8 per step is slow but never 1)."""
+    if amplification_radius(integrator, [0.1])[0] > 1.0 + 1e-13:
+        return 0.0
+    unstable = amplification_radius(integrator, Z_SCAN) > 1.0 + STABLE_GROWTH
+    return float(Z_SCAN[np.argmax(unstable)]) if unstable.any() else float(Z_SCAN[-1])
+
+
+def stable_cfl(scene) -> float:
+    """The largest stable CFL (dt c0 / dx) for the scene's kernel, h/dx, cutoff and integrator."""
+    return largest_stable_z(scene.integrator) / (scene.dx * largest_symbol(scene))
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """The predicted relative RMS error of u at the run's final time and the largest stable CFL."""
+
+    predicted_error: float
+    predicted_me: float
+    stable_cfl: float
+    t_end: float
+    lattice_phase_error: float  # c0 D(k)/k - 1 at the pulse's wavenumber k = 1 / pulse width: the lattice's lag
+    step_phase_error: float  # the same with the integrator's step: phase speed / c0 - 1 (lag + the step's lead)
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+def predict(scene) -> Prediction:
+    """The error of the scene's run predicted from the dispersion relation (linear part; see the module)."""
+    x, u, t = predicted_velocity(scene)
+    err = analytic_errors(scene, x, u, t)
+    k = 1.0 / scene.pulse_width
+    d = float(symbol(scene, np.array([k]))[0][0])
+    return Prediction(predicted_error=err.mse, predicted_me=err.me, stable_cfl=stable_cfl(scene), t_end=t,
+                      lattice_phase_error=d / k - 1.0,
+                      step_phase_error=step_phase_angle(scene.integrator, scene.c0 * d * scene.dt)
+                      / (scene.c0 * k * scene.dt) - 1.0)
+
+
+def step_phase_angle(integrator: str, z: float) -> float:
+    """The phase a right-running mode turns through in one step, rad, for c0 D dt = z (leapfrog: 2 asin(z/2))."""
+    solver = ModeSolver([z], [0.0], [0.0], 1.0, 1.0, 1.0)
+    columns = []
+    for e in np.eye(4):
+        solver.set_state(e[:, None])
+        for _stage, op in step_program(integrator, solver, first=False):
+            op()
+        columns.append(solver.state()[:, 0])
+    eig = np.linalg.eigvals(np.stack(columns, axis=1))
+    angles = np.abs(np.angle(eig[np.abs(eig) > 0.5]))  # the auxiliary rates' eigenvalues are 0
+    return float(angles[np.argmin(np.abs(angles - z))])  # the physical mode: nearest the exact phase z
