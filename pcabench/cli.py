@@ -303,6 +303,47 @@ def cmd_accuracy(args) -> int:
     return 0
 
 
+def cmd_advise(args) -> int:
+    from . import store
+    from .advise import advise
+    from .profiles import machine_id
+
+    if not 0 < args.error <= 1:
+        raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
+    results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
+    df = store.load(results) if results is not None and Path(results).exists() else None
+    if df is None or df.empty:
+        raise OptionError(f"no stored runs in {results}: run `pcabench study --front --quick` first, "
+                          "or use --reference")
+    machines = df.machine.value_counts()
+    machine = args.machine or (machine_id() if machine_id() in machines else machines.index[0])
+    if machine not in machines:
+        raise OptionError(f"--machine {machine!r}: the stores hold {', '.join(machines.index)}")
+    out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model)}
+    if args.json:
+        print(json.dumps(out, sort_keys=True, default=str))
+        return 0
+    head = f"{args.model} to a relative RMS error of u <= {args.error:g} at t = {args.t_end:g} s on {machine}"
+    if not out["found"]:
+        s = out["suggestion"]
+        print(f"{head}: none of the {out['runs_considered']} stored runs reaches it.")
+        if "study" in s:
+            print(f"predicted cheapest: {s['kernel']}, h = {s['h_factor']:g} dx, CFL {s['cfl']:g}, dx {s['dx']:g} "
+                  f"(predicted {s['predicted_error']:.3g}); run:\n  {s['study']}")
+        print("the paper's configuration needs dx <= "
+              + (f"{s['paper_dx']:g} m (predicted)" if s["paper_dx"] else "below the searched dx"))
+        return 1
+    print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
+          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} of a predicted stable {out['stable_cfl']:.3g}, "
+          f"dx {out['dx']:g}, {out['n_particles']:,} particles, {out['steps']} steps)\n  {out['command']}")
+    if out["paper_seconds"]:
+        print(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
+              f"{out['speedup_over_paper']:.3g}x slower\n  {out['paper_command']}")
+    else:
+        print("  no stored run of the paper's configuration reaches it")
+    return 0
+
+
 def cmd_profile(args) -> int:
     from . import profiles
 
@@ -404,6 +445,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--integrator", choices=INTEGRATORS, help=f"default {Scene.default('integrator')}")
     p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")
     p.set_defaults(func=cmd_accuracy)
+
+    p = sub.add_parser("advise", help="the fastest stored run that reaches an error at a physical time",
+                       description="Among one machine's stored runs at --t-end, the fastest by time to solution "
+                                   "(init + steps, JIT apart) whose relative RMS error of u is at most --error, "
+                                   "the paper configuration's time to the same error, and the command line.")
+    p.add_argument("--error", type=number("--error"), required=True, help="relative RMS error of u, e.g. 0.01")
+    p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical time, s (default 10)")
+    p.add_argument("--model", choices=MODELS, default="linear", help="default linear")
+    p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
+    p.add_argument("--results", help=results_help)
+    p.add_argument("--machine", help="a machine (profile id) of the stores; default this one, else the first")
+    p.add_argument("--json", action="store_true", help="one JSON object: command, error, seconds, paper_seconds")
+    p.set_defaults(func=cmd_advise)
 
     p = sub.add_parser("profile", help="capture this machine's hardware profile")
     p.add_argument("--save", action="store_true", help="store it among the user's profiles")

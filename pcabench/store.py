@@ -250,6 +250,7 @@ def load(paths):
         scene = row.get("scene") or {}
         for key in ("strip_height", "cutoff_factor", "h_factor", "cfl", "t_final", "height"):
             r[key] = scene.get(key)
+        r["kernel"] = scene.get("kernel") or "gaussian"  # rows from before the kernel option: the Gaussian
         # how the run ends: the paper's fixed step count, or a fixed physical time
         r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
         r["domain"] = "strip" if scene.get("strip_height") else "full"

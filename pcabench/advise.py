@@ -1,0 +1,124 @@
+"""``pcabench advise``: the fastest stored run that reaches an error at a physical time.
+
+A researcher wants an answer of a given accuracy at a given physical time in
+the least time. Among one machine's finished runs at that time (and model),
+the fastest by time to solution (init + steps, JIT apart) whose relative RMS
+error of u is at most the target; beside it, the fastest run of the paper's
+configuration (Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet) that reaches the
+same error, and the ratio. The margin to instability comes from the
+dispersion relation (solvers/dispersion.py). Where no stored run reaches the
+target, the prediction names the sweep that would.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from solvers import Scene
+from solvers.dispersion import predict
+
+from .reports.tables import default_numerics, latest
+
+# The configurations the prediction searches when no stored run reaches a target (a small, cheap grid).
+SEARCH_KERNELS = ("gaussian", "wendland-c2", "wendland-c4")
+SEARCH_H = (1.3, 1.6, 2.13)
+SEARCH_DX = (1.0, 0.5, 0.4, 0.25, 0.2, 0.125, 0.1, 0.05, 0.025)
+SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
+
+
+def scene_of(r) -> dict:
+    """A stored run's scene parameters (the defaults where the row predates them)."""
+    return {"kernel": r.get("kernel") or "gaussian", "h_factor": r["h_factor"], "cutoff_factor": r["cutoff_factor"],
+            "cfl": r["cfl"], "integrator": r["integrator"], "dx": r["dx"], "strip_height": r["strip_height"]}
+
+
+def command(r, t_end: float) -> str:
+    """The ``pcabench run`` command line that reproduces stored run ``r``."""
+    s = scene_of(r)
+    parts = [f"pcabench run --solver {r['solver']} --dx {s['dx']:g} --t-end {t_end:g} --model {r['model']}"]
+    for option, key in (("--kernel", "kernel"), ("--h-factor", "h_factor"), ("--cutoff", "cutoff_factor"),
+                        ("--cfl", "cfl"), ("--integrator", "integrator")):
+        value = s[key]
+        if value is not None and value != Scene.default(key):
+            parts.append(f"{option} {value:g}" if isinstance(value, float) else f"{option} {value}")
+    if s["strip_height"] is not None and not (isinstance(s["strip_height"], float) and math.isnan(s["strip_height"])):
+        parts.append(f"--strip-height {s['strip_height']:g}")
+    if r["precision"] != Scene.default("precision"):
+        parts.append(f"--precision {r['precision']}")
+    if int(r["threads"]) > 1:
+        parts.append(f"--threads {int(r['threads'])}")
+    return " ".join(parts)
+
+
+def reaching(df, t_end: float, model: str):
+    """Finished runs of ``model`` that ended at ``t_end`` (the newest of each configuration), fastest first."""
+    d = df[(df.status == "ok") & (df.model == model) & df.t_final.notna()]
+    d = d[np.isclose(d.t_final.astype(float), t_end, rtol=1e-6)]
+    return latest(d).sort_values("t_solution") if not d.empty else d
+
+
+def paper_configuration(df):
+    """Rows of the paper's numerics: default integrator, CFL, h/dx and cutoff, and the Gaussian kernel."""
+    d = default_numerics(df)
+    return d[d["kernel"].fillna("gaussian") == "gaussian"] if "kernel" in d else d
+
+
+def advise(df, error: float, t_end: float, model: str = "linear") -> dict:
+    """The fastest stored run reaching ``error`` at ``t_end``, the paper configuration's, and the ratio."""
+    runs = reaching(df, t_end, model)
+    hits = runs[runs.mse <= error] if not runs.empty else runs
+    out = {"error_target": error, "t_end": t_end, "model": model, "runs_considered": int(len(runs))}
+    if hits.empty:
+        out["found"] = False
+        out["suggestion"] = suggest(error, t_end, model)
+        return out
+    best = hits.iloc[0]
+    scene = Scene(t_end=t_end, model=model, memory_limit_bytes=2**62,
+                  **{k: v for k, v in scene_of(best).items() if not (isinstance(v, float) and math.isnan(v))})
+    stable = predict(scene).stable_cfl
+    paper = paper_configuration(hits)
+    paper_best = paper.iloc[0] if not paper.empty else None
+    out.update(found=True, command=command(best, t_end), error=float(best.mse), seconds=float(best.t_solution),
+               machine=str(best.machine), solver=str(best.solver), threads=int(best.threads),
+               n_particles=int(best.n_particles), steps=int(best.steps), **scene_of(best),
+               stable_cfl=stable, cfl_margin=stable / float(best.cfl) if stable else 0.0,
+               paper_seconds=None if paper_best is None else float(paper_best.t_solution),
+               paper_error=None if paper_best is None else float(paper_best.mse),
+               paper_command=None if paper_best is None else command(paper_best, t_end))
+    out["speedup_over_paper"] = out["paper_seconds"] / out["seconds"] if out["paper_seconds"] else None
+    return out
+
+
+def suggest(error: float, t_end: float, model: str = "linear") -> dict:
+    """From the prediction: the cheapest configuration of a small grid predicted to reach ``error`` at ``t_end``
+    (cost ~ particles x steps x neighbours on the thinnest strip), and the paper configuration's dx."""
+    best, paper = None, None
+    for kern, h, dx in itertools.product(SEARCH_KERNELS, SEARCH_H, SEARCH_DX):
+        try:
+            base = Scene(dx=dx, t_end=t_end, model="linear", kernel=kern, h_factor=h, memory_limit_bytes=2**62)
+        except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
+            continue
+        limit = predict(base.replace(t_end=min(t_end, 10 * dx))).stable_cfl
+        for share in SEARCH_CFL_SHARE if limit > 0 else ():
+            scene = base.replace(cfl=round(share * limit, 2))
+            p = predict(scene)
+            if p.predicted_error > error:
+                continue
+            cost = (1 / dx) * scene.n_steps * (scene.cutoff / dx) ** 2
+            if best is None or cost < best[0]:
+                best = (cost, scene, p)
+    for dx in SEARCH_DX:
+        scene = Scene(dx=dx, t_end=t_end, model="linear", memory_limit_bytes=2**62)
+        if predict(scene).predicted_error <= error:
+            paper = scene
+    out = {"paper_dx": None if paper is None else paper.dx}
+    if best is not None:
+        _, s, p = best
+        out.update(kernel=getattr(s, "kernel", "gaussian"), h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,
+                   predicted_error=p.predicted_error,
+                   study=(f"pcabench study --solver linkedlist-cpu --model {model} --t-end {t_end:g} --strip "
+                          f"--kernel {getattr(s, 'kernel', 'gaussian')} --h-factor {s.h_factor:g} --cfl {s.cfl:g} "
+                          f"--dx {s.dx:g} {s.dx / 2:g}"))
+    return out
