@@ -1,7 +1,7 @@
 """The ``pcabench`` command line: the only module that knows about argparse.
 
     pcabench run --solver linkedlist-cpu --dx 0.1 --t-end 10
-    pcabench study --quick | --paper | --stability | --dx 1 0.5 ...
+    pcabench study --quick | --paper | --stability | --front [quick|full] | --dx 1 0.5 ...
     pcabench report [--reference]
     pcabench profile [--save | --asv]
     pcabench gpu-check --out DIR
@@ -177,7 +177,8 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")) \
             or args.strip:
         raise OptionError("--dx is needed to build a matrix from the scene options (or use a preset alone)")
-    name = "paper" if args.paper else "stability" if args.stability else "quick"
+    name = "paper" if args.paper else "stability" if args.stability else \
+        {None: "quick", "quick": "front", "full": "front-full"}[args.front]
     return name, preset(name)
 
 
@@ -313,7 +314,7 @@ def cmd_advise(args) -> int:
     results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
     df = store.load(results) if results is not None and Path(results).exists() else None
     if df is None or df.empty:
-        raise OptionError(f"no stored runs in {results}: run `pcabench study --front --quick` first, "
+        raise OptionError(f"no stored runs in {results}: run `pcabench study --front` first, "
                           "or use --reference")
     machines = df.machine.value_counts()
     machine = args.machine or (machine_id() if machine_id() in machines else machines.index[0])
@@ -393,6 +394,9 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets")
     g.add_argument("--stability", action="store_true",
                    help="CFL x integrator x h/dx, run length and float32: the stability map")
+    g.add_argument("--front", nargs="?", const="quick", choices=("quick", "full"),
+                   help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
+                        "model on the strip, serial (quick: 288 runs, about 30 min on 2 cores; full: 2400)")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
     m.add_argument("--solver", nargs="+", choices=SOLVERS)
     add_scene_options(m, many=True)

@@ -14,7 +14,8 @@ from solvers import Scene
 from .spec import ALL_CORES, SERIAL, RunSpec
 
 # Seconds per run before it is recorded as a timeout, by preset (--run-budget overrides).
-RUN_BUDGET = {"quick": 120.0, "paper": 900.0, "stability": 120.0, "matrix": 900.0}
+RUN_BUDGET = {"quick": 120.0, "paper": 900.0, "stability": 120.0, "matrix": 900.0, "front": 300.0,
+              "front-full": 900.0}
 
 # The stability preset's scene: the design's dx = 0.25 on a strip, the linear model
 # (exactly the linear wave equation, so growth is the integrator's, not the physics').
@@ -101,7 +102,31 @@ def stability() -> list[RunSpec]:
     return runs
 
 
-PRESETS = {"quick": quick, "paper": paper, "stability": stability}
+# The speed-accuracy front at t = 10 s on the strip, serial: kernel x h/dx x CFL x dx x precision x model.
+# CFL 6 is past every configuration's predicted stable step: the front shows where methods fail.
+FRONT = {
+    "quick": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0, 6.0),
+                  dx=(0.4, 0.2, 0.1), precision=("float64", "float32"), model=("linear", "lagrangian")),
+    "full": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.0, 1.3, 1.6, 2.13, 2.6),
+                 cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0), dx=(0.4, 0.2, 0.1, 0.05, 0.025),
+                 precision=("float64", "float32"), model=("linear", "lagrangian")),
+}
+FRONT_T_END = 10.0
+
+
+def front(size: str = "quick") -> list[RunSpec]:
+    """Time to solution against error at t = 10 s: the product of FRONT[size], smallest N first."""
+    axes = FRONT[size]
+    names = [k for k in axes if k != "dx"]
+    return [_spec(dx=dx, t_end=FRONT_T_END, strip=True, **dict(zip(names, values)))
+            for dx in sorted(axes["dx"], reverse=True) for values in itertools.product(*(axes[k] for k in names))]
+
+
+def front_full() -> list[RunSpec]:
+    return front("full")
+
+
+PRESETS = {"quick": quick, "paper": paper, "stability": stability, "front": front, "front-full": front_full}
 
 
 def preset(name: str) -> list[RunSpec]:

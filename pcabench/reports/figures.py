@@ -274,30 +274,37 @@ def _groups(rows, keys):
     return list(seen.items())
 
 
+KERNEL_COLOURS = {"gaussian": "tab:blue", "wendland-c2": "tab:orange", "wendland-c4": "tab:green"}
+
+
 def speed_vs_accuracy(df, out: Path, pid: str):
+    """Time to solution against error at a fixed time, one panel per time and model: every run (colour:
+    kernel; hollow: float32), the paper's method starred, each model's front, and the prediction beside it."""
     points, front = T.speed_front(df)
-    if not points:
+    panels = sorted(k for k in {(p["t_final"], p["model"]) for p in points}
+                    if sum((q["t_final"], q["model"]) == k for q in points) >= 3)  # a lone point is no trade-off
+    if not panels:
         return None
     path = out / "speed_vs_accuracy.png"
-    configs = sorted({p["config"] for p in points})
-    colours = dict(zip(configs, palette(len(configs))))
-    model_marker = {"linear": "o", "fixed": "s", "lagrangian": "^"}
-    counts = {t: sum(p["t_final"] == t for p in points) for t in {p["t_final"] for p in points}}
-    finals = sorted(t for t, c in counts.items() if c >= 3) or sorted(counts)  # a lone point is no trade-off
-    with figure(path, f"Speed against accuracy at a fixed physical time ({pid}); colour: solver, marker: model, "
-                "hollow: full domain", "time to solution (s: init + steps, no JIT)", "relative RMS error of u",
-                ncols=len(finals), logx=True, logy=True, size=(6 * len(finals) + 3.5, 4.6)) as axes:
-        for ax, t_final in zip(axes, finals):
-            for (config, model, domain), pts in _groups([p for p in points if p["t_final"] == t_final],
-                                                        ("config", "model", "domain")):
-                ax.plot([p["seconds"] for p in pts], [p["mse"] for p in pts], ls="none", ms=7,
-                        marker=model_marker.get(model, "x"), color=colours[config],
-                        mfc="none" if domain == "full" else colours[config], label=f"{config}, {model}")
-            fp = [p for p in front if p["t_final"] == t_final]
-            if fp:
-                ax.step([p["seconds"] for p in fp], [p["mse"] for p in fp], color="black", where="post", lw=1.5,
-                        label="front of the linear runs (fastest to each error)")
-            ax.set_title(f"t = {t_final:g} s", fontsize=9)
+    with figure(path, f"Time to solution against error ({pid}): every finished run; black line: the fastest run "
+                "to each error", "time to solution (s: init + steps, no JIT)", "relative RMS error of u at t",
+                ncols=len(panels), logx=True, logy=True, size=(5.2 * len(panels) + 3.8, 4.6)) as axes:
+        for ax, (t_final, model) in zip(axes, panels):
+            here = [p for p in points if (p["t_final"], p["model"]) == (t_final, model)]
+            for (kern, precision), pts in _groups(here, ("kernel", "precision")):
+                colour = KERNEL_COLOURS.get(kern, "grey")
+                ax.plot([p["seconds"] for p in pts], [p["mse"] for p in pts], ls="none", marker="o", ms=4.5,
+                        color=colour, mfc="none" if precision == "float32" else colour, alpha=0.75,
+                        label=f"{kern}, {precision}")
+            paper = [p for p in here if p["paper_method"]]
+            ax.plot([p["seconds"] for p in paper], [p["mse"] for p in paper], ls="none", marker="*", ms=11,
+                    mfc="none", mec="black", mew=1.1, label="the paper's method (Gaussian, h 2.13dx, 3h, CFL 0.2)")
+            fp = [p for p in front if (p["t_final"], p["model"]) == (t_final, model)]
+            ax.step([p["seconds"] for p in fp], [p["mse"] for p in fp], color="black", where="post", lw=1.3,
+                    label="front: fastest run to each error")
+            ax.plot([p["seconds"] for p in fp], [T.predicted_error(p) for p in fp], ls="none", marker="x", ms=6,
+                    color="crimson", label="front runs, predicted (dispersion relation, linear part)")
+            ax.set_title(f"{model}, t = {t_final:g} s ({len(here)} runs)", fontsize=9)
     return path
 
 
