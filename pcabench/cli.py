@@ -149,6 +149,7 @@ def cmd_run(args) -> int:
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
+        out["mse_isothermal"] = record.mse_isothermal
         out["message"] = record.message
         print(json.dumps(to_row(out), allow_nan=False))  # standard JSON: null, never NaN
     else:
@@ -158,6 +159,8 @@ def cmd_run(args) -> int:
         print(f"mean neighbours  {record.mean_neighbours:.2f}")
         print(f"MSE (rel. RMS)   {record.mse:.6g}")
         print(f"ME (max, m/s)    {record.me:.6g}")
+        if record.mse_isothermal is not None:
+            print(f"MSE against the isothermal solution (lagrangian's own limit) {record.mse_isothermal:.6g}")
         print(f"status           {record.status}"
               + (f" at step {record.failed_step}" if record.failed_step else ""))
         if record.message:

@@ -38,6 +38,7 @@ class RunRecord:
     threads: int = 1
     pair_loop: str = ""  # how the solver visited pairs: list, gather (the paper's) or all-pairs
     steps_requested: int = 0
+    mse_isothermal: float | None = None  # lagrangian only: relative RMS error of u against the isothermal solution
     scene: dict = field(default_factory=dict)
     message: str = ""
     profile_id: str = ""

@@ -10,6 +10,7 @@ import math
 
 from solvers import Scene, SceneError, make_solver, resolve_pair_loop
 from solvers.analytic import errors as analytic_errors
+from solvers.isothermal1d import isothermal_errors
 from solvers.integrators import step_program
 
 from .clock import clock_for
@@ -60,6 +61,8 @@ def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int = 1,
             record.status = "ok"
             err = analytic_errors(scene, fields.x, fields.u, fields.t)
             record.mse, record.me = err.mse, err.me
+            if scene.model == "lagrangian":
+                record.mse_isothermal = isothermal_errors(scene, fields.x, fields.u, fields.t).mse
             record.mean_neighbours = solver.mean_neighbours()
     except SceneError:
         raise  # bad input is the caller's to report, not a run result

@@ -27,7 +27,11 @@ class Errors:
 
 def errors(scene, x, u, t) -> Errors:
     """Paper eq. 11 over all particles: sqrt(mean((u-u_the)^2)/mean(u_the^2)), max|u-u_the|."""
-    u_the = pulse_velocity(scene, x, t)
+    return relative_errors(u, pulse_velocity(scene, x, t))
+
+
+def relative_errors(u, u_the) -> Errors:
+    """Eq. 11 of ``u`` against any reference ``u_the`` at the same points."""
     diff = np.asarray(u, dtype=np.float64) - u_the
     if not np.all(np.isfinite(diff)):
         return Errors(float("nan"), float("nan"))

@@ -35,3 +35,13 @@ def isothermal_pulse(scene, t_end: float, cells_per_m: int = 200, cfl: float = 0
         fh = flux(half)
         q[:, 1:-1] -= dt / dx * (fh[:, 1:] - fh[:, :-1])  # edge cells stay at rest
     return x, q[1] / q[0]
+
+
+def isothermal_errors(scene, x, u, t, cells_per_m: int = 100):
+    """Eq. 11 of ``u`` (at positions ``x``) against the isothermal solution at ``t``: what the `lagrangian`
+    model's error is measured against, its own limit (100 cells per m: the reference's own error is far
+    below the runs')."""
+    from .analytic import relative_errors
+
+    x_ref, u_ref = isothermal_pulse(scene, t, cells_per_m=cells_per_m)
+    return relative_errors(u, np.interp(x, x_ref, u_ref))
