@@ -262,7 +262,9 @@ def load(paths):
         flat.append(r)
     df = pd.DataFrame(flat)
     if not df.empty:
-        for col in ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end"):  # null (NaN stored) -> NaN
+        if "mse_isothermal" not in df:
+            df["mse_isothermal"] = np.nan  # rows from before it was measured
+        for col in ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal"):  # null -> NaN
             if col in df:
                 df[col] = pd.to_numeric(df[col], errors="coerce")
         if "host" not in df:

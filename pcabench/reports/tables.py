@@ -301,7 +301,7 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
                "kernel": r.get("kernel") or "gaussian", "h_factor": r.h_factor, "cfl": r.cfl,
                "integrator": r.integrator, "cutoff_factor": r.cutoff_factor, "precision": r.precision, "model": r.model, "domain": r.domain,
                "dx": r.dx, "N": int(r.n_particles), "t_final": r.t_final, "seconds": r.t_solution, "mse": r.mse,
-               "strip_height": r.strip_height, "solver": r.solver, "threads": int(r.threads)}
+               "mse_isothermal": r.mse_isothermal, "strip_height": r.strip_height, "solver": r.solver, "threads": int(r.threads)}
               for _, r in pts.iterrows()]
     front = []
     for t_final, model in sorted({(p["t_final"], p["model"]) for p in points}):
