@@ -248,6 +248,8 @@ def cmd_study(args) -> int:
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
             raise OptionError(f"{flag} must be > 0 seconds (got {value})")
+    if not args.cluster:
+        check_folder(paths.user_profiles(), home_option())  # where the sweep saves this machine's profile
     if not args.no_report:
         check_folder(args.reports, "--reports")  # before the sweep, not after it
     if args.cluster:
@@ -260,7 +262,6 @@ def cmd_study(args) -> int:
     else:
         profile = profiles.capture()
         store_path = Path(args.results) / store_name(profile["id"])
-        check_folder(paths.user_profiles(), home_option())
         check_writable(store_path)
         profiles.save(profile)
         print(f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
@@ -290,7 +291,7 @@ def cmd_report(args) -> int:
             raise OptionError("--reference needs a source checkout (its reports/ folder)")
         results, reports = results or paths.reference_results(), reports or paths.reference_reports()
     results, reports = results or paths.user_results(), reports or paths.user_reports()
-    check_folder(reports, "--out" if args.out else "the reports folder")
+    check_folder(reports, "--out" if args.out else "--reference" if args.reference else home_option())
     for p in write_reports(Path(results), Path(reports)):
         print(f"wrote {p}", file=sys.stderr)
     return 0
@@ -445,7 +446,8 @@ def main(argv=None) -> int:
     except (SceneError, OptionError, StoreError) as exc:
         parser.exit(2, f"pcabench: error: {exc}\n")
     except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
-        parser.exit(2, f"pcabench: error: {exc.filename or ''}: {exc.strerror or exc}\n")
+        where = f"{exc.filename}: " if exc.filename else ""
+        parser.exit(2, f"pcabench: error: {where}{exc.strerror or exc}\n")
     except SolverUnavailable as exc:
         parser.exit(3, f"pcabench: {exc}\n")
     except KeyboardInterrupt:
