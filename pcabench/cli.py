@@ -16,7 +16,10 @@ import argparse
 import json
 import math
 import os
+import re
 import sys
+import tempfile
+import warnings
 from pathlib import Path
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
@@ -51,12 +54,14 @@ class Parser(argparse.ArgumentParser):
 
 
 # ---------------------------------------------------------------- option types
+DECIMAL = re.compile(r"[+-]?((\d+\.?\d*|\.\d+)(e[+-]?\d+)?|nan|inf|infinity)", re.ASCII | re.I)  # ASCII, as typed
+
+
 def positive_int(name):
     def parse(text):
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1 (got {text!r})") from None
+        if not text.isascii() or not text.strip().lstrip("+-").isdigit():
+            raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1 (got {text!r})")
+        value = int(text)
         if value < 1:
             raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1 (got {value})")
         return value
@@ -65,15 +70,22 @@ def positive_int(name):
 
 def number(name, low: float | None = None):
     def parse(text):
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        if not DECIMAL.fullmatch(text.strip()):
+            raise argparse.ArgumentTypeError(f"{name} must be a number such as 0.5 or 1e-3 (got {text!r})")
+        value = float(text)
         if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
         if low is not None and value < low:
             raise argparse.ArgumentTypeError(f"{name} must be at least {low:g} (got {text!r})")
         return value
+    return parse
+
+
+def folder(name):
+    def parse(text):
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"{name} needs a folder (got {text!r})")
+        return text
     return parse
 
 
@@ -120,14 +132,39 @@ def scene_from_args(args) -> Scene:
 
 
 def check_output_path(path, option: str) -> None:
-    """OptionError naming ``option`` unless a file can be written at ``path`` (checked before any work)."""
+    """OptionError naming ``option`` unless a file can be written at ``path`` (tried before any work)."""
     path = Path(path)
-    if path.is_dir():
-        raise OptionError(f"{option} {path} is a folder; give a file name")
+    if not str(path).strip() or path.is_dir():
+        raise OptionError(f"{option} {str(path)!r} is not a file name")
     if not path.parent.is_dir():
         raise OptionError(f"{option} {path}: the folder {path.parent} does not exist")
-    if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
-        raise OptionError(f"{option} {path} is not writable")
+    existed = path.exists()
+    try:
+        with open(path, "ab"):
+            pass
+    except OSError as exc:
+        raise OptionError(f"{option} {path} is not writable: {exc.strerror or exc}") from None
+    if not existed:
+        path.unlink()
+
+
+def check_folder(path, option: str) -> Path:
+    """OptionError naming ``option`` unless the folder ``path`` can be made and written (tried in the
+    nearest folder that exists, leaving nothing behind)."""
+    path = Path(path)
+    here = path
+    while not here.exists() and here != here.parent:
+        here = here.parent
+    try:
+        tempfile.TemporaryFile(dir=here).close()
+    except OSError as exc:
+        raise OptionError(f"{option} {path} is not a writable folder: {exc.strerror or exc}") from None
+    return path
+
+
+def home_option() -> str:
+    """How the user sets the folder of their profiles and defaults: the variable if set."""
+    return "PCABENCH_HOME" if os.environ.get("PCABENCH_HOME") else "the pcabench home"
 
 
 # ---------------------------------------------------------------- commands
@@ -139,7 +176,9 @@ def cmd_run(args) -> int:
     scene = scene_from_args(args)
     spec = RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto").resolved()
     check_specs([spec])  # the solver can run here (a GPU for linkedlist-gpu), before anything is printed
-    if args.fields:
+    if args.fields is not None:
+        if args.fields.strip() and not args.fields.endswith(".npz"):
+            args.fields += ".npz"  # as numpy.savez names it
         check_output_path(args.fields, "--fields")
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
@@ -216,6 +255,10 @@ def cmd_study(args) -> int:
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
             raise OptionError(f"{flag} must be > 0 seconds (got {value})")
+    if not args.cluster:
+        check_folder(paths.user_profiles(), home_option())  # where the sweep saves this machine's profile
+    if not args.no_report:
+        check_folder(args.reports, "--reports")  # before the sweep, not after it
     if args.cluster:
         from .cluster import cluster_sweep, dask_distributed
 
@@ -255,6 +298,7 @@ def cmd_report(args) -> int:
             raise OptionError("--reference needs a source checkout (its reports/ folder)")
         results, reports = results or paths.reference_results(), reports or paths.reference_reports()
     results, reports = results or paths.user_results(), reports or paths.user_reports()
+    check_folder(reports, "--out" if args.out else "--reference" if args.reference else home_option())
     for p in write_reports(Path(results), Path(reports)):
         print(f"wrote {p}", file=sys.stderr)
     return 0
@@ -358,7 +402,8 @@ def cmd_profile(args) -> int:
         print(asv_machine.write(profile))
         return 0
     if args.save:
-        print(f"wrote {profiles.save(profile, args.out)}", file=sys.stderr)
+        out = check_folder(args.out, "--out") if args.out else check_folder(paths.user_profiles(), home_option())
+        print(f"wrote {profiles.save(profile, out)}", file=sys.stderr)
     print(json.dumps(profile, indent=2))
     return 0
 
@@ -404,8 +449,8 @@ def build_parser() -> argparse.ArgumentParser:
     m.add_argument("--solver", nargs="+", choices=SOLVERS)
     add_scene_options(m, many=True)
     m.add_argument("--strip", action="store_true", help="the thinnest y-periodic strip instead of 20 m")
-    p.add_argument("--results", default=str(paths.user_results()), help=results_help)
-    p.add_argument("--reports", default=str(paths.user_reports()), help=reports_help)
+    p.add_argument("--results", type=folder("--results"), default=str(paths.user_results()), help=results_help)
+    p.add_argument("--reports", type=folder("--reports"), default=str(paths.user_reports()), help=reports_help)
     p.add_argument("--run-budget", type=number("--run-budget"), help="seconds per run before it is a timeout "
                    "(default: quick 120, paper 900, stability 120, matrix 900)")
     p.add_argument("--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0,
@@ -421,12 +466,12 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="regenerate the reports from the stored results")
     p.add_argument("--reference", action="store_true",
                    help="the committed reference: reports/results -> reports/ of the checkout")
-    p.add_argument("--results", help=results_help)
-    p.add_argument("--out", help=reports_help)
+    p.add_argument("--results", type=folder("--results"), help=results_help)
+    p.add_argument("--out", type=folder("--out"), help=reports_help)
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("runs", help="list and filter stored runs, or compare two machines or commits")
-    p.add_argument("--results", help=results_help)
+    p.add_argument("--results", type=folder("--results"), help=results_help)
     p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
     p.add_argument("--solver")
     p.add_argument("--status")
@@ -468,7 +513,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("profile", help="capture this machine's hardware profile")
     p.add_argument("--save", action="store_true", help="store it among the user's profiles")
-    p.add_argument("--out", help=f"folder to store it in (default: {paths.user_profiles()})")
+    p.add_argument("--out", type=folder("--out"), help=f"folder to store it in (default: {paths.user_profiles()})")
     p.add_argument("--no-gpu", action="store_true")
     p.add_argument("--asv", action="store_true",
                    help="write this machine's entry into ~/.asv-machine.json and print its name (for --machine)")
@@ -492,14 +537,21 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    shown = warnings.formatwarning
+    warnings.formatwarning = lambda message, *_, **__: f"pcabench: warning: {message}\n"  # one line each
     try:
         return args.func(args)
     except (SceneError, OptionError, StoreError) as exc:
         parser.exit(2, f"pcabench: error: {exc}\n")
+    except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
+        where = f"{exc.filename}: " if exc.filename else ""
+        parser.exit(2, f"pcabench: error: {where}{exc.strerror or exc}\n")
     except SolverUnavailable as exc:
         parser.exit(3, f"pcabench: {exc}\n")
     except KeyboardInterrupt:
         parser.exit(130, "pcabench: interrupted\n")
+    finally:
+        warnings.formatwarning = shown
 
 
 if __name__ == "__main__":

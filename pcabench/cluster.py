@@ -9,9 +9,10 @@ hang or out-of-memory is recorded as in a local sweep and never takes the
 worker down, and the record carries the worker's hardware profile and host,
 captured there. Every task asks for one ``timing`` resource (and GPU runs for
 one ``GPU``): with one ``timing`` slot per worker, timed runs never share a
-worker's cores or card. The client is the only writer: each record goes to
-its machine's store under ``--results`` as it arrives, so a killed client
-loses no finished run, and rerunning the command resumes. A run whose worker
+worker's cores or card. The client is the only writer: it locks the whole
+``--results`` folder before any work (no other sweep may write there while it
+runs), and each record goes to its machine's store there as it arrives, so a
+killed client loses no finished run, and rerunning the command resumes. A run whose worker
 dies is retried on another worker by Dask (``distributed.scheduler.allowed-failures``
 times), then recorded as ``error`` (lost).
 """
@@ -33,6 +34,7 @@ from .sweep import RETRIED, eta_text, failed_record, run_child
 
 TIMING = "timing"  # one per worker: one timed run at a time
 GPU = "GPU"
+LOOPBACK = "127.0.0.1"  # a local cluster (scheduler, workers, dashboard) listens here only
 
 
 def dask_distributed():
@@ -45,7 +47,8 @@ def dask_distributed():
 
 
 def connect(address: str, stack: ExitStack):
-    """A Client for ``address``: ``local:N`` starts a LocalCluster of N one-thread workers (closed with ``stack``)."""
+    """A Client for ``address``: ``local:N`` starts a LocalCluster of N one-thread workers on loopback only
+    (closed with ``stack``)."""
     dd = dask_distributed()
     if address.startswith("local:"):
         try:
@@ -55,7 +58,8 @@ def connect(address: str, stack: ExitStack):
         if n < 1:
             raise OptionError(f"--cluster local:N needs N >= 1 workers (got {address!r})")
         cluster = stack.enter_context(dd.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                                      dashboard_address=":0", resources={TIMING: 1}))
+                                                      host=LOOPBACK, dashboard_address=f"{LOOPBACK}:0",
+                                                      resources={TIMING: 1}))
         return stack.enter_context(dd.Client(cluster))
     if "://" not in address:
         raise OptionError(f"--cluster must be a scheduler address such as tcp://host:8786, or local:N "
@@ -89,21 +93,24 @@ def cluster_sweep(specs: list[RunSpec], results: Path, run_budget: float, addres
                   retry_failed: bool = False) -> list[dict]:
     """Run ``specs`` as Dask tasks on the cluster at ``address``; each record stored as it arrives."""
     results = Path(results)
-    results.mkdir(parents=True, exist_ok=True)
+    with store.SweepLock(results, whole_folder=True) as lock:  # before any work: every store it may write
+        return _cluster_sweep(specs, results, run_budget, address, stream, retry_failed, Stores(results, lock))
+
+
+def _cluster_sweep(specs, results, run_budget, address, stream, retry_failed, stores) -> list[dict]:
     commit = git_commit()
     rows = store.read_rows(results)
     # on a cluster a run may land on any worker: it is done once stored from any of them
     done = {_unplaced(r["solver"], r.get("threads", 1), r.get("scene") or {}, r.get("preset", ""), r.get("commit"),
                       r.get("pair_loop", "")) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
-    specs = [s.resolved() for s in specs]
+    specs = list(dict.fromkeys(s.resolved() for s in specs))  # a run given twice is run once
     todo = [s for s in specs if _unplaced(s.solver, s.threads, s.scene, s.preset, commit, s.pair_loop) not in done]
     for s in specs:
         if s not in todo:
             print(f"{s.label}: already stored", file=stream, flush=True)
     finished = [r for r in rows if r.get("status") == "ok"]
-    stored, stores = [], Stores(results)
+    stored = []
     with ExitStack() as stack:
-        stack.enter_context(stores)
         client = connect(address, stack)
         print(f"pcabench: Dask dashboard at {client.dashboard_link}", file=stream, flush=True)
         workers = worker_resources(client)
@@ -153,21 +160,16 @@ def _unplaced(solver, threads, scene, preset, commit, pair_loop) -> str:
 
 
 class Stores:
-    """The client's stores under ``results``, one per machine; each locked from its first write to the end."""
+    """The client's stores under ``results``, one per machine, all under ``lock`` (the folder's, held by the
+    cluster sweep); each store's reserve is kept from its first write."""
 
-    def __init__(self, results: Path):
-        self.results, self.locks = results, {}
+    def __init__(self, results: Path, lock: store.SweepLock):
+        self.results, self.lock, self.paths = results, lock, set()
 
     def append(self, row: dict) -> dict:
         path = self.results / store.store_name(row["profile_id"], row.get("host") or host_id())
-        if path not in self.locks:
+        if path not in self.paths:
             store.check_writable(path)
-            self.locks[path] = store.SweepLock(path).__enter__()
+            self.lock.keep_reserve(path)
+            self.paths.add(path)
         return store.append(row, path)
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        for lock in self.locks.values():
-            lock.__exit__(*exc)

@@ -27,12 +27,17 @@ import json
 import os
 import platform
 import re
+import warnings
 from pathlib import Path
 
 from . import paths
 
 MACHINE_ID_ENV = "PCABENCH_MACHINE_ID"  # the id a sweep gives its children
 FAKE_GPU_ENV = "PCABENCH_FAKE_GPU"  # test hook: a card name gpu_info() reports
+
+class ProfileWarning(UserWarning):
+    """A stored hardware profile was skipped (not JSON, or not an object)."""
+
 
 # Datasheet peaks for cards we know (FP32/FP64 TFLOP/s without tensor cores, TB/s).
 DATASHEET = {
@@ -168,10 +173,19 @@ def _folders() -> list[Path]:
 
 
 def stored() -> dict:
-    """Every stored profile by id."""
+    """Every stored profile by id; a file that is not a JSON object is skipped with one warning naming it."""
     out = {}
     for folder in _folders():
-        out.update({p.stem: json.loads(p.read_text()) for p in sorted(folder.glob("*.json"))})
+        for p in sorted(folder.glob("*.json")):
+            try:
+                profile = json.loads(p.read_bytes().decode("utf-8"))
+            except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not JSON
+                profile = f"{type(exc).__name__}: {exc}"
+            if isinstance(profile, dict):
+                out[p.stem] = profile
+            else:
+                warnings.warn(f"{p}: not a hardware profile (a JSON object), skipped ({str(profile)[:80]})",
+                              ProfileWarning, stacklevel=2)
     return out
 
 

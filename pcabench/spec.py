@@ -39,6 +39,8 @@ def parse_threads(text) -> int | str:
     if isinstance(text, str) and text.strip().lower() == ALL_CORES:
         return ALL_CORES
     try:
+        if isinstance(text, bool) or isinstance(text, str) and not text.isascii():
+            raise ValueError  # True is not a count, nor are digits of other scripts
         value = int(text)
     except (TypeError, ValueError):
         raise OptionError(f"--threads must be an integer >= 1 or 'all' (got {text!r})") from None

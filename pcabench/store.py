@@ -6,14 +6,21 @@ the guarantees below make the plain file as safe as a database for one
 writer at a time.
 
 - Every write takes an exclusive lock on the file (``fcntl.flock``), repairs
-  a torn tail left by a crash or a full disk (the partial line is moved to
-  ``<store>.torn`` and the file cut back to its last complete line), then
-  appends one line and fsyncs. A torn record never takes a good one with it.
-- A sweep holds ``<store>.lock`` for its whole life (:class:`SweepLock`), so a
-  second sweep on the same store is refused at once, with the first's pid.
-- Every row carries ``schema`` (:data:`SCHEMA`) and is validated on load:
-  a bad row is skipped with one warning naming the file and line, a row of a
-  newer schema is reported as such, and nothing crashes on them.
+  its tail (a complete last record that only lacks its newline gets it; a
+  partial line left by a crash is moved to ``<store>.torn`` and the file cut
+  back to its last complete line), then appends one line and fsyncs. A write
+  that fails (a full disk) is cut back off: no partial line is left.
+- A sweep holds its store's lock for its whole life (:class:`SweepLock`), so a
+  second sweep on the same store is refused at once, with the first's pid; it
+  also keeps ``<store>.reserve``, space given up to store the record that
+  meets a full disk, after which the sweep stops.
+- Nothing is written through a symbolic link: a store, lock, reserve or
+  ``.torn`` file that is one is refused.
+- Every row carries ``schema`` (:data:`SCHEMA`) and is validated on load
+  (:func:`validate`: types, ranges, finite numbers, names safe as file names,
+  no control characters): a bad row is skipped with one warning naming the
+  file and line, a row of a newer schema is reported as such, and nothing
+  crashes on them.
 - Stores taken on different machines merge by concatenation: a record keeps
   its ``run_id`` wherever it is copied, and duplicates are dropped on load.
 """
@@ -25,22 +32,34 @@ import hashlib
 import json
 import math
 import os
+import re
 import shutil
+import sys
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from .record import STEP_STAGES
+from solvers import Scene, SceneError
+from solvers.scene import MAX_STEPS
+
+from .record import STATUSES, STEP_STAGES
 
 SCHEMA = 2  # version of the row format; rows from before versioning are schema 1
 REQUIRED = {"solver": str, "status": str, "n_particles": int, "steps": int, "dx": (int, float),
             "stages": dict, "scene": dict, "profile_id": str}
 MIN_FREE_BYTES = 1 << 20  # a sweep needs room for its records: refuse to start with less free space
+RESERVE_BYTES = 1 << 18  # <store>.reserve: room for the record that meets a full disk
+MAX_SECONDS = 1e9  # a stage time above this (31 years) is not a measurement
+NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*", re.ASCII)  # a machine or host name, safe as a file name
+CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 
 
 class StoreWarning(UserWarning):
     """A row of a store was skipped (torn, corrupt, invalid, or from a newer schema)."""
+
+
+FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)  # the disk (or the quota, or the file size limit) is full
 
 
 class StoreError(OSError):
@@ -59,6 +78,8 @@ def _clean(value):
         return None
     if isinstance(value, dict):
         return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
     return value
 
 
@@ -70,11 +91,29 @@ def to_row(record) -> dict:
     return row
 
 
+def check_name(name, what: str) -> str:
+    """``name`` if it is safe as a file name (letters, digits, ``. _ -``; not starting with a dot or dash);
+    else StoreError naming ``what``."""
+    if not isinstance(name, str) or not NAME.fullmatch(name):
+        raise StoreError(f"{what} {name!r} is not a safe name (letters, digits, '.', '_', '-')")
+    return name
+
+
 def store_name(profile_id: str, host: str | None = None) -> str:
     """The file name of a machine's store: hardware profile and host, so two hosts never share one by accident."""
     from .provenance import host_id
 
-    return f"{profile_id}--{host or host_id()}.jsonl"
+    return f"{check_name(profile_id, 'profile_id')}--{check_name(host or host_id(), 'host')}.jsonl"
+
+
+def _open(path, flags: int, mode: int = 0o644) -> int:
+    """``os.open`` that refuses a symbolic link (StoreError naming the path)."""
+    try:
+        return os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC, mode)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise StoreError(f"{path} is a symbolic link; pcabench writes only regular files") from None
+        raise
 
 
 def check_writable(path) -> Path:
@@ -82,9 +121,10 @@ def check_writable(path) -> Path:
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "a", encoding="utf-8"):
-            pass
+        os.close(_open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT))
     except OSError as exc:
+        if isinstance(exc, StoreError):
+            raise
         raise StoreError(f"results store {path} is not writable: {exc.strerror or exc}") from None
     free = shutil.disk_usage(path.parent).free
     if free < MIN_FREE_BYTES:
@@ -93,107 +133,225 @@ def check_writable(path) -> Path:
     return path
 
 
-def _repair_tail(f, path: Path) -> None:
-    """Cut a torn last line (no newline) off the locked file ``f``, keeping it in ``<store>.torn``."""
-    size = os.fstat(f.fileno()).st_size
-    if size == 0:
+def _write_all(fd: int, data: bytes) -> None:
+    while data:
+        data = data[os.write(fd, data):]
+
+
+def _complete(line: bytes) -> bool:
+    """Whether ``line`` is a whole record (a crash cuts a record's closing brace off, so a cut one never is)."""
+    try:
+        return validate(json.loads(line.decode("utf-8"), parse_constant=_no_constant)) == ""
+    except ValueError:
+        return False
+
+
+def _repair_tail(fd: int, path: Path) -> None:
+    """Mend the last line of the locked store ``fd`` if it lacks its newline: a whole record gets the
+    newline; a torn line is moved to ``<store>.torn`` and the file cut back to its last complete line."""
+    size = os.fstat(fd).st_size
+    if size == 0 or os.pread(fd, 1, size - 1) == b"\n":
         return
-    f.seek(size - 1)
-    if f.read(1) == b"\n":
-        return
-    # find the last newline before the torn tail
-    pos, block = size, 1 << 16
-    start = 0
-    while pos > 0:
-        step = min(block, pos)
+    pos, start = size, 0
+    while pos > 0:  # find the last newline before the tail
+        step = min(1 << 16, pos)
         pos -= step
-        f.seek(pos)
-        chunk = f.read(step)
-        k = chunk.rfind(b"\n")
+        k = os.pread(fd, step, pos).rfind(b"\n")
         if k >= 0:
             start = pos + k + 1
             break
-    f.seek(start)
-    torn = f.read()
-    with open(f"{path}.torn", "ab") as t:
-        t.write(torn + b"\n")
-    f.truncate(start)
-    warnings.warn(f"{path}: a torn last line ({len(torn)} bytes, a write cut short) was moved to {path}.torn",
+    tail = os.pread(fd, size - start, start)
+    if _complete(tail):
+        _write_all(fd, b"\n")
+        return
+    torn = _open(f"{path}.torn", os.O_WRONLY | os.O_APPEND | os.O_CREAT)
+    try:
+        _write_all(torn, tail + b"\n")
+        os.fsync(torn)
+    finally:
+        os.close(torn)
+    os.ftruncate(fd, start)
+    warnings.warn(f"{path}: a torn last line ({len(tail)} bytes, a write cut short) was moved to {path}.torn",
                   StoreWarning, stacklevel=3)
 
 
+def reserve_path(path) -> Path:
+    """The space a sweep keeps beside its store, given up to store the record that meets a full disk."""
+    return Path(f"{path}.reserve")
+
+
+def keep_reserve(path) -> Path:
+    """Make the reserve of the store at ``path`` (:data:`RESERVE_BYTES`) unless it exists; its path."""
+    reserve = reserve_path(path)
+    try:
+        fd = _open(reserve, os.O_WRONLY | os.O_CREAT | os.O_EXCL)
+    except FileExistsError:
+        return reserve
+    try:
+        _write_all(fd, bytes(RESERVE_BYTES))
+    finally:
+        os.close(fd)
+    return reserve
+
+
 def append(record, path) -> dict:
-    """Append one run record (a RunRecord or dict) to the store at ``path`` safely; returns the row."""
+    """Append one run record (a RunRecord or dict) to the store at ``path`` safely; returns the row.
+
+    A failed write leaves the file as it was. On a full disk the store's reserve (:class:`SweepLock`),
+    if any, is given up and the write tried again: the record is then stored, and StoreError says the
+    disk is full all the same, so that the sweep stops.
+    """
     row = to_row(record)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    line = (json.dumps(row, sort_keys=True) + "\n").encode("utf-8")
+    line = (json.dumps(row, sort_keys=True, allow_nan=False) + "\n").encode("utf-8")
+    freed = False
     try:
-        with open(path, "a+b") as f:
-            fcntl.flock(f.fileno(), fcntl.LOCK_EX)
-            try:
-                _repair_tail(f, path)
-                before = f.seek(0, os.SEEK_END)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd = _open(path, os.O_RDWR | os.O_APPEND | os.O_CREAT)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            while True:
+                _repair_tail(fd, path)
+                before = os.fstat(fd).st_size
                 try:
-                    f.write(line)
-                    f.flush()
-                    os.fsync(f.fileno())
-                except OSError:
-                    f.truncate(before)  # a full disk leaves no torn line behind
-                    raise
-            finally:
-                fcntl.flock(f.fileno(), fcntl.LOCK_UN)
+                    _write_all(fd, line)
+                    os.fsync(fd)
+                    break
+                except OSError as exc:
+                    os.ftruncate(fd, before)  # a failed write leaves no partial line behind
+                    reserve = reserve_path(path)
+                    if exc.errno not in FULL or freed or not reserve.is_file() or reserve.is_symlink():
+                        raise
+                    reserve.unlink()
+                    freed = True
+        finally:
+            os.close(fd)  # and with it the lock
+    except StoreError:
+        raise
     except OSError as exc:
-        if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        if exc.errno in FULL:
             raise StoreError(f"results store {path}: the disk is full; the record was not stored") from None
         raise StoreError(f"results store {path} is not writable: {exc.strerror or exc}") from None
+    if freed:
+        raise StoreError(f"results store {path}: the disk is full; this run's record was stored in the space "
+                         "kept for it, and the sweep stops: free some space and rerun to resume")
     return row
 
 
 class SweepLock:
-    """Held by a sweep for its whole life: a second sweep on the same store is refused (StoreError)."""
+    """Held by a sweep for its whole life, before any work: a second sweep on the same store is refused
+    (StoreError naming the holder).
 
-    def __init__(self, store_path):
-        self.path = Path(f"{store_path}.lock")
-        self.file = None
+    ``SweepLock(store_path)`` locks one store: ``<store>.lock`` exclusively and the folder's
+    ``.sweeps.lock`` shared, and keeps ``<store>.reserve`` (see :func:`append`) until released.
+    ``SweepLock(folder, whole_folder=True)`` locks every store of a folder, as a cluster sweep (whose
+    records may belong to any machine) needs: ``.sweeps.lock`` exclusively.
+    """
+
+    FOLDER_LOCK = ".sweeps.lock"
+
+    def __init__(self, path, whole_folder: bool = False):
+        path = Path(path)
+        self.folder = path if whole_folder else path.parent
+        self.store = None if whole_folder else path
+        self.fds, self.reserves = [], []
+
+    def _lock(self, path: Path, how: int, what: str, holder_wrote_pid: bool = True) -> int:
+        fd = _open(path, os.O_RDWR | os.O_CREAT)
+        self.fds.append(fd)
+        try:
+            fcntl.flock(fd, how | fcntl.LOCK_NB)
+        except BlockingIOError:  # only an exclusive holder writes its pid
+            holder = os.pread(fd, 200, 0).decode("utf-8", "replace").strip() if holder_wrote_pid else ""
+            self.__exit__()
+            raise StoreError(f"{what} is in use by another sweep{f' ({holder})' if holder else ''}; "
+                             "wait for it, or give this one its own --results folder") from None
+        return fd
 
     def __enter__(self):
-        self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.file = open(self.path, "a+")
         try:
-            fcntl.flock(self.file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            self.file.seek(0)
-            holder = self.file.read().strip() or "another process"
-            self.file.close()
-            raise StoreError(f"results store {str(self.path)[:-5]} is in use by another sweep ({holder}); "
-                             "wait for it, or give this one its own --results folder") from None
-        self.file.seek(0)
-        self.file.truncate()
-        self.file.write(f"pid {os.getpid()}")
-        self.file.flush()
+            self.folder.mkdir(parents=True, exist_ok=True)
+            if self.store is None:
+                fd = self._lock(self.folder / self.FOLDER_LOCK, fcntl.LOCK_EX, f"results folder {self.folder}",
+                                holder_wrote_pid=False)
+            else:
+                self._lock(self.folder / self.FOLDER_LOCK, fcntl.LOCK_SH,
+                           f"results folder {self.folder} (a cluster sweep)")
+                fd = self._lock(Path(f"{self.store}.lock"), fcntl.LOCK_EX, f"results store {self.store}")
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"pid {os.getpid()}".encode(), 0)
+            if self.store is not None:
+                self.reserves.append(keep_reserve(self.store))
+        except StoreError:
+            self.__exit__()
+            raise
+        except OSError as exc:
+            self.__exit__()
+            raise StoreError(f"results folder {self.folder} is not writable: {exc.strerror or exc}") from None
         return self
 
+    def keep_reserve(self, store_path) -> None:
+        """Keep a reserve for another store of the locked folder too (a cluster sweep's), while locked."""
+        self.reserves.append(keep_reserve(store_path))
+
     def __exit__(self, *exc):
-        fcntl.flock(self.file.fileno(), fcntl.LOCK_UN)
-        self.file.close()
+        for reserve in self.reserves:
+            reserve.unlink(missing_ok=True)
+        for fd in self.fds:
+            os.close(fd)
+        self.fds, self.reserves = [], []
+
+
+def _no_constant(name):
+    raise ValueError(f"{name} is not standard JSON")
 
 
 def validate(row) -> str:
-    """Why ``row`` is not a usable run record ('' if it is)."""
+    """Why ``row`` is not a usable run record ('' if it is): types, ranges, finite numbers, safe names."""
     if not isinstance(row, dict):
         return f"not a record but a JSON {type(row).__name__}"
     version = row.get("schema", 1)
-    if not isinstance(version, int) or version > SCHEMA:
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        return f"'schema' must be an integer >= 1 (got {version!r})"
+    if version > SCHEMA:
         return f"a row of a newer pcabench (schema {version}; this one reads up to {SCHEMA}): upgrade to read it"
     for key, kind in REQUIRED.items():
         if key not in row:
             return f"missing {key!r}"
         if not isinstance(row[key], kind) or isinstance(row[key], bool):
             return f"{key!r} is {type(row[key]).__name__}, not {getattr(kind, '__name__', 'a number')}"
-    missing = [s for s in STEP_STAGES if not isinstance(row["stages"].get(s), (int, float))]
+    bad = [key for key, value in [*row.items(), *row["scene"].items()]
+           if key != "message" and isinstance(value, str) and CONTROL.search(value)]
+    if bad:
+        return f"{bad[0]!r} holds control characters"
+    if row["status"] not in STATUSES:
+        return f"'status' must be one of {', '.join(STATUSES)} (got {row['status']!r})"
+    for key in ("profile_id", "host"):  # they name the machine's files and report folder
+        if (key == "profile_id" or row.get(key)) and not NAME.fullmatch(str(row.get(key))):
+            return f"{key!r} must be a name of letters, digits, '.', '_', '-' (got {row.get(key)!r})"
+    if not 0 <= row["steps"] <= MAX_STEPS:
+        return f"'steps' must be in [0, {MAX_STEPS}] (got {row['steps']})"
+    if not 0 <= row["n_particles"] <= 2**31 - 1:
+        return f"'n_particles' must be in [0, 2^31-1] (got {row['n_particles']})"
+    if not 0 < row["dx"] < math.inf:
+        return f"'dx' must be a finite number > 0 (got {row['dx']})"
+    threads = row.get("threads")
+    if threads is not None and (not isinstance(threads, int) or isinstance(threads, bool) or threads < 1):
+        return f"'threads' must be an integer >= 1 (got {threads!r})"
+    for stage, seconds in row["stages"].items():
+        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool) or not 0 <= seconds <= MAX_SECONDS:
+            return f"stage {stage!r} must be a time in [0, {MAX_SECONDS:g}] s (got {seconds!r})"
+    missing = [s for s in STEP_STAGES if s not in row["stages"]]
     if missing:
         return f"stages lack {', '.join(missing)}"
+    if "dx" not in row["scene"]:
+        return "'scene' lacks dx"
+    fields = Scene.__dataclass_fields__
+    try:
+        Scene(**{k: v for k, v in row["scene"].items() if k in fields and fields[k].compare},
+              memory_limit_bytes=sys.maxsize)
+    except (SceneError, TypeError) as exc:
+        return f"'scene' is not a valid scene ({exc})"
     return ""
 
 
@@ -220,11 +378,13 @@ def read_rows(paths) -> list[dict]:
                     warnings.warn(f"{file}:{number}: a blank line, skipped", StoreWarning, stacklevel=2)
                     continue
                 try:
-                    row = json.loads(raw.decode("utf-8"))
+                    row = json.loads(raw.decode("utf-8"), parse_constant=_no_constant)
                 except UnicodeDecodeError:
                     why = "not UTF-8 text"
                 except json.JSONDecodeError as exc:
                     why = f"not JSON ({exc.msg}; a torn or hand-edited line?)"
+                except ValueError as exc:  # NaN or Infinity
+                    why = f"not standard JSON ({exc})"
                 else:
                     why = validate(row)
                 if why:

@@ -8,8 +8,8 @@ leaves no run going on unsupervised. The sweep holds the store's lock and is
 its only writer; every finished run is appended at once, and a rerun skips
 the runs the store already holds for this machine (hardware profile and
 host), commit and preset (:func:`pcabench.spec.identity`), so an interrupted
-sweep resumes where it stopped; ``retry_failed`` reruns timeouts, skips and
-errors. A run predicted to take longer than the run budget is stored as
+sweep resumes where it stopped (a run given twice is run once); ``retry_failed``
+reruns timeouts, skips and errors. A run predicted to take longer than the run budget is stored as
 ``skipped`` with the prediction.
 """
 from __future__ import annotations
@@ -24,6 +24,8 @@ import threading
 import time
 from pathlib import Path
 
+from solvers.scene import cgroup_memory_folders
+
 from . import store
 from .predict import predicted_seconds
 from .profiles import MACHINE_ID_ENV, machine_id
@@ -32,7 +34,6 @@ from .record import RunRecord, step_seconds
 from .spec import RunSpec, identity, row_identity
 
 RETRIED = ("timeout", "skipped", "error")  # statuses --retry-failed runs again
-OOM_EVENTS = "/sys/fs/cgroup/memory.events"  # cgroup v2: counts the kernel's OOM kills
 
 
 def failed_record(spec: RunSpec, status: str, message: str, profile: str, seconds: float | None = None) -> RunRecord:
@@ -54,15 +55,16 @@ def _die_with_parent() -> None:
 
 
 def oom_kills() -> int | None:
-    """The cgroup's count of OOM kills so far, or None where the kernel does not say."""
-    try:
-        with open(OOM_EVENTS) as f:
-            for line in f:
-                if line.startswith("oom_kill "):
-                    return int(line.split()[1])
-    except (OSError, ValueError):
-        pass
-    return None
+    """The kernel's count of OOM kills so far in this process's cgroup and its ancestors (v2
+    ``memory.events``, v1 ``memory.oom_control``), or None where the kernel does not say."""
+    counts = []
+    for *_, events in cgroup_memory_folders():
+        try:
+            with open(events) as f:
+                counts += [int(line.split()[1]) for line in f if line.startswith("oom_kill ")]
+        except (OSError, ValueError, IndexError):
+            pass
+    return sum(counts) if counts else None
 
 
 def exit_status(returncode: int, oom_before: int | None, oom_after: int | None) -> tuple[str, str]:
@@ -162,7 +164,7 @@ def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed, ru
     done = {row_identity(r) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
     mine = [r for r in rows if r.get("profile_id") == profile and r.get("host") == host]
     t_start, stored, failed = time.perf_counter(), [], 0
-    specs = [s.resolved() for s in specs]
+    specs = list(dict.fromkeys(s.resolved() for s in specs))  # a run given twice is run once
     for i, spec in enumerate(specs, 1):
         label = f"[{i}/{len(specs)}] {spec.label}"
         if identity(spec.solver, spec.threads, spec.scene, spec.preset, profile, commit, host,

@@ -93,17 +93,26 @@ class LinkedListCPU(CellListSolver):
         self.pair_loop = self.choose_pair_loop(scene, self.requested_pair_loop)
 
     @staticmethod
-    def choose_pair_loop(scene, requested: str = "auto") -> str:
+    def list_fits(scene) -> bool:
+        """Whether the particle arrays and the pair list fit in the scene's memory limit."""
+        return scene.memory_bytes() + pairlist.list_bytes(scene) <= scene.memory_limit()
+
+    @classmethod
+    def choose_pair_loop(cls, scene, requested: str = "auto") -> str:
         """``auto``: ``list`` where the arrays and the pair list fit in the scene's memory limit, else ``gather``."""
         if requested != "auto":
             return requested
-        fits = scene.memory_bytes() + pairlist.list_bytes(scene) <= scene.memory_limit()
-        return "list" if fits else "gather"
+        return "list" if cls.list_fits(scene) else "gather"
 
     def check_scene(self, scene) -> None:
         if not isinstance(self.threads, int) or not 1 <= self.threads <= numba.config.NUMBA_NUM_THREADS:
             raise SceneError(f"threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} "
                              f"on this machine (got {self.threads!r})")
+        if self.requested_pair_loop == "list" and not self.list_fits(scene):
+            arrays, pairs = scene.memory_bytes(), pairlist.list_bytes(scene)
+            raise SceneError(f"pair_loop list: dx = {scene.dx} m needs {pairs / 2**30:.3g} GiB of pair list and "
+                             f"{arrays / 2**30:.3g} GiB of arrays, more than the {scene.memory_limit() / 2**30:.3g} "
+                             "GiB available; use --pair-loop gather (or auto)")
 
     def probe(self) -> "LinkedListCPU":
         return type(self)(threads=self.threads, pair_loop=self.pair_loop)

@@ -30,6 +30,8 @@ INT_ARRAYS_PER_PARTICLE = 4  # cell id, permutation, sort scratch (int32/int64)
 # list's 3-row stencil without seeing a neighbour twice: this many cutoffs.
 STRIP_CUTOFFS = 3.0
 
+MAX_STEPS = 10_000_000  # the most steps a run may take (1e7)
+
 # Scene parameters that choose the numerical method rather than the physics.
 NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor")
 
@@ -47,14 +49,41 @@ def _read_int(path: str) -> int | None:
         return None
 
 
-# cgroup (v2, then v1) files of the memory limit and the usage: (limit, usage)
-CGROUP_FILES = (("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
-                ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"))
+CGROUP_MOUNT = "/sys/fs/cgroup"
+PROC_CGROUP = "/proc/self/cgroup"  # this process's cgroup in each hierarchy
+# cgroup v2 (the unified hierarchy at the mount) and v1 (its memory hierarchy): folder, limit, usage, events
+CGROUP_MEMORY = (("", "memory.max", "memory.current", "memory.events"),
+                 ("memory", "memory.limit_in_bytes", "memory.usage_in_bytes", "memory.oom_control"))
+
+
+def cgroup_memory_folders() -> list[tuple[str, str, str, str]]:
+    """``(folder, limit, usage, events)`` files of this process's memory cgroup and each of its ancestors,
+    v2 then v1, innermost first: every level's limit applies, and a nested one may be the smallest."""
+    own = {}
+    try:
+        with open(PROC_CGROUP) as f:
+            for line in f:
+                _, controllers, path = line.rstrip("\n").split(":", 2)
+                for sub, *_ in CGROUP_MEMORY:
+                    if (controllers == "") if sub == "" else (sub in controllers.split(",")):
+                        own[sub] = path
+    except (OSError, ValueError):
+        pass
+    out = []
+    for sub, limit, usage, events in CGROUP_MEMORY:
+        parts = [p for p in own.get(sub, "/").split("/") if p not in ("", ".", "..")]
+        for k in range(len(parts), -1, -1):
+            folder = os.path.join(CGROUP_MOUNT, sub, *parts[:k])
+            if os.path.isdir(folder):
+                out.append((folder, os.path.join(folder, limit), os.path.join(folder, usage),
+                            os.path.join(folder, events)))
+    return out
 
 
 def available_memory_bytes() -> int:
     """Memory this process may still use, bytes: the smallest of the host's available memory
-    (MemAvailable) and the cgroup's limit less its usage (cgroup v2 memory.max, or v1's limit)."""
+    (MemAvailable) and, at every level of its cgroup (v2 memory.max, v1 memory.limit_in_bytes), the
+    limit less the usage."""
     limits = []
     try:
         with open("/proc/meminfo") as f:
@@ -63,7 +92,7 @@ def available_memory_bytes() -> int:
                     limits.append(int(line.split()[1]) * 1024)
     except (OSError, ValueError):
         pass
-    for limit_path, usage_path in CGROUP_FILES:
+    for _, limit_path, usage_path, _ in cgroup_memory_folders():
         limit = _read_int(limit_path)
         if limit is not None and limit < 2**60:
             limits.append(max(limit - (_read_int(usage_path) or 0), 0))
@@ -150,6 +179,9 @@ class Scene:
              f"cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core (got {self.cutoff_factor})")
         need(self.cutoff_factor <= 5.0,
              f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7")
+        need(self.h_factor * self.cutoff_factor > 1,
+             f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
+             f"(got {self.cutoff_factor:g} * {self.h_factor:g} = {self.cutoff_factor * self.h_factor:g})")
         need(self.cfl > 0, f"cfl (dt*c0/dx) must be > 0 (got {self.cfl}); dt must be positive")
         need(self.cfl <= 50, f"cfl (dt*c0/dx) must be <= 50 (got {self.cfl})")
         need(self.blowup_factor > 1, f"blowup_factor must be > 1 (got {self.blowup_factor})")
@@ -162,11 +194,11 @@ class Scene:
         if self.steps is not None:
             need(isinstance(self.steps, int) and not isinstance(self.steps, bool) and self.steps >= 1,
                  f"steps must be an integer >= 1 (got {self.steps!r})")
-            need(self.steps <= 10_000_000, f"steps must be <= 1e7 (got {self.steps})")
+            need(self.steps <= MAX_STEPS, f"steps must be <= 1e7 (got {self.steps})")
         if self.t_end is not None:
             finite("t_end")
             need(self.t_end > 0, f"t_end must be > 0 s (got {self.t_end})")
-            need(self.t_end / self.dt_max <= 10_000_000,
+            need(self.t_end / self.dt_max <= MAX_STEPS,
                  f"t_end = {self.t_end} s needs more than 1e7 steps at dt = {self.dt_max:g} s")
         least = STRIP_CUTOFFS * self.cutoff
         need(self.height >= least * (1 - 1e-9),

@@ -40,25 +40,35 @@ def test_a_cluster_sweep_makes_the_same_runs_as_a_serial_one_and_resumes(tmp_pat
     assert len(store.read_rows(dask)) == 4
 
 
+def children(pid: int) -> list[int]:
+    """The processes whose parent is ``pid``."""
+    out = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True).stdout.split()
+    return [int(p) for p in out]
+
+
+def run_child_under_a_worker(root: int) -> tuple[int, int] | None:
+    """(worker, run child) among the descendants of ``root`` only: a test signals only what it started."""
+    for worker in children(root):
+        for child in children(worker):
+            try:
+                if b"pcabench.child" in open(f"/proc/{child}/cmdline", "rb").read():
+                    return worker, child
+            except OSError:
+                continue
+    return None
+
+
 def test_a_killed_worker_loses_and_duplicates_nothing(tmp_path):
     args = ["--dx", "0.25", "0.2", "--steps", "150", "--no-report", "--cluster", "local:2"]
     proc = subprocess.Popen([sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(tmp_path)],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    worker = None
+    found = None
     deadline = time.time() + 180
-    while time.time() < deadline and worker is None and proc.poll() is None:
-        out = subprocess.run(["pgrep", "-f", "pcabench.child"], capture_output=True, text=True).stdout.split()
-        for pid in out:
-            try:
-                ppid = int(next(l for l in open(f"/proc/{pid}/status") if l.startswith("PPid:")).split()[1])
-            except (OSError, StopIteration):
-                continue
-            if ppid != proc.pid:  # a run's child under a Dask worker process
-                worker = ppid
-                break
+    while time.time() < deadline and found is None and proc.poll() is None:
+        found = run_child_under_a_worker(proc.pid)
         time.sleep(0.1)
-    assert worker is not None, "no run started on a worker"
-    os.kill(worker, 9)  # the worker dies mid-run; its run's child dies with it
+    assert found is not None, "no run started on a worker of this test's cluster"
+    os.kill(found[0], 9)  # the worker dies mid-run; its run's child dies with it
     _, err = proc.communicate(timeout=600)
     assert proc.returncode == 0, err[-2000:]
     rows = store.read_rows(tmp_path)
@@ -80,3 +90,19 @@ def test_bad_cluster_addresses_are_one_line(address, capsys, tmp_path):
         cli.main(["study", *SWEEP, "--cluster", address, "--results", str(tmp_path)])
     err = capsys.readouterr().err
     assert exc.value.code == 2 and "--cluster" in err and "Traceback" not in err
+
+
+def test_a_local_cluster_listens_on_loopback_only():
+    from contextlib import ExitStack
+
+    import psutil
+
+    from pcabench.cluster import connect
+
+    with ExitStack() as stack:
+        client = connect("local:1", stack)
+        here = psutil.Process()
+        listening = [c.laddr for p in (here, *here.children(recursive=True))
+                     for c in p.net_connections("inet") if c.status == psutil.CONN_LISTEN]
+        assert listening and all(addr.ip == "127.0.0.1" for addr in listening), listening
+        assert "127.0.0.1" in client.dashboard_link

@@ -2,6 +2,7 @@
 unwritable and full stores, corrupt rows, killed children, retries, and the memory actually available."""
 from __future__ import annotations
 
+import errno
 import json
 import os
 import signal
@@ -199,11 +200,20 @@ def test_retry_failed_runs_timeouts_skips_and_errors_again(tmp_path, monkeypatch
 
 
 # ---------------------------------------------------------------- memory and numeric options
+def fake_cgroups(tmp_path, monkeypatch, proc_cgroup: str, files: dict) -> None:
+    """A cgroup mount under tmp_path: ``proc_cgroup`` is this process's /proc/self/cgroup, ``files`` maps
+    a path under the mount to its text."""
+    (tmp_path / "proc_cgroup").write_text(proc_cgroup)
+    for rel, text in files.items():
+        (tmp_path / "cg" / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / "cg" / rel).write_text(text)
+    monkeypatch.setattr(scene_module, "CGROUP_MOUNT", str(tmp_path / "cg"))
+    monkeypatch.setattr(scene_module, "PROC_CGROUP", str(tmp_path / "proc_cgroup"))
+
+
 def test_the_memory_check_uses_the_cgroup_limit(tmp_path, monkeypatch):
-    limit, usage = tmp_path / "memory.max", tmp_path / "memory.current"
-    limit.write_text(f"{1 << 30}\n")
-    usage.write_text(f"{256 << 20}\n")
-    monkeypatch.setattr(scene_module, "CGROUP_FILES", ((str(limit), str(usage)),))
+    fake_cgroups(tmp_path, monkeypatch, "0::/\n", {"memory.max": f"{1 << 30}\n", "memory.current": f"{256 << 20}\n"})
+    limit = tmp_path / "cg" / "memory.max"
     assert scene_module.available_memory_bytes() == (1 << 30) - (256 << 20)
     with pytest.raises(SceneError, match="smallest dx that fits"):
         Scene(dx=0.01)  # 10M particles: about 2.4 GB of arrays, more than the 0.75 GiB left in the cgroup
@@ -228,3 +238,278 @@ def test_numeric_options_refuse_meaningless_values_in_run_and_study(command, arg
     assert exc.value.code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
     assert all(w in err for w in words), err
     assert not list(tmp_path.glob("*.jsonl"))
+
+
+# ---------------------------------------------------------------- hostile input (issue 21)
+def test_a_last_record_without_its_newline_is_kept_not_moved_to_torn(tmp_path):
+    path = tmp_path / "s.jsonl"
+    store.append(record(dx=1.0), path)
+    store.append(record(dx=0.5), path)
+    with open(path, "r+b") as f:  # `truncate -s -1`: the last record loses its newline only
+        f.truncate(path.stat().st_size - 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", store.StoreWarning)
+        store.append(record(dx=0.4), path)
+    assert [r["dx"] for r in store.read_rows(path)] == [1.0, 0.5, 0.4]
+    assert not (tmp_path / "s.jsonl.torn").exists()
+
+
+def test_a_write_cut_short_by_a_full_file_system_leaves_the_store_as_it_was(tmp_path):
+    """A real short write: the kernel stops the line at RLIMIT_FSIZE (EFBIG, as ENOSPC would)."""
+    path = tmp_path / "s.jsonl"
+    store.append(record(dx=1.0), path)
+    before = path.read_bytes()
+    script = f"""
+import resource, signal, sys
+from pcabench import store
+from pcabench.record import RunRecord
+from solvers import Scene
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+rec = RunRecord.before_run(Scene(dx=0.5, steps=3), "linkedlist-cpu", 1, profile_id="m")
+resource.setrlimit(resource.RLIMIT_FSIZE, ({len(before) + 100}, resource.RLIM_INFINITY))
+try:
+    store.append(rec, {str(path)!r})
+except store.StoreError as exc:
+    sys.exit(str(exc))
+"""
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 1 and "disk is full; the record was not stored" in proc.stderr, proc.stderr
+    assert path.read_bytes() == before  # no partial line
+
+
+def test_a_full_disk_stores_the_run_in_the_reserve_and_stops_the_sweep(tmp_path, monkeypatch):
+    path = tmp_path / "s.jsonl"
+    specs = [RunSpec("linkedlist-cpu", Scene(dx=dx, steps=2)) for dx in (1.0, 0.5)]
+    real_write, full = os.write, []
+
+    def filling(fd, data):  # the disk fills during the store's first write: half the line, then ENOSPC
+        if os.readlink(f"/proc/self/fd/{fd}") == str(path) and (tmp_path / "s.jsonl.reserve").exists():
+            full.append(real_write(fd, data[:len(data) // 2]))
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real_write(fd, data)
+
+    def fake_child(spec, timeout, commit, machine, stream=None):
+        monkeypatch.setattr(os, "write", filling)
+        rec = sweep_module.failed_record(spec, "ok", "", machine)
+        rec.steps = 2
+        return store.to_row(rec)
+
+    with pytest.raises(store.StoreError, match="was stored in the space kept for it"):
+        sweep(specs, path, run_budget=60, sweep_budget=60, runner=fake_child)
+    monkeypatch.setattr(os, "write", real_write)
+    assert full and path.read_bytes().endswith(b"\n")
+    assert [r["dx"] for r in store.read_rows(path)] == [1.0]  # the run that met the full disk is stored
+
+
+def test_a_report_writes_nothing_outside_its_folder_whatever_the_store_holds(tmp_path, capsys):
+    results, out, outside = tmp_path / "results", tmp_path / "deep" / "out", tmp_path / "outside"
+    outside.mkdir()
+    (outside / "report.md").write_text("mine")
+    (outside / "keep.png").write_bytes(b"png")
+    good = store.append(record(), results / "m.jsonl")
+    with open(results / "m.jsonl", "a") as f:
+        for pid, host in (("../../outside", ""), (str(outside), ""), ("m", "../../../outside"), ("..", "")):
+            f.write(json.dumps(dict(good, profile_id=pid, host=host, run_id=pid + host)) + "\n")
+    with pytest.warns(store.StoreWarning, match="profile_id|host"):
+        assert cli.main(["report", "--results", str(results), "--out", str(out)]) == 0
+    assert (outside / "report.md").read_text() == "mine" and (outside / "keep.png").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["deep", "outside", "results"]
+    with pytest.raises(store.StoreError, match="not a safe name"):
+        store.store_name("../x", "h")
+
+
+def test_nothing_is_written_through_a_symlink_in_the_results_folder(tmp_path):
+    target = tmp_path / "precious.txt"
+    target.write_text("line one\nline two")
+    results = tmp_path / "results"
+    results.mkdir()
+    path = results / "s.jsonl"
+    (results / "s.jsonl.lock").symlink_to(target)
+    with pytest.raises(store.StoreError, match="symbolic link"):
+        with store.SweepLock(path):
+            pass
+    path.symlink_to(target)
+    with pytest.raises(store.StoreError, match="symbolic link"):
+        store.append(record(), path)
+    with pytest.raises(store.StoreError, match="symbolic link"):
+        store.check_writable(path)
+    assert target.read_text() == "line one\nline two"
+
+
+ODD_ROWS = {
+    "threads 'x'": {"threads": "x"},
+    "steps 10**400": {"steps": 10**400},
+    "stage 1e300": {"stages": {"input": 0, "init": 0, "snp": 1e300, "pi": 0.1, "su": 0.1, "output": 0}},
+    "NaN": {"mse": float("nan")},
+    "Infinity": {"dx": float("inf")},
+    "scene {}": {"scene": {}},
+    "steps -5": {"steps": -5},
+    "empty profile_id": {"profile_id": ""},
+    "control characters": {"status": "ok\x1b[2J\x1b[31m"},
+    "unknown status": {"status": "fine"},
+    "schema '2'": {"schema": "2"},
+}
+
+
+@pytest.mark.parametrize("name", ODD_ROWS)
+def test_an_odd_but_schema_typed_row_is_skipped_with_one_warning(name, tmp_path):
+    path = tmp_path / "s.jsonl"
+    good = store.append(record(), path)
+    with open(path, "a") as f:
+        f.write(json.dumps(dict(good, run_id="odd", **ODD_ROWS[name])) + "\n")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rows = store.read_rows(path)
+    assert [r["run_id"] for r in rows] == [good["run_id"]]
+    messages = [str(w.message) for w in caught]
+    assert len(messages) == 1 and f"{path}:2:" in messages[0], messages
+    if name == "schema '2'":
+        assert "newer" not in messages[0] and "integer" in messages[0]
+
+
+def test_study_report_and_runs_survive_every_odd_row_at_once(tmp_path, capsys, monkeypatch):
+    results = tmp_path / "results"
+    path = results / "m.jsonl"
+    good = store.append(record(), path)
+    with open(path, "a") as f:
+        for name, change in ODD_ROWS.items():
+            f.write(json.dumps(dict(good, run_id=name, **change)) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", store.StoreWarning)
+        assert cli.main(["runs", "--results", str(results)]) == 0
+        out = capsys.readouterr().out
+        assert "\x1b" not in out and len(out.splitlines()) == 2  # the header and the good row
+        assert cli.main(["report", "--results", str(results), "--out", str(tmp_path / "out")]) == 0
+        spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))
+        monkeypatch.setattr(sweep_module, "machine_id", lambda: good["profile_id"])
+        monkeypatch.setattr(sweep_module, "host_id", lambda: good["host"])
+        made = []
+
+        def fake_child(spec, timeout, commit, machine, stream=None):
+            made.append(spec)
+            rec = sweep_module.failed_record(spec, "ok", "", machine)
+            rec.steps = 2
+            return store.to_row(rec)
+
+        sweep([spec], path, run_budget=60, sweep_budget=60, runner=fake_child)  # reads them all to predict
+    assert len(made) == 1
+
+
+def test_a_run_given_twice_is_run_and_stored_once(tmp_path):
+    made = []
+
+    def fake_child(spec, timeout, commit, machine, stream=None):
+        made.append(spec)
+        rec = sweep_module.failed_record(spec, "ok", "", machine)
+        rec.steps = 2
+        return store.to_row(rec)
+
+    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))
+    sweep([spec, spec], tmp_path / "s.jsonl", run_budget=60, sweep_budget=60, runner=fake_child)
+    assert len(made) == 1 and len(store.read_rows(tmp_path / "s.jsonl")) == 1
+
+
+# ---------------------------------------------------------------- locks before any work, every executor
+def test_a_cluster_sweep_locks_its_results_folder_before_any_work(tmp_path, monkeypatch):
+    from pcabench import cluster
+
+    def no_work(*args, **kw):
+        raise AssertionError("the cluster sweep started work without the lock")
+
+    monkeypatch.setattr(cluster, "connect", no_work)
+    monkeypatch.setattr(store, "read_rows", no_work)
+    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))
+    with store.SweepLock(tmp_path / "m--h.jsonl"):  # a plain sweep runs on one store of the folder
+        with pytest.raises(store.StoreError, match="in use by another sweep"):
+            cluster.cluster_sweep([spec], tmp_path, 60, "local:1")
+    with store.SweepLock(tmp_path, whole_folder=True):  # a cluster sweep holds the folder
+        with pytest.raises(store.StoreError, match="in use by another sweep"):
+            sweep([spec], tmp_path / "m--h.jsonl", run_budget=60, sweep_budget=60, runner=no_work)
+
+
+# ---------------------------------------------------------------- memory: nested cgroups and the pair list
+def test_the_memory_check_sees_a_nested_cgroup_v1_limit_and_its_oom_kills(tmp_path, monkeypatch):
+    unlimited = "9223372036854771712\n"
+    fake_cgroups(tmp_path, monkeypatch, "5:memory:/jobs/small\n0::/\n", {
+        "memory/memory.limit_in_bytes": unlimited, "memory/memory.usage_in_bytes": "0\n",
+        "memory/jobs/memory.limit_in_bytes": unlimited, "memory/jobs/memory.usage_in_bytes": "0\n",
+        "memory/jobs/small/memory.limit_in_bytes": f"{512 << 20}\n",
+        "memory/jobs/small/memory.usage_in_bytes": f"{12 << 20}\n",
+        "memory/jobs/small/memory.oom_control": "oom_kill_disable 0\nunder_oom 0\noom_kill 2\n"})
+    assert scene_module.available_memory_bytes() == 500 << 20
+    with pytest.raises(SceneError, match="smallest dx that fits"):
+        Scene(dx=0.02)  # 2.5M particles, about 0.56 GiB of arrays: more than the 0.49 GiB left
+    assert sweep_module.oom_kills() == 2  # so a kill by the nested limit is out-of-memory, not error
+
+
+def test_pair_loop_list_is_checked_against_the_memory_available(monkeypatch, capsys):
+    from solvers.pairlist import list_bytes
+
+    scene = Scene(dx=0.1, steps=2)
+    monkeypatch.setattr(scene_module, "available_memory_bytes",
+                        lambda: scene.memory_bytes() + list_bytes(scene) // 2)
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["run", "--solver", "linkedlist-cpu", "--dx", "0.1", "--steps", "2", "--pair-loop", "list"])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "pair list" in err and "--pair-loop gather" in err, err
+    assert len(err.strip().splitlines()) == 1
+    assert RunSpec("linkedlist-cpu", scene).resolved().pair_loop == "gather"  # auto falls back
+
+
+# ---------------------------------------------------------------- one line, never a traceback
+def one_line_error(capsys, *argv, seconds=5.0):
+    t0 = time.perf_counter()
+    with pytest.raises(SystemExit) as exc:
+        cli.main(list(argv))
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert time.perf_counter() - t0 < seconds  # refused before any run
+    return err
+
+
+def test_unwritable_home_reports_and_out_are_one_line_before_any_work(tmp_path, capsys, monkeypatch):
+    blocker = tmp_path / "file"
+    blocker.write_text("a file, so nothing can be made under it, not even by root")
+    monkeypatch.setenv("PCABENCH_HOME", str(blocker / "home"))
+    err = one_line_error(capsys, "study", "--dx", "1", "--steps", "2", "--no-report", "--results", str(tmp_path / "r"))
+    assert "PCABENCH_HOME" in err
+    assert "PCABENCH_HOME" in one_line_error(capsys, "profile", "--save", "--no-gpu")
+    monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
+    err = one_line_error(capsys, "study", "--dx", "1", "--steps", "2", "--results", str(tmp_path / "r"),
+                         "--reports", str(blocker / "reports"))
+    assert "--reports" in err and not list((tmp_path / "r").glob("*.jsonl"))
+    store.append(record(), tmp_path / "r" / "m.jsonl")
+    err = one_line_error(capsys, "report", "--results", str(tmp_path / "r"), "--out", str(blocker / "out"))
+    assert "--out" in err
+
+
+def test_a_malformed_hardware_profile_is_one_warning_not_a_traceback(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("PCABENCH_HOME", str(tmp_path))
+    (tmp_path / "hardware_profiles").mkdir()
+    (tmp_path / "hardware_profiles" / "m.json").write_text('{"cpu": {"model": "x"')
+    (tmp_path / "hardware_profiles" / "n.json").write_text("[1, 2]")
+    store.append(record(), tmp_path / "r" / "m.jsonl")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert cli.main(["report", "--results", str(tmp_path / "r"), "--out", str(tmp_path / "out")]) == 0
+    named = {str(w.message).split(":")[0] for w in caught if "hardware profile" in str(w.message)}
+    assert named == {str(tmp_path / "hardware_profiles" / "m.json"), str(tmp_path / "hardware_profiles" / "n.json")}
+
+
+@pytest.mark.parametrize("command,args,words", [
+    ("run", ["--solver", "linkedlist-cpu", "--dx", "\uff11"], ["--dx", "number"]),  # a full-width 1
+    ("study", ["--dx", "1", "--steps", "\u0662"], ["--steps", "integer"]),  # an Arabic-Indic 2
+    ("study", ["--dx", "1", "--threads", "\u0662"], ["--threads", "integer"]),
+    ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--fields", ""], ["--fields", "file name"]),
+    ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--fields", "/proc/x.npz"], ["--fields", "not writable"]),
+    ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--h-factor", "0.5", "--cutoff", "1"],
+     ["cutoff_factor * h_factor", "> 1"]),
+    ("study", ["--dx", "1", "--results", ""], ["--results", "folder"]),
+    ("report", ["--out", ""], ["--out", "folder"]),
+])
+def test_smaller_bad_inputs_are_one_line_before_any_work(command, args, words, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
+    err = one_line_error(capsys, command, *args)
+    assert all(w in err for w in words), err
+    assert list(tmp_path.iterdir()) == []  # nothing written, not even into the current folder
