@@ -22,8 +22,7 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from solvers import INTEGRATORS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
-from solvers.kernel import KERNELS
+from solvers import INTEGRATORS, KERNELS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
 
 from . import __version__, paths
 from .progress import Progress
@@ -108,8 +107,11 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     end.add_argument("--t-end", type=number("--t-end"), **n, help="physical end time, s")
     p.add_argument("--model", choices=MODELS, **n, help=f"default {d('model')}")
     p.add_argument("--integrator", choices=INTEGRATORS, **n, help=f"default {d('integrator')}")
+    p.add_argument("--kernel", choices=KERNELS, **n,
+                   help=f"SPH kernel (default {d('kernel')}, truncated at --cutoff; the Wendland kernels are cut "
+                        f"at their compact support 2h)")
     p.add_argument("--cutoff", type=number("--cutoff"), **n,
-                   help=f"kernel cutoff in units of h (default {d('cutoff_factor'):g})")
+                   help=f"the Gaussian's cutoff in units of h (default {d('cutoff_factor'):g})")
     p.add_argument("--h-factor", type=number("--h-factor"), **n, help=f"h / dx (default {d('h_factor'):g})")
     p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
     p.add_argument("--threads", type=threads_option, **n,
@@ -123,7 +125,7 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
 ACCURACY_OPTIONS = {"kernel": "kernel", "integrator": "integrator", "cutoff": "cutoff_factor", "h_factor": "h_factor",
                     "cfl": "cfl"}
 SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
-                 "h_factor": "h_factor", "cfl": "cfl"}
+                 "kernel": "kernel", "h_factor": "h_factor", "cfl": "cfl"}
 
 
 def scene_from_args(args) -> Scene:
@@ -188,6 +190,7 @@ def cmd_run(args) -> int:
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
+        out["kernel"] = scene.kernel
         out["mse_isothermal"] = record.mse_isothermal
         out["message"] = record.message
         print(json.dumps(to_row(out), allow_nan=False))  # standard JSON: null, never NaN
@@ -195,6 +198,7 @@ def cmd_run(args) -> int:
         print(record.stage_table())
         print(f"particles        {record.n_particles:,}")
         print(f"steps            {record.steps} (t = {record.t_end:.6g} s)")
+        print(f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)")
         print(f"mean neighbours  {record.mean_neighbours:.2f}")
         print(f"MSE (rel. RMS)   {record.mse:.6g}")
         print(f"ME (max, m/s)    {record.me:.6g}")

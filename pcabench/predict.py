@@ -1,9 +1,11 @@
 """Predict a run's wall time from the finished runs of the same solver, to skip hopeless sizes.
 
 The time of one step is fitted as ``a * N**b`` over this host's finished runs
-of the same solver, precision, model and threads (any protocol). With two or
-more sizes ``b`` is fitted; with one, ``b`` is the algorithm's order (2 for
-all-pair, 1 for a cell list). A run whose predicted time, steps times step
+of the same solver, precision, model and threads (any protocol), per
+neighbour for the cell lists: their step time is taken proportional to the
+neighbours per particle, (cutoff / dx)^2, so runs of another kernel or h/dx
+inform the fit. With two or more sizes ``b`` is fitted; with one, ``b`` is
+the algorithm's order (2 for all-pair, 1 for a cell list). A run whose predicted time, steps times step
 plus JIT and start-up, exceeds the run budget is recorded as ``skipped`` with
 the prediction, instead of being run into the wall.
 """
@@ -16,6 +18,7 @@ import numpy as np
 from .record import step_seconds
 
 ORDER = {"allpair-cpu": 2.0}  # the default is 1.0: the cell list is linear in N
+ALL_PAIRS = ("allpair-cpu",)  # tests every pair whatever the cutoff: not scaled by neighbours
 START_UP = 5.0  # s: a child process, imports and JIT on a tiny scene (measured 3-7 s on a laptop CPU)
 
 
@@ -27,12 +30,22 @@ def _same_config(row: dict, spec) -> bool:
             and (row.get("steps") or 0) > 0)
 
 
+def _reach(solver: str, scene: dict) -> float:
+    """(cutoff / dx)^2 of a scene dict, which the neighbours per particle scale with (1 for all-pair)."""
+    if solver in ALL_PAIRS or not scene.get("cutoff") or not scene.get("dx"):
+        return 1.0
+    return (scene["cutoff"] / scene["dx"]) ** 2
+
+
 def step_model(spec, rows: list[dict]):
-    """``(a, b, sizes)`` of the fitted step time ``a * N**b`` (s), or None without data."""
+    """``(a, b, sizes)`` of the fitted step time ``a * N**b`` (s) at ``spec``'s neighbours per particle,
+    or None without data."""
     pts = {}
+    reach = _reach(spec.solver, spec.scene.as_dict())
     for row in rows:
         if _same_config(row, spec):
-            pts.setdefault(int(row["n_particles"]), []).append(step_seconds(row["stages"], row["steps"]))
+            scale = reach / _reach(spec.solver, row["scene"])
+            pts.setdefault(int(row["n_particles"]), []).append(scale * step_seconds(row["stages"], row["steps"]))
     pts = {n: float(np.median(v)) for n, v in pts.items() if n > 0 and min(v) > 0}
     if not pts:
         return None

@@ -31,7 +31,7 @@ def _spec(solver="linkedlist-cpu", threads=SERIAL, strip=False, pair_loop="auto"
     """One run; ``strip`` puts it on the thinnest y-periodic strip Scene accepts."""
     if strip:
         scene["strip_height"] = Scene.thinnest_strip(scene["dx"], scene.get("cutoff_factor"),
-                                                     scene.get("h_factor"))
+                                                     scene.get("h_factor"), scene.get("kernel"))
     return RunSpec(solver, Scene(**scene), threads, pair_loop=pair_loop)
 
 
@@ -141,7 +141,7 @@ def matrix(solvers=("linkedlist-cpu",), dxs=(), threads=(SERIAL,), steps=(None,)
     """The product of the option lists, smallest N first, as run specs of preset ``matrix``.
 
     ``scene_lists`` maps Scene parameters (precision, model, integrator, cfl,
-    h_factor, cutoff_factor) to lists; a parameter not given keeps Scene's
+    h_factor, cutoff_factor, kernel) to lists; a parameter not given keeps Scene's
     default. ``steps`` and ``t_ends`` are lists too (give one of them; neither
     means the paper's 100 steps).
     """

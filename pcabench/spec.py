@@ -122,24 +122,27 @@ def scene_parameters(scene: Scene) -> dict:
     return {k: getattr(scene, k) for k in fields if fields[k].compare}
 
 
+def stored_parameters(scene: dict) -> dict:
+    """A stored scene dict's own parameters (derived keys dropped), each one a row predates at its default:
+    the value runs had before the parameter existed (rows without ``kernel`` are Gaussian)."""
+    fields = Scene.__dataclass_fields__
+    return {k: scene.get(k, fields[k].default) for k in fields if fields[k].compare}
+
+
 def scene_from_row(row: dict) -> Scene:
     """The Scene of a stored row (derived keys dropped)."""
-    fields = Scene.__dataclass_fields__
-    return Scene(**{k: v for k, v in (row.get("scene") or {}).items() if k in fields and fields[k].compare})
+    return Scene(**stored_parameters(row.get("scene") or {}))
 
 
 def identity(solver: str, threads: int, scene: Scene | dict, preset: str, profile: str, commit: str,
              host: str, pair_loop: str = "") -> str:
     """The key of a run for resuming and de-duplication: the same key is the same run.
 
-    ``scene`` may be a Scene or a stored row's scene dict (its derived keys are ignored).
+    ``scene`` may be a Scene or a stored row's scene dict (its derived keys are ignored, the parameters
+    it predates take their defaults: :func:`stored_parameters`).
     ``pair_loop`` is the loop the run used (rows from before pair loops had none).
     """
-    if isinstance(scene, dict):
-        fields = Scene.__dataclass_fields__
-        scene = {k: v for k, v in scene.items() if k in fields and fields[k].compare}
-    else:
-        scene = scene_parameters(scene)
+    scene = stored_parameters(scene) if isinstance(scene, dict) else scene_parameters(scene)
     return json.dumps([solver, int(threads), scene, preset or "", profile, commit, host, pair_loop or ""],
                       sort_keys=True, default=str)
 

@@ -401,6 +401,8 @@ def load(paths):
     """The stores ``paths`` as one tidy pandas DataFrame (stage times as columns t_<stage>)."""
     import pandas as pd
 
+    from .spec import stored_parameters
+
     rows = read_rows(paths)
     flat = []
     for row in rows:
@@ -408,7 +410,8 @@ def load(paths):
         for stage, seconds in (row.get("stages") or {}).items():
             r[f"t_{stage}"] = seconds
         scene = row.get("scene") or {}
-        for key in ("strip_height", "cutoff_factor", "h_factor", "cfl", "t_final", "height"):
+        scene = {**stored_parameters(scene), **scene}  # a parameter the row predates at its default (kernel)
+        for key in ("strip_height", "cutoff_factor", "kernel", "h_factor", "cfl", "t_final", "height"):
             r[key] = scene.get(key)
         r["kernel"] = scene.get("kernel") or "gaussian"  # rows from before the kernel option: the Gaussian
         # how the run ends: the paper's fixed step count, or a fixed physical time

@@ -6,6 +6,7 @@ that the package works with no CUDA library installed.
 from __future__ import annotations
 
 from .interface import STAGES, Fields, Solver, SolverUnavailable
+from .kernel import KERNELS
 from .scene import INTEGRATORS, MODELS, NUMERICS, PRECISIONS, Scene, SceneError
 
 SOLVERS = ("allpair-cpu", "linkedlist-cpu", "linkedlist-gpu")
@@ -56,5 +57,5 @@ def make_solver(name: str, threads: int = 1, pair_loop: str = "auto") -> Solver:
 
 
 __all__ = ["Scene", "SceneError", "Solver", "SolverUnavailable", "Fields", "STAGES", "SOLVERS",
-           "MODELS", "INTEGRATORS", "PRECISIONS", "NUMERICS", "PAIR_LOOPS", "check_pair_loop", "make_solver",
+           "MODELS", "INTEGRATORS", "PRECISIONS", "KERNELS", "NUMERICS", "PAIR_LOOPS", "check_pair_loop", "make_solver",
            "resolve_pair_loop"]

@@ -15,9 +15,9 @@ from .backend import cpu_pairs, cpu_updates
 from .interface import Solver, tiny_scene
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str) -> dict:
-    """The all-pair interaction loops for ``precision`` (serial, as in the paper)."""
-    P = cpu_pairs(precision)
+def sweeps(precision: str, kernel: str) -> dict:
+    """The all-pair interaction loops for ``precision`` and ``kernel`` (serial, as in the paper)."""
+    P = cpu_pairs(precision, kernel)
 
     def continuity(lx, ly, sx, sy, u, v, vol, drho, out, k):
         n = lx.shape[0]
@@ -51,7 +51,7 @@ class AllPairCPU(Solver):
         """Nothing to build: the all-pair search happens inside the interaction loop."""
 
     def launch(self, name: str, *args):
-        return sweeps(self.scene.precision)[name](*args)
+        return sweeps(self.scene.precision, self.scene.kernel)[name](*args)
 
     def _sweep(self, continuity: bool, momentum: bool) -> None:
         a = self.arrays

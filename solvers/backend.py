@@ -5,14 +5,15 @@ from functools import lru_cache
 
 
 @lru_cache(maxsize=None)
-def cpu_pairs(precision: str):
-    """The pair functions for numba's CPU target in ``precision``, inlined into the sweeps that call them."""
+def cpu_pairs(precision: str, kernel: str = "gaussian"):
+    """The pair functions for numba's CPU target in ``precision`` with ``kernel``'s G, inlined into the
+    sweeps that call them."""
     import numba
 
     from .kernel import make_exp_neg_table
     from .pairs import make_pairs
 
-    return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision))
+    return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision)
 
 
 def _gather_range(src, order, out, lo, hi):
@@ -28,7 +29,7 @@ def cpu_updates(precision: str, parallel: bool) -> dict:
     the system update (kick, advance) and the gather that reorders an array (``parts`` ranges)."""
     import numba
 
-    P = cpu_pairs(precision)
+    P = cpu_pairs(precision)  # the per-particle functions only: they do not depend on the kernel
     prange = numba.prange
     gather_range = numba.njit(nogil=True)(_gather_range)
 

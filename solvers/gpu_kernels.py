@@ -20,15 +20,15 @@ SCAN_ITEMS = 4  # cells per thread in one pass of the cellBegin scan
 
 
 @lru_cache(maxsize=None)
-def kernels(precision: str):
-    """The device kernels for ``precision`` (compiled by numba-cuda on first launch).
+def kernels(precision: str, kernel: str = "gaussian"):
+    """The device kernels for ``precision`` and ``kernel`` (compiled by numba-cuda on first launch).
 
     float32 kernels use fastmath (the hardware's approximate expf, ~2 ulp);
     float64 kernels use the accurate libdevice exp.
     """
     device_backend()  # the device is usable (or simulated), numba-cuda patched for this NumPy
     fast = precision == "float32"
-    P = make_pairs(cuda.jit(device=True, fastmath=fast), exp_neg_math)
+    P = make_pairs(cuda.jit(device=True, fastmath=fast), exp_neg_math, kernel, precision)
     jit = cuda.jit(fastmath=fast)
     scan_threads = scan_block()  # a compile-time constant of cell_begin (its shared-memory tile)
 

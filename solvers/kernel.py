@@ -1,9 +1,19 @@
-"""The truncated 2D Gaussian kernel and the constants the pair loops need.
+"""The SPH kernels and the constants the pair loops need.
 
-W(r) = exp(-r^2/h^2) / (pi h^2) for r < cutoff, 0 beyond, so that
-grad_i W_ij = G(r^2) * (x_i - x_j) with G = -2 exp(-r^2/h^2) / (pi h^4).
-The truncation is not renormalised: at a 3h cutoff it biases the sound speed
-by about 0.12 % (9 % at 2h), an error floor the reports state.
+Three kernels (``KERNELS``), each as W(r) and G(r) = W'(r) / r, so that
+grad_i W_ij = G(r_ij) (x_i - x_j):
+
+- ``gaussian`` (the paper's): W = exp(-r^2/h^2) / (pi h^2) for r < cutoff,
+  0 beyond, G = -2 exp(-r^2/h^2) / (pi h^4). The truncation is not
+  renormalised: at a 3h cutoff it biases the sound speed by about 0.12 %
+  (9 % at 2h), an error floor the reports state.
+- ``wendland-c2``, ``wendland-c4``: Wendland's kernels in their 2D
+  normalisation, compact support 2h (``SUPPORT``): nothing is truncated and
+  no exp is needed, only q = r/h.
+
+The reference forms (:func:`value`, :func:`gradient_factor`, NumPy) are the
+truth; :func:`make_gradient` is the one compiled G every solver's pair code
+evaluates (solvers/pairs.py, solvers/pairlist.py).
 
 The constant tuple ``k`` is built in the solver's precision so that float32
 loops never promote to float64. Its layout is indexed by the names below.
@@ -19,7 +29,7 @@ import numpy as np
 SPACING = 0  # dx, m
 NY = 1  # lattice rows in the periodic height
 INV_H2 = 2  # 1 / h^2, 1/m^2
-GRAD0 = 3  # G(0) = -2 / (pi h^4), 1/m^4
+GRAD0 = 3  # G(0), 1/m^4: -2 / (pi h^4) for the Gaussian, -35 / (4 pi h^4) C2, -21 / (2 pi h^4) C4
 RC2 = 4  # cutoff^2, m^2
 RHO0 = 5  # rho0, kg/m^3
 C0SQ = 6  # c0^2, m^2/s^2
@@ -36,7 +46,7 @@ def constants(scene, dtype) -> tuple:
         SPACING: scene.dx,
         NY: float(scene.ny),
         INV_H2: 1.0 / (h * h),
-        GRAD0: -2.0 / (math.pi * h**4),
+        GRAD0: float(gradient_factor(scene.kernel, 0.0, h)),
         RC2: scene.cutoff**2,
         RHO0: scene.rho0,
         C0SQ: scene.c0**2,
@@ -83,6 +93,37 @@ def gradient_factor(kernel: str, r, h: float):
         return -35.0 / (4.0 * math.pi * h**4) * s**3
     if kernel == "wendland-c4":
         return -21.0 / (4.0 * math.pi * h**4) * s**5 * (5.0 * q + 2.0)
+    raise ValueError(f"kernel must be one of {', '.join(KERNELS)} (got {kernel!r})")
+
+
+def make_gradient(kernel: str, dtype, exp_neg):
+    """G(r^2, k) = W'(r) / r of ``kernel`` for the pair loops, 1/m^4, in ``dtype`` throughout (to be compiled).
+
+    ``exp_neg(x) = exp(-x)`` (compiled by the caller) serves the Gaussian; the
+    Wendland kernels take q = sqrt(r^2 / h^2) once and no exp. ``r2`` must be
+    within the cutoff (the loops test it first). Each kernel is its own
+    function, so a solver compiles only its kernel's arithmetic.
+    """
+    if kernel == "gaussian":
+        def gradient(r2, k):
+            return k[GRAD0] * exp_neg(r2 * k[INV_H2])
+        return gradient
+    t = np.dtype(dtype).type
+    one, half = t(1.0), t(0.5)
+    if kernel == "wendland-c2":
+        def gradient(r2, k):  # G(0) (1 - q/2)^3
+            s = one - half * math.sqrt(r2 * k[INV_H2])
+            return k[GRAD0] * (s * s * s)
+        return gradient
+    if kernel == "wendland-c4":
+        c4_slope = t(2.5)  # (5q + 2) / 2 = 1 + 2.5 q, with G(0) = -21 / (2 pi h^4)
+
+        def gradient(r2, k):  # G(0) (1 - q/2)^5 (1 + 5q/2)
+            q = math.sqrt(r2 * k[INV_H2])
+            s = one - half * q
+            s2 = s * s
+            return k[GRAD0] * (s2 * s2 * s) * (one + c4_slope * q)
+        return gradient
     raise ValueError(f"kernel must be one of {', '.join(KERNELS)} (got {kernel!r})")
 
 

@@ -48,9 +48,9 @@ def _counting_sort(cell, ncells, begin, order, sorted_cell):
 
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str, parallel: bool) -> dict:
-    """The interaction loops for ``precision``, serial or on numba's thread pool."""
-    P = cpu_pairs(precision)
+def sweeps(precision: str, kernel: str, parallel: bool) -> dict:
+    """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool."""
+    P = cpu_pairs(precision, kernel)
     prange = numba.prange
 
     def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
@@ -131,7 +131,7 @@ class LinkedListCPU(CellListSolver):
     def launch(self, name: str, *args):
         if self.threads > 1:
             numba.set_num_threads(self.threads)
-        return sweeps(self.scene.precision, self.threads > 1)[name](*args)
+        return sweeps(self.scene.precision, self.scene.kernel, self.threads > 1)[name](*args)
 
     def sort_cells(self) -> None:
         """Counting sort by cell (x-sorted within each cell for the pair list), then the pair list if used."""

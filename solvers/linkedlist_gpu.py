@@ -101,7 +101,7 @@ class LinkedListGPU(CellListSolver):
         from .gpu_kernels import kernels  # numba.cuda only once a device (or the simulator) is known
 
         blocks, threads = grid or (self.blocks, self.threads_per_block)
-        kernels(self.scene.precision)[name][blocks, threads, self.launch_stream](*args)
+        kernels(self.scene.precision, self.scene.kernel)[name][blocks, threads, self.launch_stream](*args)
 
     def sort_cells(self) -> None:
         """Counting sort by cell in three launches; the spare block becomes the current one."""

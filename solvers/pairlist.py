@@ -2,7 +2,7 @@
 
 The gather loop (solvers/pairs.py) visits the 3x3 cell stencil of every
 particle in every sweep: each pair is found twice per sweep (once from each
-side), and the Gaussian is evaluated four times per pair per Verlet step.
+side), and the kernel is evaluated four times per pair per Verlet step.
 Here SNP, after the cell sort, lists each pair once (j after i in the half
 stencil: the rest of i's cell row from i + 1, and the three cells of the row
 above) with its kernel factors f = G(r^2) r_ij; the sweeps then stream over
@@ -42,7 +42,8 @@ import numpy as np
 
 from .compress import PAD, compress_within
 from .denormals import flush_off, flush_on
-from .kernel import GRAD0, INV_H2, NONLIN, NY, RC2, RHO0, SPACING, make_exp_neg_table
+from .backend import cpu_pairs
+from .kernel import NONLIN, NY, RC2, RHO0, SPACING
 
 INDEX_BYTES = 4  # uint32 neighbour index per pair
 ROW_BYTES = 4 + 8  # per particle: its pair count (uint32) and where its pairs start (uint64)
@@ -76,9 +77,9 @@ def list_bytes(scene, budget: int | None = None) -> int:
 
 
 @lru_cache(maxsize=None)
-def kernels(precision: str, parallel: bool) -> dict:
-    """The list build and the two sweeps for ``precision``, serial or on numba's threads."""
-    exp_neg = numba.njit(inline="always")(make_exp_neg_table(precision))
+def kernels(precision: str, kernel: str, parallel: bool) -> dict:
+    """The list build (with ``kernel``'s G) and the two sweeps for ``precision``, serial or on numba's threads."""
+    gradient = cpu_pairs(precision, kernel).gradient  # the pair code's G (solvers/pairs.py)
     prange = numba.prange
     jit = numba.njit(nogil=True, parallel=parallel, error_model="numpy")
     flush = precision == "float32"  # subnormals to zero in float32 (solvers/denormals.py)
@@ -165,7 +166,7 @@ def kernels(precision: str, parallel: bool) -> dict:
                 start[i] = at
                 count[i] = m
                 for q in range(min(m, end - at)):  # the kernel factors of the pairs in range
-                    g = k[GRAD0] * exp_neg(cr2[q] * k[INV_H2])
+                    g = gradient(cr2[q], k)
                     nbr[at + q] = cj[q]
                     fx[at + q] = g * crx[q]
                     fy[at + q] = g * cry[q]
@@ -255,7 +256,7 @@ class PairList:
     def __init__(self, scene, threads: int):
         dt = np.dtype(scene.precision)
         n = scene.n_particles
-        self.kernels = kernels(scene.precision, threads > 1)
+        self.kernels = kernels(scene.precision, scene.kernel, threads > 1)
         self.threads = threads
         self._allocate(n, capacity(scene), dt)
         self.start = np.zeros(n, np.uint64)

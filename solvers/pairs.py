@@ -2,9 +2,9 @@
 
 :func:`make_pairs` builds the pair functions with one backend's decorator
 (``numba.njit(inline="always")`` for the CPU solvers,
-``numba.cuda.jit(device=True)`` for the GPU solver and its simulator) and that
-backend's exp(-x), so that every solver evaluates exactly the same
-expressions. The functions call each other as closure variables: numba
+``numba.cuda.jit(device=True)`` for the GPU solver and its simulator), that
+backend's exp(-x) and one kernel's G (solvers/kernel.py, chosen at compile
+time), so that every solver evaluates exactly the same expressions. The functions call each other as closure variables: numba
 compiles them as constants of the caller.
 
 Positions are lattice coordinates (lx, ly: whole numbers held in the solver's
@@ -18,22 +18,23 @@ Rates (design, section 1), with rho = rho0 + nonlin * drho (nonlin = 0 in the
 vol_j = m_j / rho_j and pr_j = c0^2 drho_j / rho_j^2:
     d(drho_i)/dt = rho_i sum_j vol_j (u_i - u_j) . r_ij G_ij
     du_i/dt      = -sum_j m_j (pr_i + pr_j) G_ij r_ij
-with grad_i W_ij = G_ij r_ij (solvers/kernel.py). ``k`` is the constant tuple
+with grad_i W_ij = G_ij r_ij (``gradient``, solvers/kernel.py). ``k`` is the constant tuple
 of :func:`solvers.kernel.constants`, read by its named slots.
 """
 import math
 from types import ModuleType
 
-from .kernel import C0SQ, GRAD0, INV_H2, NONLIN, NY, RC2, RHO0, SPACING, ZERO
+from .kernel import C0SQ, NONLIN, NY, RC2, RHO0, SPACING, ZERO, make_gradient
 
 
-def make_pairs(jit, exp_neg) -> ModuleType:
-    """The pair functions compiled with ``jit``, using ``exp_neg(x) = exp(-x)`` (itself compiled here).
+def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
+    """The pair functions compiled with ``jit`` for ``kernel`` in ``precision``, using
+    ``exp_neg(x) = exp(-x)`` (itself compiled here) where the kernel needs it.
 
     They come back as attributes of a module object, which numba resolves inside the jitted sweeps
     that call them (it cannot type a plain namespace).
     """
-    exp_neg = jit(exp_neg)
+    gradient = jit(make_gradient(kernel, precision, jit(exp_neg)))
 
     @jit
     def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):
@@ -44,7 +45,7 @@ def make_pairs(jit, exp_neg) -> ModuleType:
             ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
             r2 = rx * rx + ry * ry
             if r2 < k[RC2]:
-                g = k[GRAD0] * exp_neg(r2 * k[INV_H2])
+                g = gradient(r2, k)
                 acc += vol[j] * g * ((ui - u[j]) * rx + (vi - v[j]) * ry)
         return acc
 
@@ -58,7 +59,7 @@ def make_pairs(jit, exp_neg) -> ModuleType:
             ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
             r2 = rx * rx + ry * ry
             if r2 < k[RC2]:
-                w = mass[j] * (pri + pr[j]) * (k[GRAD0] * exp_neg(r2 * k[INV_H2]))
+                w = mass[j] * (pri + pr[j]) * gradient(r2, k)
                 ax += w * rx
                 ay += w * ry
         return ax, ay
@@ -213,7 +214,8 @@ def make_pairs(jit, exp_neg) -> ModuleType:
 
     pairs = ModuleType(f"{__name__}.compiled", "The pair functions for one backend (see make_pairs).")
     pairs.__dict__.update(
-        continuity_range=continuity_range, momentum_range=momentum_range, neighbours_range=neighbours_range,
+        gradient=gradient, continuity_range=continuity_range, momentum_range=momentum_range,
+        neighbours_range=neighbours_range,
         cell_index=cell_index, stencil_row=stencil_row, continuity_cells=continuity_cells,
         momentum_cells=momentum_cells, neighbours_cells=neighbours_cells, minimum_image_row=minimum_image_row,
         continuity_allpair=continuity_allpair, momentum_allpair=momentum_allpair,

@@ -4,7 +4,8 @@ Defaults are the reference paper's: a square lattice of spacing ``dx`` on
 x in [-10, 40] m, y in [-10, 10] m (periodic in y, free left/right edges),
 a medium at rest (rho0 = 1 kg/m^3, c0 = 1 m/s) carrying a right-travelling
 Gaussian pulse of Mach 0.05, a Gaussian kernel with h = 2.13 dx truncated at
-3 h, and dt = 0.2 dx / c0.
+3 h, and dt = 0.2 dx / c0. The kernel may instead be a Wendland kernel
+(solvers/kernel.py), whose compact support 2h is then the cutoff.
 
 A scene states its particle count and memory before anything is allocated
 (:meth:`Scene.memory_bytes`) and rejects nonsense with a message that names
@@ -15,6 +16,8 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import asdict, dataclass, field, replace
+
+from .kernel import KERNELS, SUPPORT
 
 MODELS = ("lagrangian", "fixed", "linear")
 INTEGRATORS = ("verlet", "kdk1", "euler", "rk2")
@@ -33,7 +36,7 @@ STRIP_CUTOFFS = 3.0
 MAX_STEPS = 10_000_000  # the most steps a run may take (1e7)
 
 # Scene parameters that choose the numerical method rather than the physics.
-NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor")
+NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor", "kernel")
 
 
 class SceneError(ValueError):
@@ -126,7 +129,8 @@ class Scene:
     pulse_width: float = 3.0  # the 3 in exp(-((x - c0 t)/3)^2), m
     pulse_center: float = 0.0  # pulse position at t = 0, m
     h_factor: float = 2.13  # h = h_factor * dx
-    cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h
+    cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h (the Gaussian's truncation; Wendland: the default only)
+    kernel: str = "gaussian"  # one of KERNELS (solvers/kernel.py)
     cfl: float = 0.2  # dt = cfl * dx / c0 (lowered slightly to land on t_end)
     model: str = "lagrangian"
     integrator: str = "verlet"
@@ -179,9 +183,14 @@ class Scene:
              f"cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core (got {self.cutoff_factor})")
         need(self.cutoff_factor <= 5.0,
              f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7")
-        need(self.h_factor * self.cutoff_factor > 1,
+        need(self.kernel in KERNELS, f"kernel must be one of {', '.join(KERNELS)} (got {self.kernel!r})")
+        need(self.kernel not in SUPPORT or self.cutoff_factor == self.default("cutoff_factor"),
+             f"cutoff_factor applies to the truncated Gaussian only: {self.kernel} is cut at its compact support "
+             f"{SUPPORT.get(self.kernel, 0):g}h (got cutoff_factor {self.cutoff_factor:g})")
+        reach = self.cutoff_ratio(self.kernel, self.cutoff_factor)
+        need(self.h_factor * reach > 1,
              f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
-             f"(got {self.cutoff_factor:g} * {self.h_factor:g} = {self.cutoff_factor * self.h_factor:g})")
+             f"(got {reach:g} * {self.h_factor:g} = {reach * self.h_factor:g})")
         need(self.cfl > 0, f"cfl (dt*c0/dx) must be > 0 (got {self.cfl}); dt must be positive")
         need(self.cfl <= 50, f"cfl (dt*c0/dx) must be <= 50 (got {self.cfl})")
         need(self.blowup_factor > 1, f"blowup_factor must be > 1 (got {self.blowup_factor})")
@@ -220,8 +229,8 @@ class Scene:
 
     @property
     def cutoff(self) -> float:
-        """Kernel truncation radius, m."""
-        return self.cutoff_factor * self.h
+        """Interaction radius, m: the kernel's support (:meth:`cutoff_ratio` h)."""
+        return self.cutoff_ratio(self.kernel, self.cutoff_factor) * self.h
 
     @property
     def nx(self) -> int:
@@ -305,15 +314,22 @@ class Scene:
         return cls.__dataclass_fields__[name].default
 
     @classmethod
-    def thinnest_strip(cls, dx: float, cutoff_factor: float | None = None,
-                       h_factor: float | None = None) -> float:
-        """The thinnest y-periodic strip height the rules accept at ``dx``, in whole rows, m."""
+    def cutoff_ratio(cls, kernel: str | None = None, cutoff_factor: float | None = None) -> float:
+        """cutoff / h, the one rule: a Wendland kernel's compact support (``SUPPORT``), else the
+        Gaussian's truncation ``cutoff_factor`` (None: the defaults)."""
+        kernel = cls.default("kernel") if kernel is None else kernel
         cutoff_factor = cls.default("cutoff_factor") if cutoff_factor is None else cutoff_factor
+        return SUPPORT.get(kernel, cutoff_factor)
+
+    @classmethod
+    def thinnest_strip(cls, dx: float, cutoff_factor: float | None = None,
+                       h_factor: float | None = None, kernel: str | None = None) -> float:
+        """The thinnest y-periodic strip height the rules accept at ``dx``, in whole rows, m."""
         h_factor = cls.default("h_factor") if h_factor is None else h_factor
-        return math.ceil(STRIP_CUTOFFS * cutoff_factor * h_factor * (1 + 1e-9)) * dx
+        return math.ceil(STRIP_CUTOFFS * cls.cutoff_ratio(kernel, cutoff_factor) * h_factor * (1 + 1e-9)) * dx
 
     def uses_default_numerics(self) -> bool:
-        """True when integrator, CFL, h/dx and cutoff are the defaults (the paper's method)."""
+        """True when integrator, CFL, h/dx, cutoff and kernel are the defaults (the paper's method)."""
         return all(getattr(self, name) == self.default(name) for name in NUMERICS)
 
     # ------------------------------------------------------------ helpers
@@ -329,7 +345,7 @@ class Scene:
 
     def describe(self) -> str:
         return (f"{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
-                f"h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
+                f"{self.kernel} kernel, h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
                 f"{self.n_steps} steps to t = {self.t_final:.4g} s, "
                 f"{self.model}/{self.integrator}/{self.precision}, "
                 f"arrays <= {self.memory_bytes() / 2**20:.1f} MiB")

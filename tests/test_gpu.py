@@ -24,8 +24,9 @@ import json, sys, tempfile, numpy as np
 from pathlib import Path
 from pcabench.run import run
 from solvers import Scene
-precision, model, steps, integrator = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
-scene = Scene(dx=1.0, x_min=-8.0, x_max=8.0, steps=steps, model=model, precision=precision, integrator=integrator)
+precision, model, steps, integrator, kernel = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
+scene = Scene(dx=1.0, x_min=-8.0, x_max=8.0, steps=steps, model=model, precision=precision, integrator=integrator,
+              kernel=kernel)
 out = {}
 with tempfile.TemporaryDirectory() as d:
     for solver in ("linkedlist-cpu", "linkedlist-gpu"):
@@ -38,9 +39,9 @@ print(json.dumps(out))
 """
 
 
-def _simulate(precision, model, steps, integrator="verlet"):
+def _simulate(precision, model, steps, integrator="verlet", kernel="gaussian"):
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps), integrator],
+    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps), integrator, kernel],
                           capture_output=True, text=True, env=env, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
