@@ -448,7 +448,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="CFL x integrator x h/dx, run length and float32: the stability map")
     g.add_argument("--front", nargs="?", const="quick", choices=("quick", "full"),
                    help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
-                        "model on the strip, serial (quick: 288 runs, about 30 min on 2 cores; full: 2400)")
+                        "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the predicted fastest, serial (quick: 296 runs; full: 2408)")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
     m.add_argument("--solver", nargs="+", choices=SOLVERS)
     add_scene_options(m, many=True)

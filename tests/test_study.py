@@ -176,7 +176,7 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
         assert image.shape[0] > 100 and image.shape[1] > 100 and image.std() > 0, name
     a = (out / "machine-a" / "report.md").read_text()
     for words in ("Table 4", "Table 5", "Table 6", "Fig. 9", "Fig. 8", "fitted order 2.00", "stops falling at dx = 0.2",
-                  "Speed against accuracy", "cost of each simplification", "accurate up to CFL", "bounded up to CFL", "skipped"):
+                  "Time to a given accuracy", "paper / fastest", "cost of each simplification", "accurate up to CFL", "bounded up to CFL", "skipped"):
         assert words in a, words
     cards = (out / "cards.md").read_text()
     assert "machine-b" in cards and "Tesla K20c" in cards and "Quadro M4000" in cards
