@@ -52,6 +52,12 @@ def command(r, t_end: float) -> str:
     return " ".join(parts)
 
 
+def error_column(model: str) -> str:
+    """What "error" means for ``model``: against the linear pulse, or for lagrangian against the isothermal
+    solution, the equations it solves (its error against the linear pulse never falls below their 9.8 %)."""
+    return "mse_isothermal" if model == "lagrangian" else "mse"
+
+
 def reaching(df, t_end: float, model: str):
     """Finished runs of ``model`` that ended at ``t_end`` (the newest of each configuration), fastest first."""
     d = df[(df.status == "ok") & (df.model == model) & df.t_final.notna()]
@@ -65,11 +71,17 @@ def paper_configuration(df):
     return d[d["kernel"].fillna("gaussian") == "gaussian"] if "kernel" in d else d
 
 
-def advise(df, error: float, t_end: float, model: str = "linear") -> dict:
-    """The fastest stored run reaching ``error`` at ``t_end``, the paper configuration's, and the ratio."""
+def advise(df, error: float, t_end: float, model: str = "linear", domain: str | None = None) -> dict:
+    """The fastest stored run reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``, if given),
+    the fastest run of the paper's configuration on the same domain reaching it, and the ratio. Like is
+    compared with like: a strip holds fewer particles than the full domain for the same answer."""
     runs = reaching(df, t_end, model)
-    hits = runs[runs.mse <= error] if not runs.empty else runs
-    out = {"error_target": error, "t_end": t_end, "model": model, "runs_considered": int(len(runs))}
+    if domain is not None and not runs.empty:
+        runs = runs[runs.domain == domain]
+    column = error_column(model)
+    hits = runs[runs[column] <= error] if not runs.empty else runs
+    out = {"error_target": error, "t_end": t_end, "model": model, "runs_considered": int(len(runs)),
+           "error_against": "the isothermal solution" if column == "mse_isothermal" else "the linear pulse"}
     if hits.empty:
         out["found"] = False
         out["suggestion"] = suggest(error, t_end, model)
@@ -78,14 +90,17 @@ def advise(df, error: float, t_end: float, model: str = "linear") -> dict:
     scene = Scene(t_end=t_end, model=model, memory_limit_bytes=2**62,
                   **{k: v for k, v in scene_of(best).items() if not (isinstance(v, float) and math.isnan(v))})
     stable = predict(scene).stable_cfl
-    paper = paper_configuration(hits)
+    same = hits[hits.domain == best.domain]
+    if best.domain == "strip":  # the same strip: the thinnest one differs with the method, so same height only
+        same = same[np.isclose(same.strip_height.astype(float), float(best.strip_height))]
+    paper = paper_configuration(same)
     paper_best = paper.iloc[0] if not paper.empty else None
-    out.update(found=True, command=command(best, t_end), error=float(best.mse), seconds=float(best.t_solution),
-               machine=str(best.machine), solver=str(best.solver), threads=int(best.threads),
+    out.update(found=True, command=command(best, t_end), error=float(best[column]), seconds=float(best.t_solution),
+               machine=str(best.machine), solver=str(best.solver), domain=str(best.domain), threads=int(best.threads),
                n_particles=int(best.n_particles), steps=int(best.steps), **scene_of(best),
                stable_cfl=stable, cfl_margin=stable / float(best.cfl) if stable else 0.0,
                paper_seconds=None if paper_best is None else float(paper_best.t_solution),
-               paper_error=None if paper_best is None else float(paper_best.mse),
+               paper_error=None if paper_best is None else float(paper_best[column]),
                paper_command=None if paper_best is None else command(paper_best, t_end))
     out["speedup_over_paper"] = out["paper_seconds"] / out["seconds"] if out["paper_seconds"] else None
     return out
@@ -113,7 +128,8 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
         scene = Scene(dx=dx, t_end=t_end, model="linear", memory_limit_bytes=2**62)
         if predict(scene).predicted_error <= error:
             paper = scene
-    out = {"paper_dx": None if paper is None else paper.dx}
+    out = {"paper_dx": None if paper is None else paper.dx, "smallest_dx_searched": min(SEARCH_DX),
+           "note": "predicted from the linear part (solvers/dispersion.py)"}
     if best is not None:
         _, s, p = best
         out.update(kernel=getattr(s, "kernel", "gaussian"), h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,

@@ -371,28 +371,34 @@ def cmd_advise(args) -> int:
     machine = args.machine or (machine_id() if machine_id() in machines else machines.index[0])
     if machine not in machines:
         raise OptionError(f"--machine {machine!r}: the stores hold {', '.join(machines.index)}")
-    out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model)}
+    out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain)}
     if args.json:
         print(json.dumps(out, sort_keys=True, default=str))
         return 0
-    head = f"{args.model} to a relative RMS error of u <= {args.error:g} at t = {args.t_end:g} s on {machine}"
+    head = (f"{args.model} to a relative RMS error of u <= {args.error:g} (against {out['error_against']}) at "
+            f"t = {args.t_end:g} s on {machine}"
+            + (f", {args.domain} domain" if args.domain else ""))
     if not out["found"]:
         s = out["suggestion"]
         print(f"{head}: none of the {out['runs_considered']} stored runs reaches it.")
-        if "study" in s:
-            print(f"predicted cheapest: {s['kernel']}, h = {s['h_factor']:g} dx, CFL {s['cfl']:g}, dx {s['dx']:g} "
-                  f"(predicted {s['predicted_error']:.3g}); run:\n  {s['study']}")
-        print("the paper's configuration needs dx <= "
-              + (f"{s['paper_dx']:g} m (predicted)" if s["paper_dx"] else "below the searched dx"))
+        if "study" not in s:
+            print("no method of the searched grid is predicted to reach it")
+        else:
+            print(f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, CFL {s['cfl']:g}, "
+                  f"dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); run:\n  {s['study']}")
+        print(f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)" if s["paper_dx"] else
+              f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)")
         return 1
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
           f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} of a predicted stable {out['stable_cfl']:.3g}, "
-          f"dx {out['dx']:g}, {out['n_particles']:,} particles, {out['steps']} steps)\n  {out['command']}")
+          f"dx {out['dx']:g}, {out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps)"
+          + (" -- close to the stability limit" if out["cfl_margin"] < 1.2 else "") + f"\n  {out['command']}")
     if out["paper_seconds"]:
         print(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
               f"{out['speedup_over_paper']:.3g}x slower\n  {out['paper_command']}")
     else:
-        print("  no stored run of the paper's configuration reaches it")
+        print("  no stored run of the paper's configuration on the same domain reaches it "
+              "(`pcabench advise --domain full` or `strip` compares another)")
     return 0
 
 
@@ -512,6 +518,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
     p.add_argument("--results", help=results_help)
     p.add_argument("--machine", help="a machine (profile id) of the stores; default this one, else the first")
+    p.add_argument("--domain", choices=("strip", "full"), help="only runs on the y-periodic strip or the full "
+                   "domain (default: either; the paper's configuration is always taken on the fastest run's)")
     p.add_argument("--json", action="store_true", help="one JSON object: command, error, seconds, paper_seconds")
     p.set_defaults(func=cmd_advise)
 

@@ -1,0 +1,54 @@
+"""The pair-list build's cost per candidate and per listed pair, for each kernel (pytest-benchmark).
+
+    python -m pytest -o addopts="" tests/benchmarks/test_list_build.py --benchmark-only [--benchmark-json=F]
+
+A Wendland kernel needs no exp and has half the Gaussian's candidates (support 2h against 3h); "gaussian 2h"
+is the Gaussian cut at the Wendland support, so it shows the cost of the exp alone. Serial, on the lattice
+(`linear`), the build alone; extra info: candidates and pairs per particle, ns per candidate and per pair of
+the best round.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from solvers import Scene, make_solver
+
+DX = 0.1  # 100,000 particles on the paper's domain
+CONFIGS = {"gaussian": {"kernel": "gaussian"}, "wendland-c2": {"kernel": "wendland-c2"},
+           "wendland-c4": {"kernel": "wendland-c4"}, "gaussian 2h": {"kernel": "gaussian", "cutoff_factor": 2.0}}
+
+
+def candidates(solver) -> int:
+    """The candidates the build scans: the rest of each particle's cell row within a cutoff to its right, and
+    the row above within a cutoff either side (rows sorted by x, as the build's binary searches bound them)."""
+    a, rc, ncx = solver.arrays, solver.scene.cutoff, solver.ncx
+    x = (a["lx"].astype(float) + 0.5) * solver.scene.dx + a["sx"]
+    total = 0
+    for cy in range(solver.ncy):
+        lo, hi = int(solver.begin[cy * ncx]), int(solver.begin[(cy + 1) * ncx])
+        up = (cy + 1) % solver.ncy
+        ulo, uhi = int(solver.begin[up * ncx]), int(solver.begin[(up + 1) * ncx])
+        xr, xu = x[lo:hi], x[ulo:uhi]
+        total += int((np.searchsorted(xr, xr + rc, "left") - (np.arange(hi - lo) + 1)).sum())
+        total += int((np.searchsorted(xu, xr + rc, "left") - np.searchsorted(xu, xr - rc, "right")).sum())
+    return total
+
+
+@pytest.mark.parametrize("precision", ("float64", "float32"))
+@pytest.mark.parametrize("name", list(CONFIGS))
+def test_list_build(benchmark, name, precision):
+    solver = make_solver("linkedlist-cpu", threads=1, pair_loop="list")
+    solver.input(Scene(dx=DX, steps=1, model="linear", precision=precision, **CONFIGS[name]))
+    solver.warmup()
+    solver.init()
+    solver.snp()
+    benchmark.group = f"pair-list build, {precision}, N={solver.scene.n_particles}"
+    benchmark.pedantic(lambda: solver.pairs.build(*solver.geometry(), solver.k), rounds=7, iterations=1,
+                       warmup_rounds=1)
+    n, cand, pairs = solver.scene.n_particles, candidates(solver), solver.pairs.pairs
+    best = benchmark.stats.stats.min
+    benchmark.extra_info.update({"kernel": name, "precision": precision, "n_particles": n,
+                                 "candidates_per_particle": cand / n, "pairs_per_particle": pairs / n,
+                                 "ns_per_candidate": 1e9 * best / cand, "ns_per_pair": 1e9 * best / pairs})
+    assert pairs / n == pytest.approx(np.pi * (solver.scene.cutoff / DX) ** 2 / 2, rel=0.1)  # each pair once

@@ -1,0 +1,74 @@
+"""pcabench advise: the fastest stored run reaching an error, like with like, and the paper's method beside it."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from pcabench import store
+from pcabench.advise import advise
+from pcabench.sweep import failed_record
+from pcabench.spec import RunSpec
+from solvers import Scene
+
+from .conftest import cli_main
+
+
+def _row(path, seconds, mse, strip=True, model="linear", mse_isothermal=None, status="ok", **method):
+    dx = method.pop("dx", 0.2)
+    kw = dict(dx=dx, t_end=10.0, model=model, **method)
+    if strip:
+        kw["strip_height"] = 4.0
+    spec = RunSpec("linkedlist-cpu", Scene(**kw)).resolved()
+    rec = failed_record(spec, status, "", "m")
+    rec.steps, rec.t_end, rec.mse, rec.me, rec.mean_neighbours = spec.scene.n_steps, 10.0, mse, 0.001, 50.0
+    rec.mse_isothermal = mse_isothermal
+    rec.stages = {"input": 0.0, "init": 0.0, "snp": 0.0, "pi": seconds, "su": 0.0, "output": 0.0}
+    store.append(rec, path)
+
+
+@pytest.fixture
+def results(tmp_path):
+    path = tmp_path / "results" / store.store_name("m", "h")
+    path.parent.mkdir()
+    _row(path, 50.0, 0.008)  # the paper's method on the strip
+    _row(path, 2.0, 0.006, kernel="wendland-c2", h_factor=2.0, cfl=2.5)
+    _row(path, 1.0, 0.02, kernel="wendland-c4", h_factor=1.3, cfl=1.0)  # faster, not accurate enough
+    _row(path, 0.1, 0.001, strip=False, kernel="wendland-c4", cfl=1.0, status="unstable")  # failed: never advised
+    _row(path, 900.0, 0.007, strip=False)  # the paper's method on the full domain
+    _row(path, 30.0, 0.007, strip=False, kernel="wendland-c2", h_factor=2.0, cfl=2.5)
+    _row(path, 80.0, 0.09, model="lagrangian", mse_isothermal=0.011)
+    _row(path, 3.0, 0.09, model="lagrangian", mse_isothermal=0.012, kernel="wendland-c2", h_factor=2.0, cfl=2.5)
+    return path.parent
+
+
+def test_the_fastest_run_reaching_the_error_against_the_paper_method_on_the_same_domain(results):
+    df = store.load(results)
+    out = advise(df, 0.01, 10.0)
+    assert out["found"] and out["seconds"] == pytest.approx(2.0) and out["kernel"] == "wendland-c2"
+    assert out["domain"] == "strip" and out["paper_seconds"] == pytest.approx(50.0)  # not the full domain's 900
+    assert out["speedup_over_paper"] == pytest.approx(25.0)
+    assert "--kernel wendland-c2" in out["command"] and "--strip-height 4" in out["command"]
+    assert 0 < out["stable_cfl"] and out["cfl_margin"] == pytest.approx(out["stable_cfl"] / 2.5)
+    full = advise(df, 0.01, 10.0, domain="full")
+    assert full["seconds"] == pytest.approx(30.0) and full["paper_seconds"] == pytest.approx(900.0)
+
+
+def test_lagrangian_is_judged_against_its_own_limit(results):
+    out = advise(store.load(results), 0.0125, 10.0, model="lagrangian")
+    assert out["error_against"] == "the isothermal solution"
+    assert out["seconds"] == pytest.approx(3.0) and out["paper_seconds"] == pytest.approx(80.0)
+    assert advise(store.load(results), 0.0105, 10.0, model="lagrangian")["found"] is False
+
+
+def test_advise_command_json_and_what_no_run_reaches(results, capsys):
+    rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", "m", "--json",
+                            capsys=capsys)
+    assert rc == 0, err
+    data = json.loads(out)
+    assert {"command", "error", "seconds", "paper_seconds"} <= set(data)
+    rc, out, err = cli_main("advise", "--error", "0.02", "--t-end", "5", "--results", str(results), "--machine", "m",
+                            capsys=capsys)
+    assert rc == 1 and "none of the 0 stored runs" in out and "pcabench study" in out
+    rc, out, err = cli_main("advise", "--error", "2", "--results", str(results), capsys=capsys)
+    assert rc == 2 and "--error" in err and "Traceback" not in err
