@@ -73,8 +73,9 @@ def paper_configuration(df):
 
 def advise(df, error: float, t_end: float, model: str = "linear", domain: str | None = None) -> dict:
     """The fastest stored run reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``, if given),
-    the fastest run of the paper's configuration on the same domain reaching it, and the ratio. Like is
-    compared with like: a strip holds fewer particles than the full domain for the same answer."""
+    the fastest run of the paper's configuration on the same kind of domain reaching it, and the ratio. Like
+    is compared with like: a strip holds fewer particles than the full domain for the same answer, and on a
+    strip each method runs on the thinnest strip its support allows (a compact kernel's is thinner)."""
     runs = reaching(df, t_end, model)
     if domain is not None and not runs.empty:
         runs = runs[runs.domain == domain]
@@ -90,10 +91,7 @@ def advise(df, error: float, t_end: float, model: str = "linear", domain: str | 
     scene = Scene(t_end=t_end, model=model, memory_limit_bytes=2**62,
                   **{k: v for k, v in scene_of(best).items() if not (isinstance(v, float) and math.isnan(v))})
     stable = predict(scene).stable_cfl
-    same = hits[hits.domain == best.domain]
-    if best.domain == "strip":  # the same strip: the thinnest one differs with the method, so same height only
-        same = same[np.isclose(same.strip_height.astype(float), float(best.strip_height))]
-    paper = paper_configuration(same)
+    paper = paper_configuration(hits[hits.domain == best.domain])  # on a strip: each on its own thinnest strip
     paper_best = paper.iloc[0] if not paper.empty else None
     out.update(found=True, command=command(best, t_end), error=float(best[column]), seconds=float(best.t_solution),
                machine=str(best.machine), solver=str(best.solver), domain=str(best.domain), threads=int(best.threads),

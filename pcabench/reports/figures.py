@@ -281,26 +281,28 @@ def speed_vs_accuracy(df, out: Path, pid: str):
     """Time to solution against error at a fixed time, one panel per time and model: every run (colour:
     kernel; hollow: float32), the paper's method starred, each model's front, and the prediction beside it."""
     points, front = T.speed_front(df)
-    panels = sorted(k for k in {(p["t_final"], p["model"]) for p in points}
-                    if sum((q["t_final"], q["model"]) == k for q in points) >= 3)  # a lone point is no trade-off
+    panels = sorted((k for k in {(p["t_final"], p["model"]) for p in points}
+                     if sum((q["t_final"], q["model"]) == k for q in points) >= 10),  # a few points are no front
+                    key=lambda k: (k[0], T.FRONT_MODELS.index(k[1])))
     if not panels:
         return None
     path = out / "speed_vs_accuracy.png"
     with figure(path, f"Time to solution against error ({pid}): every finished run; black line: the fastest run "
-                "to each error", "time to solution (s: init + steps, no JIT)", "relative RMS error of u at t",
+                "to each error", "time to solution (s: init + steps, no JIT)",
+                "relative RMS error of u at t (lagrangian: vs isothermal)",
                 ncols=len(panels), logx=True, logy=True, size=(5.2 * len(panels) + 3.8, 4.6)) as axes:
         for ax, (t_final, model) in zip(axes, panels):
             here = [p for p in points if (p["t_final"], p["model"]) == (t_final, model)]
             for (kern, precision), pts in _groups(here, ("kernel", "precision")):
                 colour = KERNEL_COLOURS.get(kern, "grey")
-                ax.plot([p["seconds"] for p in pts], [p["mse"] for p in pts], ls="none", marker="o", ms=4.5,
+                ax.plot([p["seconds"] for p in pts], [p["error"] for p in pts], ls="none", marker="o", ms=4.5,
                         color=colour, mfc="none" if precision == "float32" else colour, alpha=0.75,
                         label=f"{kern}, {precision}")
             paper = [p for p in here if p["paper_method"]]
-            ax.plot([p["seconds"] for p in paper], [p["mse"] for p in paper], ls="none", marker="*", ms=11,
+            ax.plot([p["seconds"] for p in paper], [p["error"] for p in paper], ls="none", marker="*", ms=11,
                     mfc="none", mec="black", mew=1.1, label="the paper's method (Gaussian, h 2.13dx, 3h, CFL 0.2)")
             fp = [p for p in front if (p["t_final"], p["model"]) == (t_final, model)]
-            ax.step([p["seconds"] for p in fp], [p["mse"] for p in fp], color="black", where="post", lw=1.3,
+            ax.step([p["seconds"] for p in fp], [p["error"] for p in fp], color="black", where="post", lw=1.3,
                     label="front: fastest run to each error")
             ax.plot([p["seconds"] for p in fp], [T.predicted_error(p) for p in fp], ls="none", marker="x", ms=6,
                     color="crimson", label="front runs, predicted (dispersion relation, linear part)")
