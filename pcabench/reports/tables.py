@@ -338,6 +338,28 @@ def predicted_error(p: dict) -> float:
                          memory_limit_bytes=2**62, **scene)).predicted_error
 
 
+def predicted_by_model(df, dxs=(0.4, 0.2, 0.1)) -> list[dict]:
+    """Measured against predicted error for every model: the paper's method on the strip at t = 10 s."""
+    d = latest(paper_method_rows(df[(df.status == "ok") & (df.domain == "strip") & (df.protocol == "t = 10 s")]))
+    rows = []
+    for model in ("linear", "fixed", "lagrangian"):
+        for dx in dxs:
+            r = d[(d.model == model) & np.isclose(d.dx.astype(float), dx) & (d.precision == "float64")]
+            if r.empty:
+                continue
+            r = r.sort_values("timestamp").iloc[-1]
+            p = {"kernel": "gaussian", "h_factor": r.h_factor, "cfl": r.cfl, "integrator": r.integrator,
+                 "cutoff_factor": r.cutoff_factor, "dx": dx, "t_final": r.t_final, "strip_height": r.strip_height}
+            rows.append({"model": model, "dx": dx, "measured": r.mse, "predicted": predicted_error(p),
+                         "isothermal": r.mse_isothermal})
+    return rows
+
+
+def paper_method_rows(df):
+    """The rows of the paper's numerics (``is_paper_method``)."""
+    return df[[is_paper_method(r) for _, r in df.iterrows()]] if not df.empty else df
+
+
 def fastest_to(points, targets=(0.10, 0.05, 0.02, 0.01, 0.005)) -> list[dict]:
     """For each time, model and error target: the fastest run reaching it, the fastest run of the paper's
     method reaching it, and how many times faster the first is."""
