@@ -19,7 +19,7 @@ import numpy as np
 from solvers import Scene
 from solvers.dispersion import predict
 
-from .reports.tables import default_numerics, latest
+from .reports.tables import comparable, default_numerics, latest
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid).
 SEARCH_KERNELS = ("gaussian", "wendland-c2", "wendland-c4")
@@ -73,9 +73,10 @@ def paper_configuration(df):
 
 def advise(df, error: float, t_end: float, model: str = "linear", domain: str | None = None) -> dict:
     """The fastest stored run reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``, if given),
-    the fastest run of the paper's configuration on the same kind of domain reaching it, and the ratio. Like
-    is compared with like: a strip holds fewer particles than the full domain for the same answer, and on a
-    strip each method runs on the thinnest strip its support allows (a compact kernel's is thinner)."""
+    the fastest run of the paper's configuration reaching it that compares with it, and the ratio. Like is
+    compared with like (``tables.comparable``): the same kind of domain (a strip holds fewer particles than
+    the full domain; on a strip each method runs on the thinnest strip its support allows), the same
+    threads and the same commit."""
     runs = reaching(df, t_end, model)
     if domain is not None and not runs.empty:
         runs = runs[runs.domain == domain]
@@ -91,10 +92,11 @@ def advise(df, error: float, t_end: float, model: str = "linear", domain: str | 
     scene = Scene(t_end=t_end, model=model, memory_limit_bytes=2**62,
                   **{k: v for k, v in scene_of(best).items() if not (isinstance(v, float) and math.isnan(v))})
     stable = predict(scene).stable_cfl
-    paper = paper_configuration(hits[hits.domain == best.domain])  # on a strip: each on its own thinnest strip
+    paper = paper_configuration(hits[[comparable(r, best) for _, r in hits.iterrows()]])
     paper_best = paper.iloc[0] if not paper.empty else None
     out.update(found=True, command=command(best, t_end), error=float(best[column]), seconds=float(best.t_solution),
-               machine=str(best.machine), solver=str(best.solver), domain=str(best.domain), threads=int(best.threads),
+               machine=str(best.machine), solver=str(best.solver), domain=str(best.domain),
+               precision=str(best.precision), commit=str(best.commit)[:12], threads=int(best.threads),
                n_particles=int(best.n_particles), steps=int(best.steps), **scene_of(best),
                stable_cfl=stable, cfl_margin=stable / float(best.cfl) if stable else 0.0,
                paper_seconds=None if paper_best is None else float(paper_best.t_solution),

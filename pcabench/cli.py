@@ -391,14 +391,15 @@ def cmd_advise(args) -> int:
         return 1
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
           f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} of a predicted stable {out['stable_cfl']:.3g}, "
-          f"dx {out['dx']:g}, {out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps)"
+          f"dx {out['dx']:g}, {out['precision']}, {out['threads']} thread(s), {out['domain']} domain, "
+          f"{out['n_particles']:,} particles, {out['steps']} steps, commit {out['commit'][:7]})"
           + (" -- close to the stability limit" if out["cfl_margin"] < 1.2 else "") + f"\n  {out['command']}")
     if out["paper_seconds"]:
         print(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
               f"{out['speedup_over_paper']:.3g}x slower\n  {out['paper_command']}")
     else:
-        print("  no stored run of the paper's configuration on the same domain reaches it "
-              "(`pcabench advise --domain full` or `strip` compares another)")
+        print("  no stored run of the paper's configuration that compares with it (same kind of domain, threads "
+              "and commit) reaches it; `pcabench advise --domain full` or `strip` looks at another")
     return 0
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import json
 import os
 import shutil
 import signal
@@ -208,7 +209,13 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
         for c in commits:
             row(c, message=f"not run: {exc} {detail}".strip())
         return rows
-    results = root / "reports" / "asv" / "results" / machine
+    # asv writes machine.json and benchmarks.json into its results folder: a scratch copy of the config points
+    # it under ``out``, so the committed reports/asv/results stay as they are (as in .ci/run)
+    scratch = Path(out).resolve() / "asv-results"
+    config = root / ".asv-gpu-check.conf.json"
+    config.write_text((root / "asv.conf.json").read_text().replace(
+        '"results_dir": "reports/asv/results"', json.dumps({"results_dir": str(scratch)})[1:-1]))
+    results = scratch / machine
     path = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
     for i, commit in enumerate(commits):
         t0, wall, sha, tmp = time.monotonic(), time.time(), None, None  # wall: results written by this run
@@ -224,7 +231,8 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
             asv_path = code + path + ([] if str(root) in path else [str(root)])
             timeout = left / (len(commits) - i)
             _say(f"{commit} = {sha[:8]}: asv run, at most {timeout:.0f} s, code from {code[0] if code else root}")
-            rc = _run([sys.executable, "-m", "asv", "run", "--python=same", "--set-commit-hash", sha,
+            rc = _run([sys.executable, "-m", "asv", "--config", str(config), "run", "--python=same",
+                       "--set-commit-hash", sha,
                        "--machine", machine, "-b", bench, "--show-stderr", *asv_args], root,
                       {**env, "ASV_PYTHONPATH": os.pathsep.join(asv_path)}, timeout)
             found = sorted(f for f in results.glob(f"{sha[:8]}-*.json") if f.stat().st_mtime >= wall)

@@ -329,13 +329,19 @@ def _section_stability(df) -> list[str]:
     return lines
 
 
+def _first_words(message: str, limit: int = 120) -> str:
+    """The message's first line, cut at a word boundary with an ellipsis if longer than ``limit``."""
+    line = message.splitlines()[0] if message else ""
+    return line if len(line) <= limit else line[:limit].rsplit(" ", 1)[0] + " ..."
+
+
 def _section_failed(df) -> list[str]:
     bad = T.latest(df[df.status != "ok"])
     if bad.empty:
         return []
     rows = [[r.solver, r.precision, r.model, r.integrator, f"{r.dx:g}", f"{int(r.n_particles):,}", r.protocol,
              fmt(r.cfl, "g"), r.status, "-" if r.failed_step is None or not np.isfinite(r.failed_step)
-             else int(r.failed_step), str(r.message).splitlines()[0][:120] if r.message else ""]
+             else int(r.failed_step), _first_words(str(r.message)) if r.message else ""]
             for _, r in bad.sort_values(["status", "solver", "dx"]).iterrows()]
     return ["## Runs that did not finish", "",
             md_table(["solver", "precision", "model", "integrator", "dx", "N", "protocol", "CFL", "status", "step",
@@ -460,6 +466,7 @@ def write_reports(results_dir: Path, reports_dir: Path) -> list[Path]:
              "- [cards.md](cards.md): Table 6, Fig. 14 and the GPU cards side by side, every system"]
     index += [f"- [{p.parent.name}]({p.parent.name}/report.md): {_machine(p.parent.name.split('--')[0])}"
               for p in paths if p.name == "report.md"]
-    index += ["", "GPU check tables and Nsight Compute profiles: [gpu/](gpu/); notes: [gpu/NOTES.md](gpu/NOTES.md)."]
+    if (reports_dir / "gpu" / "NOTES.md").exists():  # the committed reference has them; a user's results do not
+        index += ["", "GPU check tables and Nsight Compute profiles: [gpu/](gpu/); notes: [gpu/NOTES.md](gpu/NOTES.md)."]
     (reports_dir / "README.md").write_text("\n".join(index) + "\n")
     return paths + [reports_dir / "README.md"]

@@ -313,7 +313,8 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
                        "integrator": r.integrator, "cutoff_factor": r.cutoff_factor, "precision": r.precision,
                        "model": r.model, "domain": r.domain, "dx": r.dx, "N": int(r.n_particles),
                        "t_final": r.t_final, "seconds": r.t_solution, "error": float(error), "mse": r.mse,
-                       "strip_height": r.strip_height, "solver": r.solver, "threads": int(r.threads)})
+                       "strip_height": r.strip_height, "solver": r.solver, "threads": int(r.threads),
+                       "commit": str(r.commit)})
     front = []
     for t_final, model in sorted({(p["t_final"], p["model"]) for p in points}):
         best = np.inf
@@ -323,6 +324,12 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
                 best = p["error"]
                 front.append(p)
     return points, front
+
+
+def comparable(a, b) -> bool:
+    """Two runs whose times compare: the same kind of domain (on a strip each method has its own thinnest
+    strip), the same threads, and the same code (commit): speed changes from commit to commit."""
+    return a["domain"] == b["domain"] and int(a["threads"]) == int(b["threads"]) and a["commit"] == b["commit"]
 
 
 def predicted_error(p: dict) -> float:
@@ -368,8 +375,8 @@ def fastest_to(points, targets=(0.10, 0.05, 0.02, 0.01, 0.005)) -> list[dict]:
         pts = sorted((p for p in points if p["t_final"] == t_final and p["model"] == model), key=lambda p: p["seconds"])
         for target in targets:
             hit = next((p for p in pts if p["error"] <= target), None)
-            paper = hit and next((p for p in pts if p["error"] <= target and p["paper_method"]
-                                  and p["domain"] == hit["domain"]), None)
+            paper = hit and next((p for p in pts if p["error"] <= target and p["paper_method"] and comparable(p, hit)),
+                                 None)
             rows.append({"t_final": t_final, "model": model, "target": target, "best": hit, "paper": paper,
                          "speedup": paper["seconds"] / hit["seconds"] if hit and paper else None})
     return rows
