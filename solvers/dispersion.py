@@ -111,11 +111,29 @@ class ModeSolver:
         self.drho, self.u, self.ax, self.dd = (np.array(row, complex) for row in s)
 
 
-def evolve(solver: ModeSolver, integrator: str, steps: int) -> ModeSolver:
-    """``steps`` steps of ``integrator``'s program, the first one primed as a run's is."""
-    for step in range(1, steps + 1):
-        for _stage, op in step_program(integrator, solver, first=(step == 1)):
+def step_matrices(integrator: str, d, rho0: float, c0: float, dt: float, first: bool = False) -> np.ndarray:
+    """One step of ``integrator``'s program as a matrix per mode, (len(d), 4, 4), acting on (drho, u, ax, dd):
+    the program run on the four basis states (the step is linear)."""
+    d = np.asarray(d, float)
+    solver = ModeSolver(d, np.zeros_like(d), np.zeros_like(d), rho0, c0, dt)
+    columns = []
+    for e in np.eye(4):
+        solver.set_state(np.multiply.outer(e, np.ones_like(d)))
+        for _stage, op in step_program(integrator, solver, first=first):
             op()
+        columns.append(solver.state())
+    return np.moveaxis(np.stack(columns, axis=1), -1, 0)  # column j: the step of basis state e_j
+
+
+def evolve(solver: ModeSolver, integrator: str, steps: int) -> ModeSolver:
+    """``steps`` steps of ``integrator``'s program, the first one primed as a run's is: the first step's
+    matrix, then the power of the others' (so the cost does not grow with the number of steps)."""
+    first = step_matrices(integrator, solver.d, solver.rho0, solver.c0, solver.dt, first=True)
+    rest = np.linalg.matrix_power(step_matrices(integrator, solver.d, solver.rho0, solver.c0, solver.dt),
+                                  steps - 1)
+    state = np.einsum("nij,njk,kn->in", rest, first, solver.state())
+    solver.set_state(state)
+    solver.t += steps * solver.dt
     return solver
 
 
@@ -134,16 +152,7 @@ def predicted_velocity(scene) -> tuple[np.ndarray, np.ndarray, float]:
 
 def amplification_radius(integrator: str, z) -> np.ndarray:
     """Spectral radius of one step (after the first) of ``integrator`` for c0 |D| dt = z (rho0 = c0 = dt = 1)."""
-    z = np.asarray(z, float)
-    solver = ModeSolver(z, np.zeros_like(z), np.zeros_like(z), 1.0, 1.0, 1.0)
-    columns = []
-    for e in np.eye(4):
-        solver.set_state(np.multiply.outer(e, np.ones_like(z)))
-        for _stage, op in step_program(integrator, solver, first=False):
-            op()
-        columns.append(solver.state())
-    matrices = np.moveaxis(np.stack(columns, axis=1), -1, 0)  # (len(z), 4, 4): column j = step of basis e_j
-    return np.abs(np.linalg.eigvals(matrices)).max(axis=1)
+    return np.abs(np.linalg.eigvals(step_matrices(integrator, z, 1.0, 1.0, 1.0))).max(axis=1)
 
 
 def largest_stable_z(integrator: str) -> float:
@@ -189,13 +198,6 @@ def predict(scene) -> Prediction:
 
 def step_phase_angle(integrator: str, z: float) -> float:
     """The phase a right-running mode turns through in one step, rad, for c0 D dt = z (leapfrog: 2 asin(z/2))."""
-    solver = ModeSolver([z], [0.0], [0.0], 1.0, 1.0, 1.0)
-    columns = []
-    for e in np.eye(4):
-        solver.set_state(e[:, None])
-        for _stage, op in step_program(integrator, solver, first=False):
-            op()
-        columns.append(solver.state()[:, 0])
-    eig = np.linalg.eigvals(np.stack(columns, axis=1))
+    eig = np.linalg.eigvals(step_matrices(integrator, [z], 1.0, 1.0, 1.0)[0])
     angles = np.abs(np.angle(eig[np.abs(eig) > 0.5]))  # the auxiliary rates' eigenvalues are 0
     return float(angles[np.argmin(np.abs(angles - z))])  # the physical mode: nearest the exact phase z
