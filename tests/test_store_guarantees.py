@@ -177,18 +177,21 @@ def test_a_killed_child_names_its_signal_and_oom_only_when_it_was():
     assert exit_status(3, None, None) == ("error", "exit code 3")
 
 
-def test_retry_failed_runs_timeouts_skips_and_errors_again(tmp_path, monkeypatch):
-    path = tmp_path / "s.jsonl"
-    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2)).resolved()
-    made = []
-
-    def fake_child(spec, timeout, commit, machine, stream=None):
+def fake_child(made: list):
+    """A run child that runs nothing: it notes the spec in ``made`` and returns an ok record of 2 steps."""
+    def child(spec, timeout, commit, machine, stream=None):
         made.append(spec)
         rec = sweep_module.failed_record(spec, "ok", "", machine)
         rec.steps = 2
         return store.to_row(rec)
+    return child
 
-    monkeypatch.setattr(sweep_module, "run_child", fake_child)
+
+def test_retry_failed_runs_timeouts_skips_and_errors_again(tmp_path, monkeypatch):
+    path = tmp_path / "s.jsonl"
+    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2)).resolved()
+    made = []
+    monkeypatch.setattr(sweep_module, "run_child", fake_child(made))
     store.append(sweep_module.failed_record(spec, "timeout", "past the run budget", machine_id()),
                  path)
     sweep([spec], path, run_budget=60, sweep_budget=60)
@@ -288,14 +291,12 @@ def test_a_full_disk_stores_the_run_in_the_reserve_and_stops_the_sweep(tmp_path,
             raise OSError(errno.ENOSPC, "No space left on device")
         return real_write(fd, data)
 
-    def fake_child(spec, timeout, commit, machine, stream=None):
+    def filling_child(spec, timeout, commit, machine, stream=None):
         monkeypatch.setattr(os, "write", filling)
-        rec = sweep_module.failed_record(spec, "ok", "", machine)
-        rec.steps = 2
-        return store.to_row(rec)
+        return fake_child([])(spec, timeout, commit, machine, stream)
 
     with pytest.raises(store.StoreError, match="was stored in the space kept for it"):
-        sweep(specs, path, run_budget=60, sweep_budget=60, runner=fake_child)
+        sweep(specs, path, run_budget=60, sweep_budget=60, runner=filling_child)
     monkeypatch.setattr(os, "write", real_write)
     assert full and path.read_bytes().endswith(b"\n")
     assert [r["dx"] for r in store.read_rows(path)] == [1.0]  # the run that met the full disk is stored
@@ -385,27 +386,14 @@ def test_study_report_and_runs_survive_every_odd_row_at_once(tmp_path, capsys, m
         monkeypatch.setattr(sweep_module, "host_id", lambda: good["host"])
         made = []
 
-        def fake_child(spec, timeout, commit, machine, stream=None):
-            made.append(spec)
-            rec = sweep_module.failed_record(spec, "ok", "", machine)
-            rec.steps = 2
-            return store.to_row(rec)
-
-        sweep([spec], path, run_budget=60, sweep_budget=60, runner=fake_child)  # reads them all to predict
+        sweep([spec], path, run_budget=60, sweep_budget=60, runner=fake_child(made))  # reads them all to predict
     assert len(made) == 1
 
 
 def test_a_run_given_twice_is_run_and_stored_once(tmp_path):
     made = []
-
-    def fake_child(spec, timeout, commit, machine, stream=None):
-        made.append(spec)
-        rec = sweep_module.failed_record(spec, "ok", "", machine)
-        rec.steps = 2
-        return store.to_row(rec)
-
     spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))
-    sweep([spec, spec], tmp_path / "s.jsonl", run_budget=60, sweep_budget=60, runner=fake_child)
+    sweep([spec, spec], tmp_path / "s.jsonl", run_budget=60, sweep_budget=60, runner=fake_child(made))
     assert len(made) == 1 and len(store.read_rows(tmp_path / "s.jsonl")) == 1
 
 
