@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from solvers import Scene
-from solvers.dispersion import predict
+from solvers.dispersion import predict, stable_cfl
 
 from .reports.tables import comparable, default_numerics, latest
 
@@ -91,7 +91,7 @@ def advise(df, error: float, t_end: float, model: str = "linear", domain: str | 
     best = hits.iloc[0]
     scene = Scene(t_end=t_end, model=model, memory_limit_bytes=2**62,
                   **{k: v for k, v in scene_of(best).items() if not (isinstance(v, float) and math.isnan(v))})
-    stable = predict(scene).stable_cfl
+    stable = stable_cfl(scene)
     paper = paper_configuration(hits[[comparable(r, best) for _, r in hits.iterrows()]])
     paper_best = paper.iloc[0] if not paper.empty else None
     out.update(found=True, command=command(best, t_end), error=float(best[column]), seconds=float(best.t_solution),
@@ -115,7 +115,7 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
             base = Scene(dx=dx, t_end=t_end, model="linear", kernel=kern, h_factor=h, memory_limit_bytes=2**62)
         except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
             continue
-        limit = predict(base.replace(t_end=min(t_end, 10 * dx))).stable_cfl
+        limit = stable_cfl(base)
         for share in SEARCH_CFL_SHARE if limit > 0 else ():
             scene = base.replace(cfl=round(share * limit, 2))
             p = predict(scene)

@@ -122,10 +122,9 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
                         "where it fits in memory")
 
 
-ACCURACY_OPTIONS = {"kernel": "kernel", "integrator": "integrator", "cutoff": "cutoff_factor", "h_factor": "h_factor",
-                    "cfl": "cfl"}
 SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
                  "kernel": "kernel", "h_factor": "h_factor", "cfl": "cfl"}
+ACCURACY_OPTIONS = {opt: key for opt, key in SCENE_OPTIONS.items() if opt not in ("precision", "model")}  # the method
 
 
 def scene_from_args(args) -> Scene:
