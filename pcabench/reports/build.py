@@ -216,7 +216,8 @@ def _section_front(df) -> list[str]:
             "pulse for `linear`, the isothermal solution (solvers/isothermal1d.py) for `lagrangian` (its error "
             "against the linear pulse never falls below the two equations' 9.8 % difference at t = 10 s; "
             "lagrangian runs from before this was measured are left out). `fixed` solves neither and is in the "
-            "cost of the simplifications below.", "",
+            "cost of the simplifications below. A quick study runs the paper's method only (every ratio is then "
+            "1); `pcabench study --front` adds the other kernels, h/dx and steps.", "",
             md_table(["model", "t (s)", "error target", "fastest method", "dx", "domain", "precision, threads",
                       "time (s)", "error", "paper's method: dx", "threads", "time (s)", "paper / fastest"], rows), "",
             "The front (the runs no faster run of the same model beats in error), with the error the dispersion "
