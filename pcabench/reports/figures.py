@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+from matplotlib.ticker import NullFormatter
 
 from . import tables as T
 
@@ -310,6 +311,8 @@ def speed_vs_accuracy(df, out: Path, pid: str):
             ax.plot([p["seconds"] for p in fp], [T.predicted_error(p) for p in fp], ls="none", marker="x", ms=6,
                     color="crimson", label="front runs, predicted (dispersion relation, linear part)")
             ax.set_title(f"{model}, t = {t_final:g} s ({len(here)} runs)", fontsize=9)
+            for axis in (ax.xaxis, ax.yaxis):  # a narrow log range labels its minor ticks too, and they collide
+                axis.set_minor_formatter(NullFormatter())
     return path
 
 
