@@ -2,11 +2,11 @@
 
 Each measurement starts a fresh interpreter, as a new user's first run does.
 """
-from .common import jit_seconds_in_fresh_process
+from .common import jit_seconds_in_fresh_process, solver_names
 
 
 class TrackJIT:
-    params = [["allpair-cpu", "linkedlist-cpu"], ["float64", "float32"]]
+    params = [solver_names("cpu"), ["float64", "float32"]]
     param_names = ["solver", "precision"]
     unit = "s"
     timeout = 600

@@ -4,11 +4,11 @@ Compilation and the first step happen in ``setup``, outside the timed region
 (``bench_jit.py`` times compilation on its own). All-pair stops at 16K
 particles; ``PCABENCH_BENCH_LARGE=1`` adds 100K and 400K for the linked list.
 """
-from .common import Prepared, StageBenchmarks, Unsupported, cpu_dx
+from .common import Prepared, StageBenchmarks, Unsupported, cpu_dx, solver_names
 
 
 class TimeStep(StageBenchmarks):
-    params = [["allpair-cpu", "linkedlist-cpu"], ["float64", "float32"], list(cpu_dx())]
+    params = [solver_names("cpu"), ["float64", "float32"], list(cpu_dx())]
     param_names = ["solver", "precision", "dx"]
     timeout = 300
     min_run_count = 3

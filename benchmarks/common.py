@@ -45,6 +45,26 @@ analytic_errors = import_module(f"{solvers.__name__}.analytic").errors
 step_program = import_module(f"{solvers.__name__}.integrators").step_program
 
 
+def solver_names(device: str | None = None) -> list:
+    """The solvers to benchmark: every registered one (plug-ins included), or those on ``device`` (cpu, gpu).
+    Commits before the registry (2026-11-30) had these three built in."""
+    if hasattr(solvers, "registry"):
+        return [name for name, cls in solvers.registry().items() if device in (None, cls.device)]
+    builtin = {"allpair-cpu": "cpu", "linkedlist-cpu": "cpu", "linkedlist-gpu": "gpu"}
+    return [name for name, where in builtin.items() if device in (None, where)]
+
+
+def is_gpu(solver: str) -> bool:
+    return solver in solver_names("gpu")
+
+
+def is_all_pairs(solver: str) -> bool:
+    """Whether ``solver`` tests every pair (O(N^2)), so that it stops at ALLPAIR_MAX_N."""
+    if hasattr(solvers, "registry"):
+        return solvers.solver_class(solver).order >= 2
+    return solver == "allpair-cpu"
+
+
 def thinnest_strip(dx: float) -> float:
     """The thinnest y-periodic strip Scene accepts at ``dx``, m (older commits: the harness's presets)."""
     if hasattr(Scene, "thinnest_strip"):
@@ -98,9 +118,9 @@ class Prepared:
     def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=1, pair_loop=None,
                  **scene):
         self.scene = Scene(dx=dx, precision=precision, **{"steps": 100, **scene})
-        if solver == "linkedlist-gpu" and not gpu_available():
+        if is_gpu(solver) and not gpu_available():
             raise Unsupported("no CUDA GPU here")
-        if solver == "allpair-cpu" and self.scene.n_particles > ALLPAIR_MAX_N:
+        if is_all_pairs(solver) and self.scene.n_particles > ALLPAIR_MAX_N:
             raise Unsupported(f"all-pair past {ALLPAIR_MAX_N:,} particles")
         self.name = solver
         # pair_loop: commits before the pair list have none (Unsupported there)

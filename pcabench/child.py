@@ -22,15 +22,12 @@ from .store import to_row
 def run_spec(spec: RunSpec) -> dict:
     """Run one resolved spec with step progress on stderr; its record as a store row."""
     progress = Progress(f"    {spec.solver} N={spec.scene.n_particles:,}", every=5.0)
-    record = run(spec.scene, spec.solver, threads=spec.threads, profile_id=machine_id(), pair_loop=spec.pair_loop,
-                 progress=progress)
-    record.preset = spec.preset
-    return to_row(record)
+    return to_row(run(spec, machine_id(), progress=progress))
 
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    print(json.dumps(run_spec(RunSpec.from_json(argv[0]).resolved()), sort_keys=True), flush=True)
+    print(json.dumps(run_spec(RunSpec.from_json(argv[0])), sort_keys=True), flush=True)
     return 0
 
 

@@ -22,19 +22,25 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from solvers import INTEGRATORS, KERNELS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
+from solvers import DEFAULT_SOLVER, INTEGRATORS, KERNELS, MODELS, PRECISIONS, Scene, SceneError, SolverUnavailable, registry
 
 from . import __version__, paths
 from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
 
-SOLVER_HELP = """solvers:
-  allpair-cpu     every pair tested (the paper's all-pair search), serial
-  linkedlist-cpu  uniform cell list (the paper's cellBegin arrays), serial or --threads N|all;
-                  --pair-loop list (default where it fits) or gather (the paper's loop)
-  linkedlist-gpu  the cell list on a CUDA GPU, CuPy + numba-cuda (pip install -e ".[gpu]")
-models:
+
+def solver_help() -> str:
+    """The solvers section of --help, from each solver's own ``summary`` (plug-ins included)."""
+    width = max(map(len, registry())) + 2
+    lines = ["solvers:"]
+    for name, cls in registry().items():
+        first, *rest = (cls.summary or cls.__doc__ or "").strip().splitlines() or [""]
+        lines += [f"  {name:<{width}}{first}"] + [f"  {'':<{width}}{line.strip()}" for line in rest]
+    return "\n".join(lines)
+
+
+MODEL_HELP = """models:
   lagrangian  the paper's: particles move, rho = rho0 + drho (isothermal Euler at Ma 0.05)
   fixed       particles stay on the lattice, rho = rho0 + drho
   linear      particles stay, coefficients frozen at rho0: exactly the linear wave equation
@@ -114,12 +120,15 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
                    help=f"the Gaussian's cutoff in units of h (default {d('cutoff_factor'):g})")
     p.add_argument("--h-factor", type=number("--h-factor"), **n, help=f"h / dx (default {d('h_factor'):g})")
     p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
+    threaded = ", ".join(name for name, cls in registry().items() if cls.threaded)
+    loops = {name: cls.pair_loops for name, cls in registry().items() if len(cls.pair_loops) > 1}
     p.add_argument("--threads", type=threads_option, **n,
-                   help="CPU threads for linkedlist-cpu: N or 'all' (default 1: serial, like the paper's CPU code)")
-    p.add_argument("--pair-loop", choices=("auto", "list", "gather"), **n,
-                   help="linkedlist-cpu's pair loop: list (each pair once per search, kernel factors kept) or "
-                        "gather (the paper's: every particle's stencil in every sweep); default auto: list "
-                        "where it fits in memory")
+                   help=f"CPU threads for {threaded}: N or 'all' (default 1: serial, like the paper's CPU code)")
+    p.add_argument("--pair-loop", choices=("auto", *dict.fromkeys(x for v in loops.values() for x in v)), **n,
+                   help="the pair loop of a solver with several (" + "; ".join(
+                       f"{name}: {', '.join(v)}" for name, v in loops.items()) + "): list visits each pair once "
+                        "per search and keeps its kernel factors, gather is the paper's (every particle's stencil "
+                        "in every sweep); default auto: the solver's choice (list where it fits in memory)")
 
 
 SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
@@ -184,8 +193,7 @@ def cmd_run(args) -> int:
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
-    record = run(scene, spec.solver, threads=spec.threads, fields_path=args.fields, progress=progress,
-                 profile_id=machine_id(), pair_loop=spec.pair_loop)
+    record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
@@ -216,7 +224,7 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
 
     if args.dx:
         lists = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt)}
-        return "matrix", matrix(args.solver or ["linkedlist-cpu"], args.dx, threads=args.threads or [SERIAL],
+        return "matrix", matrix(args.solver or [DEFAULT_SOLVER], args.dx, threads=args.threads or [SERIAL],
                                 steps=args.steps or [None], t_ends=args.t_end or [None], strip=args.strip,
                                 pair_loops=args.pair_loop or ["auto"], **lists)
     if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")) \
@@ -253,7 +261,7 @@ def cmd_study(args) -> int:
     if args.cluster:  # the workers check their own solvers (a GPU run needs a GPU worker, not a GPU here)
         specs = [spec.resolved() for spec in specs]
     else:
-        check_specs(specs)
+        specs = check_specs(specs)
     run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
@@ -434,8 +442,8 @@ def build_parser() -> argparse.ArgumentParser:
     reports_help = f"folder for the reports (default: {paths.user_reports()})"
 
     p = sub.add_parser("run", help="run one scene on one solver and print the stage table",
-                       epilog=SOLVER_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--solver", required=True, choices=SOLVERS)
+                       epilog=solver_help() + "\n" + MODEL_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--solver", required=True, choices=registry())
     add_scene_options(p, many=False)
     p.add_argument("--strip-height", type=number("--strip-height"),
                    help="replace the 20 m height by a y-periodic strip of this height, m")
@@ -446,7 +454,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("study", help="run a sweep (each run in its own process) and write the report",
                        description="Run a preset, or the product of the matrix options, one process per run.",
-                       epilog=SOLVER_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+                       epilog=solver_help() + "\n" + MODEL_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
     g = p.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="a few minutes on a laptop CPU (default)")
     g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets")
@@ -456,7 +464,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
                         "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the predicted fastest, serial (quick: 296 runs; full: 2408)")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
-    m.add_argument("--solver", nargs="+", choices=SOLVERS)
+    m.add_argument("--solver", nargs="+", choices=registry())
     add_scene_options(m, many=True)
     m.add_argument("--strip", action="store_true", help="the thinnest y-periodic strip instead of 20 m")
     p.add_argument("--results", type=folder("--results"), default=str(paths.user_results()), help=results_help)

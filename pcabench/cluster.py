@@ -29,11 +29,12 @@ from .predict import predicted_seconds
 from .profiles import machine_id
 from .provenance import git_commit, host_id
 from .record import step_seconds
+from solvers import solver_class
+
 from .spec import OptionError, RunSpec, identity
 from .sweep import RETRIED, eta_text, failed_record, run_child
 
 TIMING = "timing"  # one per worker: one timed run at a time
-GPU = "GPU"
 LOOPBACK = "127.0.0.1"  # a local cluster (scheduler, workers, dashboard) listens here only
 
 
@@ -76,7 +77,9 @@ def worker_resources(client) -> dict:
 
 
 def task_resources(spec: RunSpec) -> dict:
-    return {TIMING: 1, GPU: 1} if spec.solver == "linkedlist-gpu" else {TIMING: 1}
+    """What one run of ``spec`` takes on a worker: its solver's ``resources`` (one ``timing`` slot; a GPU run
+    one ``GPU`` too)."""
+    return dict(solver_class(spec.solver).resources)
 
 
 def run_on_worker(spec_json: str, timeout: float, commit: str) -> dict:

@@ -198,7 +198,7 @@ def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
             fields = {}
             for solver in ("linkedlist-cpu", "linkedlist-gpu"):
                 path = out / f"compare_{solver}.npz"
-                rec = run(scene, solver, fields_path=path)
+                rec = run(RunSpec(solver, scene), fields_path=path)
                 if rec.status != "ok":
                     raise RuntimeError(f"{solver} {model} {precision}: {rec.status} {rec.message}")
                 fields[solver] = dict(np.load(path))

@@ -5,7 +5,7 @@ of the same solver, precision, model and threads (any protocol), per
 neighbour for the cell lists: their step time is taken proportional to the
 neighbours per particle, (cutoff / dx)^2, so runs of another kernel or h/dx
 inform the fit. With two or more sizes ``b`` is fitted; with one, ``b`` is
-the algorithm's order (2 for all-pair, 1 for a cell list). A run whose predicted time, steps times step
+the solver's ``order`` (2 for all-pair, 1 for a cell list). A run whose predicted time, steps times step
 plus JIT and start-up, exceeds the run budget is recorded as ``skipped`` with
 the prediction, instead of being run into the wall.
 """
@@ -15,10 +15,10 @@ import math
 
 import numpy as np
 
+from solvers import solver_class
+
 from .record import step_seconds
 
-ORDER = {"allpair-cpu": 2.0}  # the default is 1.0: the cell list is linear in N
-ALL_PAIRS = ("allpair-cpu",)  # tests every pair whatever the cutoff: not scaled by neighbours
 START_UP = 5.0  # s: a child process, imports and JIT on a tiny scene (measured 3-7 s on a laptop CPU)
 
 
@@ -32,7 +32,7 @@ def _same_config(row: dict, spec) -> bool:
 
 def _reach(solver: str, scene: dict) -> float:
     """(cutoff / dx)^2 of a scene dict, which the neighbours per particle scale with (1 for all-pair)."""
-    if solver in ALL_PAIRS or not scene.get("cutoff") or not scene.get("dx"):
+    if "all-pairs" in solver_class(solver).pair_loops or not scene.get("cutoff") or not scene.get("dx"):
         return 1.0
     return (scene["cutoff"] / scene["dx"]) ** 2
 
@@ -53,9 +53,9 @@ def step_model(spec, rows: list[dict]):
     t = np.array([pts[k] for k in sorted(pts)])
     if len(n) >= 2:
         b = float(np.polyfit(np.log(n[-3:]), np.log(t[-3:]), 1)[0])  # the three largest sizes
-        b = max(b, ORDER.get(spec.solver, 1.0) * 0.5)  # never extrapolate flatter than half the order
+        b = max(b, solver_class(spec.solver).order * 0.5)  # never extrapolate flatter than half the order
     else:
-        b = ORDER.get(spec.solver, 1.0)
+        b = solver_class(spec.solver).order
     a = float(t[-1] / n[-1] ** b)
     return a, b, [int(k) for k in n]
 

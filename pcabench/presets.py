@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import itertools
 
-from solvers import Scene
+from solvers import DEFAULT_SOLVER, Scene, solver_class
 
 from .spec import ALL_CORES, SERIAL, RunSpec
 
@@ -27,7 +27,7 @@ STABILITY_H = (1.0, 1.3)  # h/dx beside Scene's default
 INACCURATE_ABOVE = 0.20
 
 
-def _spec(solver="linkedlist-cpu", threads=SERIAL, strip=False, pair_loop="auto", **scene) -> RunSpec:
+def _spec(solver=DEFAULT_SOLVER, threads=SERIAL, strip=False, pair_loop="auto", **scene) -> RunSpec:
     """One run; ``strip`` puts it on the thinnest y-periodic strip Scene accepts."""
     if strip:
         scene["strip_height"] = Scene.thinnest_strip(scene["dx"], scene.get("cutoff_factor"),
@@ -150,7 +150,7 @@ def preset(name: str) -> list[RunSpec]:
     return [RunSpec(s.solver, s.scene, s.threads, name, s.pair_loop) for s in PRESETS[name]()]
 
 
-def matrix(solvers=("linkedlist-cpu",), dxs=(), threads=(SERIAL,), steps=(None,), t_ends=(None,),
+def matrix(solvers=(DEFAULT_SOLVER,), dxs=(), threads=(SERIAL,), steps=(None,), t_ends=(None,),
            strip=False, pair_loops=("auto",), **scene_lists) -> list[RunSpec]:
     """The product of the option lists, smallest N first, as run specs of preset ``matrix``.
 
@@ -165,8 +165,8 @@ def matrix(solvers=("linkedlist-cpu",), dxs=(), threads=(SERIAL,), steps=(None,)
     for solver, dx, nthreads, loop, end, *values in itertools.product(
             solvers, sorted(dxs, reverse=True), threads, pair_loops, ends, *(scene_lists[k] for k in names)):
         scene = dict(zip(names, values), dx=dx, **end)
-        if solver != "linkedlist-cpu":
-            loop = "auto"  # the other solvers have one pair loop each
+        if len(solver_class(solver).pair_loops) == 1:
+            loop = "auto"  # a solver with one pair loop runs it whatever the matrix asks
         spec = _spec(solver, threads=nthreads, strip=strip, pair_loop=loop, **scene)
         runs.append(RunSpec(spec.solver, spec.scene, spec.threads, "matrix", spec.pair_loop))
     return runs

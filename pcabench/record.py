@@ -53,18 +53,18 @@ class RunRecord:
                 "stages", "jit_seconds", "mse", "me", "mean_neighbours", "status", "failed_step")
 
     @classmethod
-    def before_run(cls, scene, solver: str, threads: int = 1, status: str = "error", message: str = "",
-                   profile_id: str = "", preset: str = "", pair_loop: str = "") -> "RunRecord":
-        """The record of ``scene`` on ``solver`` before any step: no times, no errors, provenance filled."""
+    def from_spec(cls, spec, machine: str = "", status: str = "error", message: str = "") -> "RunRecord":
+        """The record of the resolved RunSpec ``spec`` on machine ``machine`` before any step: no times, no
+        errors, provenance filled."""
         from .provenance import git_commit, host_id, package_versions
 
-        nan = float("nan")
-        return cls(solver=solver, precision=scene.precision, model=scene.model, integrator=scene.integrator,
+        nan, scene = float("nan"), spec.scene
+        return cls(solver=spec.solver, precision=scene.precision, model=scene.model, integrator=scene.integrator,
                    dx=scene.dx, n_particles=scene.n_particles, steps=0, t_end=0.0,
                    stages={s: 0.0 for s in STAGES}, jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan,
-                   status=status, failed_step=None, threads=int(threads), pair_loop=pair_loop, steps_requested=scene.n_steps,
-                   scene=scene.as_dict(), message=message, profile_id=profile_id, commit=git_commit(),
-                   versions=package_versions(), preset=preset, host=host_id())
+                   status=status, failed_step=None, threads=int(spec.threads), pair_loop=spec.pair_loop,
+                   steps_requested=scene.n_steps, scene=scene.as_dict(), message=message, profile_id=machine,
+                   commit=git_commit(), versions=package_versions(), preset=spec.preset, host=host_id())
 
     def as_dict(self) -> dict:
         return asdict(self)

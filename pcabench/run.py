@@ -8,13 +8,14 @@ from __future__ import annotations
 
 import math
 
-from solvers import Scene, SceneError, make_solver, resolve_pair_loop
+from solvers import SceneError, make_solver
 from solvers.analytic import errors as analytic_errors
 from solvers.isothermal1d import isothermal_errors
 from solvers.integrators import step_program
 
 from .clock import clock_for
 from .record import RunRecord
+from .spec import RunSpec
 
 
 def _is_oom(exc: BaseException) -> bool:
@@ -23,19 +24,22 @@ def _is_oom(exc: BaseException) -> bool:
         or "cudaerrormemoryallocation" in text
 
 
-def run(scene: Scene, solver_name: str = "linkedlist-cpu", threads: int = 1,
-        fields_path=None, progress=None, profile_id: str | None = None, pair_loop: str = "auto") -> RunRecord:
-    """Run ``scene`` with ``solver_name``; return its record. Never raises for a failed run."""
-    pair_loop = resolve_pair_loop(solver_name, scene, pair_loop)
-    solver = make_solver(solver_name, threads=threads, pair_loop=pair_loop)
-    record = RunRecord.before_run(scene, solver_name, threads, profile_id=profile_id or "", pair_loop=pair_loop)
+def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> RunRecord:
+    """Run ``spec`` on machine ``machine`` (its :func:`~pcabench.profiles.machine_id`); its record.
+
+    ``spec`` is resolved where the command or sweep starts (an unresolved one is resolved here, for
+    scripts). Never raises for a failed run: bad input (SceneError) is the caller's to report."""
+    spec = spec.resolved()
+    scene = spec.scene
+    solver = make_solver(spec.solver, threads=spec.threads, pair_loop=spec.pair_loop)
+    record = RunRecord.from_spec(spec, machine)
     step = 0
     try:
         clock = None
         # JIT compilation and the first launch, on a tiny scene, outside the timed region.
         solver.input(scene)
         record.jit_seconds = solver.warmup()
-        solver = make_solver(solver_name, threads=threads, pair_loop=pair_loop)
+        solver = make_solver(spec.solver, threads=spec.threads, pair_loop=spec.pair_loop)
         clock = clock_for(solver)
         clock.time("input", solver.input, scene)
         clock.time("init", solver.init)

@@ -7,7 +7,7 @@ the resume logic and the reports.
 
 The thread policy lives here and nowhere else: ``threads`` is an integer >= 1
 (1 is serial, the paper's CPU code) or ``"all"`` (every core this process may
-use, for ``linkedlist-cpu``), resolved to an integer by :func:`resolve_threads`.
+use, for a solver whose class says it is ``threaded``), resolved to an integer by :func:`resolve_threads`.
 """
 from __future__ import annotations
 
@@ -15,11 +15,10 @@ import json
 import os
 from dataclasses import dataclass
 
-from solvers import SOLVERS, Scene, check_pair_loop, resolve_pair_loop
+from solvers import Scene, SceneError, check_pair_loop, resolve_pair_loop, solver_class
 
 SERIAL = 1
 ALL_CORES = "all"
-THREADED = ("linkedlist-cpu",)  # solvers that run on more than one CPU thread
 
 
 class OptionError(ValueError):
@@ -55,12 +54,11 @@ def resolve_threads(threads, solver: str) -> int:
     An explicit count above 1 for a serial solver, or above the cores numba may
     use, is an OptionError naming ``--threads``.
     """
-    threads = parse_threads(threads)
+    threads, cls = parse_threads(threads), solver_class(solver)
     if threads == ALL_CORES:
-        return usable_cores() if solver in THREADED else SERIAL
-    if threads > 1 and solver not in THREADED:
-        why = "as in the paper" if solver == "allpair-cpu" else "one GPU thread per particle"
-        raise OptionError(f"--threads: {solver} is serial, {why} (got {threads})")
+        return usable_cores() if cls.threaded else SERIAL
+    if threads > 1 and not cls.threaded:
+        raise OptionError(f"--threads: {solver} is serial, {cls.serial_why} (got {threads})")
     import numba
 
     if threads > numba.config.NUMBA_NUM_THREADS:
@@ -85,15 +83,29 @@ class RunSpec:
     pair_loop: str = "auto"
 
     def __post_init__(self):
-        if self.solver not in SOLVERS:
-            raise OptionError(f"--solver must be one of {', '.join(SOLVERS)} (got {self.solver!r})")
+        try:
+            solver_class(self.solver)
+        except SceneError as exc:
+            raise OptionError(f"--{exc}") from None
         parse_threads(self.threads)
         check_pair_loop(self.solver, self.pair_loop)
 
+    @property
+    def is_resolved(self) -> bool:
+        """Whether ``threads`` is a count and ``pair_loop`` a loop (what a run, a record and a store key need)."""
+        return isinstance(self.threads, int) and self.pair_loop != "auto"
+
     def resolved(self) -> "RunSpec":
-        """This spec with ``threads`` as a count and ``pair_loop`` as the loop the solver will use here."""
+        """This spec with ``threads`` as a count and ``pair_loop`` as the loop the solver will use here
+        (itself if it is resolved already: a spec is resolved once, where the sweep or command starts)."""
+        if self.is_resolved:
+            return self
         return RunSpec(self.solver, self.scene, resolve_threads(self.threads, self.solver), self.preset,
                        resolve_pair_loop(self.solver, self.scene, self.pair_loop))
+
+    def key(self, machine: str, commit: str, host: str) -> str:
+        """:func:`identity` of this (resolved) spec run on ``machine``/``host`` at ``commit``."""
+        return identity(self.solver, self.threads, self.scene, self.preset, machine, commit, host, self.pair_loop)
 
     @property
     def label(self) -> str:

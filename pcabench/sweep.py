@@ -40,10 +40,7 @@ def failed_record(spec: RunSpec, status: str, message: str, profile: str, second
     """The record of a run that made no result of its own (skipped, timed out, crashed)."""
     if seconds is not None:
         message = f"{message} (after {seconds:.0f} s)"
-    record = RunRecord.before_run(spec.scene, spec.solver, spec.threads, status=status, message=message,
-                                  profile_id=profile, pair_loop=spec.pair_loop)
-    record.preset = spec.preset
-    return record
+    return RunRecord.from_spec(spec, profile, status=status, message=message)
 
 
 def _die_with_parent() -> None:

@@ -45,7 +45,10 @@ class AllPairCPU(Solver):
     """Every pair tested, serial, as in the paper's Fig. 9 comparison."""
 
     name = "allpair-cpu"
+    summary = "every pair tested (the paper's all-pair search), serial"
+    pair_loops = ("all-pairs",)
     pair_loop = "all-pairs"
+    order = 2.0
 
     def snp(self) -> None:
         """Nothing to build: the all-pair search happens inside the interaction loop."""

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import kernel
-from .scene import Scene, SceneError
+from .scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
 
 STAGES = ("input", "init", "snp", "pi", "su", "output")
 STATE = ("lx", "ly", "sx", "sy", "u", "v", "drho")
@@ -55,25 +55,69 @@ class SolverUnavailable(RuntimeError):
 
 
 class Solver(abc.ABC):
-    """Base class: state, system update, output. Subclasses: ``snp``, ``_sweep`` and ``launch``."""
+    """Base class: state, system update, output. Subclasses: ``snp``, ``_sweep`` and ``launch``.
 
-    name: str = "abstract"
-    device: str = "cpu"
-    pair_loop: str = "gather"  # how pairs are visited: gather (each particle's stencil), list, all-pairs
+    The class attributes below state what a solver is and can do. The harness
+    (run specs, predictions, cluster resources, the command line, the reports
+    and both benchmark suites) reads them through the registry
+    (solvers/registry.py) and nowhere states them again.
+    """
+
+    name: str = ""  # what --solver calls it; a class with a name is a solver the registry offers
+    summary: str = ""  # one line for --help: what it is, what it needs
+    device: str = "cpu"  # cpu or gpu: where the pair loops run
+    precisions: tuple = PRECISIONS
+    models: tuple = MODELS
+    integrators: tuple = INTEGRATORS
+    kernels: tuple = kernel.KERNELS
+    pair_loops: tuple = ("gather",)  # how it can visit pairs (gather, list, all-pairs); the first is its default
+    threaded: bool = False  # runs on more than one CPU thread (--threads N|all); else serial
+    serial_why: str = "as in the paper"  # why a serial solver is serial, for the one-line refusal
+    order: float = 1.0  # step time ~ N^order (1: a cell list; 2: every pair tested): the predictor's prior
+    resources: dict = {"timing": 1}  # what one run takes on a Dask worker: one timed run per worker at a time
     xp = np
 
-    def __init__(self, threads: int | None = None):
+    pair_loop: str = "gather"  # the loop this instance uses (one of ``pair_loops``)
+
+    def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         self.threads = threads
+        self.pair_loop = self.pair_loops[0] if pair_loop == "auto" else pair_loop
         self.scene: Scene | None = None
         self.arrays: dict = {}
         self.saved: dict = {}
         self.t = 0.0
+
+    # ------------------------------------------------------------ what it can do
+    @classmethod
+    def available(cls) -> None:
+        """Raise SolverUnavailable (one line: what to install or where to run) unless it can run here."""
+
+    @classmethod
+    def choose_pair_loop(cls, scene: Scene, requested: str = "auto") -> str:
+        """The pair loop for ``scene``: ``requested``, or for ``auto`` the solver's choice (its first)."""
+        return cls.pair_loops[0] if requested == "auto" else requested
+
+    @classmethod
+    def memory_bytes(cls, scene: Scene, pair_loop: str = "auto") -> int:
+        """Bytes a run of ``scene`` takes on the solver's device, B (the harness checks them against the
+        machine's memory): the particle arrays (:meth:`Scene.memory_bytes`) unless a solver says more."""
+        return scene.memory_bytes()
+
+    @classmethod
+    def supports(cls, scene: Scene) -> None:
+        """SceneError naming the parameter unless this solver offers the scene's precision, model,
+        integrator and kernel."""
+        for what, offered in (("precision", cls.precisions), ("model", cls.models),
+                              ("integrator", cls.integrators), ("kernel", cls.kernels)):
+            if getattr(scene, what) not in offered:
+                raise SceneError(f"{what}: {cls.name} offers {', '.join(offered)} (got {getattr(scene, what)!r})")
 
     # ------------------------------------------------------------ stages
     def input(self, scene: Scene) -> None:
         """Validate ``scene`` for this solver and prepare constants."""
         if not isinstance(scene, Scene):
             raise SceneError(f"scene must be a Scene (got {type(scene).__name__})")
+        self.supports(scene)
         self.check_scene(scene)
         self.scene = scene
         self.dtype = np.dtype(scene.precision)

@@ -83,9 +83,13 @@ class LinkedListCPU(CellListSolver):
     """Uniform cell list on the CPU, serial or multi-threaded (``threads``), with the pair list or the gather loop."""
 
     name = "linkedlist-cpu"
+    summary = ("uniform cell list (the paper's cellBegin arrays), serial or --threads N|all;\n"
+               "--pair-loop list (default where it fits) or gather (the paper's loop)")
+    pair_loops = ("list", "gather")
+    threaded = True
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
-        super().__init__(threads=threads or 1)
+        super().__init__(threads=threads or 1, pair_loop=pair_loop)
         self.requested_pair_loop = pair_loop
 
     def input(self, scene) -> None:
@@ -96,6 +100,12 @@ class LinkedListCPU(CellListSolver):
     def list_fits(scene) -> bool:
         """Whether the particle arrays and the pair list fit in the scene's memory limit."""
         return scene.memory_bytes() + pairlist.list_bytes(scene) <= scene.memory_limit()
+
+    @classmethod
+    def memory_bytes(cls, scene, pair_loop: str = "auto") -> int:
+        """The particle arrays, and the pair list where the run keeps one, B."""
+        lists = cls.choose_pair_loop(scene, pair_loop) == "list"
+        return scene.memory_bytes() + (pairlist.list_bytes(scene) if lists else 0)
 
     @classmethod
     def choose_pair_loop(cls, scene, requested: str = "auto") -> str:

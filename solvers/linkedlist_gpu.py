@@ -38,12 +38,19 @@ class LinkedListGPU(CellListSolver):
     """Uniform cell list on a CUDA GPU (or numba's CUDA simulator), one thread per particle."""
 
     name = "linkedlist-gpu"
+    summary = "the cell list on a CUDA GPU, CuPy + numba-cuda (pip install -e \".[gpu]\")"
     device = "gpu"
+    serial_why = "one GPU thread per particle"
+    resources = {"timing": 1, "GPU": 1}
 
-    def __init__(self, threads: int = 1):
+    @classmethod
+    def available(cls) -> None:
+        device_backend()  # SolverUnavailable: what to install, or that this machine has no GPU
+
+    def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         if threads not in (None, 1):
             raise SceneError(f"threads: linkedlist-gpu runs one GPU thread per particle (got --threads {threads})")
-        super().__init__(threads=1)
+        super().__init__(threads=1, pair_loop=pair_loop)
         self.cuda, self.cupy = device_backend()
         self.xp = self.cupy if self.cupy is not None else np
         self.stream = None

@@ -7,6 +7,7 @@ import pytest
 from benchmarks.common import gpu_available
 from pcabench import cli
 from pcabench.run import run
+from pcabench.spec import RunSpec
 from solvers import Scene
 
 strip_for = Scene.thinnest_strip  # the thinnest y-periodic strip the cell list accepts at dx, m
@@ -14,7 +15,7 @@ strip_for = Scene.thinnest_strip  # the thinnest y-periodic strip the cell list 
 
 def run_fields(scene: Scene, solver: str, tmp_path, threads=1):
     path = tmp_path / f"{solver}-{threads}-{scene.precision}-{scene.model}.npz"
-    record = run(scene, solver, threads=threads, fields_path=path)
+    record = run(RunSpec(solver, scene, threads), fields_path=path)
     fields = dict(np.load(path)) if path.exists() else None
     return record, fields
 

@@ -11,6 +11,7 @@ import json
 import pytest
 
 from pcabench.run import run
+from pcabench.spec import RunSpec
 from solvers import Scene
 from solvers.dispersion import largest_stable_z, predict, stable_cfl
 
@@ -30,7 +31,7 @@ def strip_scene(dx, **kw) -> Scene:
                                 dict(dx=0.2, kernel="wendland-c2")])
 def test_predicted_error_is_the_measured_error(kw):
     scene = strip_scene(**kw)
-    measured = run(scene, "linkedlist-cpu")
+    measured = run(RunSpec("linkedlist-cpu", scene))
     assert measured.status == "ok"
     predicted = predict(scene).predicted_error
     assert predicted == pytest.approx(measured.mse, rel=1e-8)
@@ -40,8 +41,8 @@ def test_predicted_error_is_the_measured_error(kw):
 def test_the_step_limit_is_where_runs_blow_up():
     scene = Scene(dx=0.5, steps=60, model="linear", strip_height=Scene.thinnest_strip(0.5))
     limit = stable_cfl(scene)
-    assert run(scene.replace(cfl=0.95 * limit), "linkedlist-cpu").status == "ok"
-    assert run(scene.replace(cfl=1.05 * limit), "linkedlist-cpu").status == "unstable"
+    assert run(RunSpec("linkedlist-cpu", scene.replace(cfl=0.95 * limit))).status == "ok"
+    assert run(RunSpec("linkedlist-cpu", scene.replace(cfl=1.05 * limit))).status == "unstable"
 
 
 def test_integrators_stability():

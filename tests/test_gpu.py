@@ -23,6 +23,7 @@ SIM_SCRIPT = r"""
 import json, sys, tempfile, numpy as np
 from pathlib import Path
 from pcabench.run import run
+from pcabench.spec import RunSpec
 from solvers import Scene
 precision, model, steps, integrator, kernel = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
 scene = Scene(dx=1.0, x_min=-8.0, x_max=8.0, steps=steps, model=model, precision=precision, integrator=integrator,
@@ -31,7 +32,7 @@ out = {}
 with tempfile.TemporaryDirectory() as d:
     for solver in ("linkedlist-cpu", "linkedlist-gpu"):
         p = Path(d) / (solver + ".npz")
-        rec = run(scene, solver, fields_path=p)
+        rec = run(RunSpec(solver, scene), fields_path=p)
         out[solver] = {"status": rec.status, "message": rec.message[:500], "neighbours": rec.mean_neighbours}
         if rec.status == "ok":
             out[solver]["fields"] = {k: np.load(p)[k].tolist() for k in ("u", "drho", "x")}

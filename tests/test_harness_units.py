@@ -41,10 +41,10 @@ def test_bad_threads_name_the_option(threads, solver, words):
 def test_a_spec_and_its_stored_row_have_one_identity():
     spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=3, cfl=0.3), ALL_CORES, "quick").resolved()
     assert RunSpec.from_json(spec.to_json()) == spec
-    record = RunRecord.before_run(spec.scene, spec.solver, spec.threads, profile_id="machine-a")
+    record = RunRecord.from_spec(spec.resolved(), "machine-a")
     record.preset, record.commit, record.host = spec.preset, "abc", "h1"
     row = store.to_row(record)
-    key = identity(spec.solver, spec.threads, spec.scene, spec.preset, "machine-a", "abc", "h1")
+    key = spec.key("machine-a", "abc", "h1")
     assert row_identity(row) == key
     # a different scene, thread count, preset, machine, commit or host is another run
     others = [identity(spec.solver, spec.threads, spec.scene.replace(cfl=0.2), "quick", "machine-a", "abc", "h1"),

@@ -93,7 +93,7 @@ def test_every_cpu_solver_agrees_on_a_wendland_kernel(tmp_path, name):
     results = {}
     for solver, loop in (("allpair-cpu", "all-pairs"), ("linkedlist-cpu", "list"), ("linkedlist-cpu", "gather")):
         path = tmp_path / f"{solver}-{loop}.npz"
-        rec = run(scene, solver, fields_path=path, pair_loop=loop)
+        rec = run(RunSpec(solver, scene, pair_loop=loop), fields_path=path)
         assert rec.status == "ok", rec.message
         results[loop] = rec.mean_neighbours, dict(np.load(path))
     nbr, ref = results["all-pairs"]
@@ -118,7 +118,7 @@ def test_linear_converges_at_second_order_for_each_kernel(name):
     for dx in CONVERGENCE_DX:
         scene = Scene(dx=dx, t_end=10.0, model="linear", kernel=name,
                       strip_height=Scene.thinnest_strip(dx, kernel=name))
-        rec = run(scene, "linkedlist-cpu")
+        rec = run(RunSpec("linkedlist-cpu", scene))
         assert rec.status == "ok", rec.message
         errors.append(rec.mse)
     order = np.log(errors[0] / errors[1]) / np.log(CONVERGENCE_DX[0] / CONVERGENCE_DX[1])

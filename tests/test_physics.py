@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from pcabench.run import run
+from pcabench.spec import RunSpec
 from solvers import Scene
 from solvers.isothermal1d import isothermal_pulse
 from solvers.kernel import make_exp_neg_table
@@ -88,7 +89,7 @@ def test_linear_model_converges_at_second_order():
     errors = {}
     for dx in (0.2, 0.1):
         scene = Scene(dx=dx, t_end=10.0, model="linear", strip_height=strip_for(dx))
-        rec = run(scene, "linkedlist-cpu", threads=2)
+        rec = run(RunSpec("linkedlist-cpu", scene, 2))
         assert rec.status == "ok"
         errors[dx] = rec.mse
     order = np.log(errors[0.2] / errors[0.1]) / np.log(2.0)
@@ -123,7 +124,7 @@ def test_isothermal_reference_differs_from_linear_pulse_by_5_percent():
 def test_forward_euler_is_caught_as_unstable():
     scene = Scene(dx=0.5, x_min=-10, x_max=20, t_end=400.0, cfl=1.0, integrator="euler",
                   model="linear", strip_height=strip_for(0.5))
-    rec = run(scene, "linkedlist-cpu")
+    rec = run(RunSpec("linkedlist-cpu", scene))
     assert rec.status == "unstable"
     assert 1 < rec.failed_step < scene.n_steps
     assert np.isnan(rec.mse)  # no errors reported for a blown-up run
@@ -132,7 +133,7 @@ def test_forward_euler_is_caught_as_unstable():
 def test_oversized_dt_is_caught_as_unstable():
     scene = Scene(dx=0.5, x_min=-10, x_max=20, steps=400, cfl=8.0, model="linear",
                   strip_height=strip_for(0.5))
-    rec = run(scene, "linkedlist-cpu")
+    rec = run(RunSpec("linkedlist-cpu", scene))
     assert rec.status == "unstable" and rec.failed_step is not None
 
 
@@ -161,13 +162,11 @@ def test_rk2_and_verlet_agree_at_small_dt(tmp_path):
 def test_lagrangian_records_carry_the_error_against_their_own_limit():
     """A lagrangian run's record scores it against the isothermal solution too, and that error falls with dx
     while the error against the linear pulse stops at the equations' difference."""
-    from pcabench.run import run
-
-    recs = [run(Scene(dx=dx, t_end=10.0, model="lagrangian", strip_height=Scene.thinnest_strip(dx)),
-                "linkedlist-cpu") for dx in (0.2, 0.1)]
+    recs = [run(RunSpec("linkedlist-cpu", Scene(dx=dx, t_end=10.0, model="lagrangian",
+                                                strip_height=Scene.thinnest_strip(dx)))) for dx in (0.2, 0.1)]
     assert all(r.status == "ok" for r in recs)
     coarse, fine = (r.mse_isothermal for r in recs)
     assert fine < coarse / 2.5  # second order: 6.5 % -> 2.0 %
     assert fine < recs[1].mse / 3  # the linear pulse is 8 % away from what lagrangian converges to
-    assert run(Scene(dx=0.5, t_end=2.0, model="linear", strip_height=Scene.thinnest_strip(0.5)),
-               "linkedlist-cpu").mse_isothermal is None
+    assert run(RunSpec("linkedlist-cpu", Scene(dx=0.5, t_end=2.0, model="linear",
+                                               strip_height=Scene.thinnest_strip(0.5)))).mse_isothermal is None

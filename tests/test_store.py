@@ -5,15 +5,16 @@ import pytest
 
 from pcabench import store
 from pcabench.run import run
+from pcabench.spec import RunSpec
 from solvers import Scene
 
 
 def test_append_read_merge_and_torn_line(tmp_path):
-    rec = run(Scene(dx=1.0, steps=3), "linkedlist-cpu", profile_id="machine-a")
+    rec = run(RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=3)), "machine-a")
     a, b = tmp_path / "a.jsonl", tmp_path / "b.jsonl"
     row = store.append(rec, a)
     store.append(rec, a)  # the same run twice: deduplicated on load
-    rec_b = run(Scene(dx=1.0, steps=3, precision="float32"), "linkedlist-cpu", profile_id="machine-b")
+    rec_b = run(RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=3, precision="float32")), "machine-b")
     store.append(rec_b, b)
     with open(a, "a") as f:
         f.write('{"solver": "linkedlist-cpu", "trunc')  # a run killed mid-write

@@ -23,7 +23,7 @@ from solvers import scene as scene_module
 
 
 def record(dx=1.0, status="ok", **kw):
-    rec = RunRecord.before_run(Scene(dx=dx, steps=3), "linkedlist-cpu", 1, status=status, profile_id="m")
+    rec = RunRecord.from_spec(RunSpec("linkedlist-cpu", Scene(dx=dx, steps=3)).resolved(), "m", status=status)
     rec.steps, rec.mse, rec.me = 3, 0.1, 0.001
     rec.stages.update(snp=0.001, pi=0.01, su=0.0005)
     for k, v in kw.items():
@@ -266,9 +266,10 @@ def test_a_write_cut_short_by_a_full_file_system_leaves_the_store_as_it_was(tmp_
 import resource, signal, sys
 from pcabench import store
 from pcabench.record import RunRecord
+from pcabench.spec import RunSpec
 from solvers import Scene
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
-rec = RunRecord.before_run(Scene(dx=0.5, steps=3), "linkedlist-cpu", 1, profile_id="m")
+rec = RunRecord.from_spec(RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=3)).resolved(), "m")
 resource.setrlimit(resource.RLIMIT_FSIZE, ({len(before) + 100}, resource.RLIM_INFINITY))
 try:
     store.append(rec, {str(path)!r})

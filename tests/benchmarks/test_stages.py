@@ -14,11 +14,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks.common import Prepared, Unsupported
+from benchmarks.common import Prepared, Unsupported, solver_names
 from pcabench.profiles import machine_id
 from solvers import Scene, make_solver
 
-SOLVERS = ("allpair-cpu", "linkedlist-cpu", "linkedlist-gpu")
 SIZES = (1.0, 0.5)  # 1,000 and 4,000 particles
 ROUNDS = 7
 
@@ -33,7 +32,7 @@ def prepared(solver, precision, dx) -> Prepared:
 
 @pytest.mark.parametrize("dx", SIZES)
 @pytest.mark.parametrize("precision", ("float64", "float32"))
-@pytest.mark.parametrize("solver", SOLVERS)
+@pytest.mark.parametrize("solver", solver_names())
 @pytest.mark.parametrize("stage", ("step", "snp", "pi", "su"))
 def test_stage(benchmark, solver, precision, dx, stage):
     p = prepared(solver, precision, dx)
