@@ -276,7 +276,8 @@ def cmd_study(args) -> int:
         dask_distributed()  # one line naming the extra, before anything else
         print(f"pcabench study ({name}): {len(specs)} runs on the Dask cluster {args.cluster}, "
               f"{run_budget:.0f} s per run at most, stores in {args.results}", file=sys.stderr, flush=True)
-        cluster_sweep(specs, Path(args.results), run_budget, args.cluster, retry_failed=args.retry_failed)
+        cluster_sweep(specs, Path(args.results), run_budget, args.cluster, retry_failed=args.retry_failed,
+                      sweep_budget=args.sweep_budget)
     else:
         profile = profiles.capture()
         store_path = Path(args.results) / store_name(profile["id"])

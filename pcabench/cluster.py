@@ -18,21 +18,19 @@ times), then recorded as ``error`` (lost).
 """
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
-import time
 from contextlib import ExitStack
 from pathlib import Path
 
-from . import store
-from .predict import predicted_seconds
-from .profiles import machine_id
-from .provenance import git_commit, host_id
-from .record import step_seconds
 from solvers import solver_class
 
+from . import store
+from .profiles import machine_id
+from .provenance import git_commit, host_id
 from .spec import OptionError, RunSpec, identity
-from .sweep import RETRIED, eta_text, failed_record, run_child
+from .sweep import Executor, failed_record, run_child, run_specs
 
 TIMING = "timing"  # one per worker: one timed run at a time
 LOOPBACK = "127.0.0.1"  # a local cluster (scheduler, workers, dashboard) listens here only
@@ -92,69 +90,61 @@ def run_on_worker(spec_json: str, timeout: float, commit: str) -> dict:
                                           timeout))
 
 
+class DaskExecutor(Executor):
+    """Runs as Dask tasks, up to one per worker in flight (so predictions learn from the runs that finish);
+    a run is done once stored from any worker."""
+
+    whose = "the cluster"
+
+    def __init__(self, client, commit: str):
+        self.client, self.commit, self.futures = client, commit, {}
+        self.slots = max(len(worker_resources(client)), 1)
+        self.finished = dask_distributed().as_completed()
+
+    def key(self, spec, commit):
+        return _unplaced(spec.solver, spec.threads, spec.scene, spec.preset, commit, spec.pair_loop)
+
+    def row_key(self, row):
+        return _unplaced(row["solver"], row.get("threads", 1), row.get("scene") or {}, row.get("preset", ""),
+                         row.get("commit"), row.get("pair_loop", ""))
+
+    def informs(self, row):
+        return row.get("status") == "ok"
+
+    def start(self, spec, timeout, budget_cut):
+        future = self.client.submit(run_on_worker, spec.to_json(), timeout, self.commit, pure=False,
+                                    resources=task_resources(spec), key=f"pcabench-run-{len(self.futures)}")
+        self.futures[future] = spec
+        self.finished.add(future)
+
+    def wait(self):
+        future = next(self.finished)
+        spec = self.futures[future]
+        try:
+            return spec, future.result()
+        except Exception as exc:  # noqa: BLE001 - the task never returned: its workers died (KilledWorker)
+            return spec, store.to_row(failed_record(spec, "error", f"lost: {type(exc).__name__}: {exc}",
+                                                    machine_id()))
+
+
 def cluster_sweep(specs: list[RunSpec], results: Path, run_budget: float, address: str, stream=sys.stderr,
-                  retry_failed: bool = False) -> list[dict]:
-    """Run ``specs`` as Dask tasks on the cluster at ``address``; each record stored as it arrives."""
+                  retry_failed: bool = False, sweep_budget: float = math.inf) -> list[dict]:
+    """Run ``specs`` as Dask tasks on the cluster at ``address``; each record stored as it arrives
+    (:func:`pcabench.sweep.run_specs`)."""
     results = Path(results)
     with store.SweepLock(results, whole_folder=True) as lock:  # before any work: every store it may write
-        return _cluster_sweep(specs, results, run_budget, address, stream, retry_failed, Stores(results, lock))
-
-
-def _cluster_sweep(specs, results, run_budget, address, stream, retry_failed, stores) -> list[dict]:
-    commit = git_commit()
-    rows = store.read_rows(results)
-    # on a cluster a run may land on any worker: it is done once stored from any of them
-    done = {_unplaced(r["solver"], r.get("threads", 1), r.get("scene") or {}, r.get("preset", ""), r.get("commit"),
-                      r.get("pair_loop", "")) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
-    specs = list(dict.fromkeys(s.resolved() for s in specs))  # a run given twice is run once
-    todo = [s for s in specs if _unplaced(s.solver, s.threads, s.scene, s.preset, commit, s.pair_loop) not in done]
-    for s in specs:
-        if s not in todo:
-            print(f"{s.label}: already stored", file=stream, flush=True)
-    finished = [r for r in rows if r.get("status") == "ok"]
-    stored = []
-    with ExitStack() as stack:
-        client = connect(address, stack)
-        print(f"pcabench: Dask dashboard at {client.dashboard_link}", file=stream, flush=True)
-        workers = worker_resources(client)
-        for need in {tuple(sorted(task_resources(s))) for s in todo}:
-            if not any(all(r.get(k, 0) >= 1 for k in need) for r in workers.values()):
-                raise OptionError(f"--cluster {address}: no worker offers the resources {', '.join(need)}; start "
-                                  f"workers with --resources \"{' '.join(f'{k}=1' for k in need)}\"")
-        dd = dask_distributed()
-        futures = {}
-        for spec in todo:
-            seconds, why = predicted_seconds(spec, finished)
-            if seconds is not None and seconds > run_budget:
-                row = store.to_row(failed_record(spec, "skipped", f"{why} > run budget {run_budget:.0f} s",
-                                                 machine_id()))
-                stored.append(stores.append(row))
-                print(f"{spec.label}: skipped, {why}", file=stream, flush=True)
-                continue
-            future = client.submit(run_on_worker, spec.to_json(), run_budget, commit, pure=False,
-                                   resources=task_resources(spec), key=f"pcabench-run-{len(futures)}")
-            futures[future] = spec
-        t0, failed, left = time.perf_counter(), 0, list(futures.values())
-        for future in dd.as_completed(futures):
-            spec = futures[future]
-            try:
-                row = future.result()
-            except Exception as exc:  # noqa: BLE001 - the task never returned: its workers died (KilledWorker)
-                row = store.to_row(failed_record(spec, "error", f"lost: {type(exc).__name__}: {exc}",
-                                                 machine_id()))
-            stored.append(stores.append(row))
-            left.remove(spec)
-            failed += row["status"] != "ok"
-            running = sum(f.status == "pending" for f in futures)
-            per_run = (time.perf_counter() - t0) / len(stored) / max(len(workers), 1)
-            mse = row.get("mse")
-            print(f"{spec.label} on {row.get('profile_id')}/{row.get('host')}: {row['status']}, step "
-                  f"{1e3 * step_seconds(row['stages'], row['steps']):.2f} ms, MSE "
-                  f"{'-' if mse is None else f'{mse:.4g}'} | sweep: {len(stored)}/{len(todo)} done, "
-                  f"{running} running or queued, {failed} not ok, {eta_text(left, finished, per_run, 'the cluster')}",
-                  file=stream, flush=True)
-            finished.append(row)
-    return stored
+        rows = store.read_rows(results)
+        specs = [s.resolved() for s in specs]
+        with ExitStack() as stack:
+            client = connect(address, stack)
+            print(f"pcabench: Dask dashboard at {client.dashboard_link}", file=stream, flush=True)
+            workers = worker_resources(client)
+            for need in {tuple(sorted(task_resources(s))) for s in specs}:
+                if not any(all(r.get(k, 0) >= 1 for k in need) for r in workers.values()):
+                    raise OptionError(f"--cluster {address}: no worker offers the resources {', '.join(need)}; "
+                                      f"start workers with --resources \"{' '.join(f'{k}=1' for k in need)}\"")
+            return run_specs(specs, DaskExecutor(client, git_commit()), Stores(results, lock), rows, run_budget,
+                             sweep_budget, stream, retry_failed)
 
 
 def _unplaced(solver, threads, scene, preset, commit, pair_loop) -> str:

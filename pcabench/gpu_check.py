@@ -51,7 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
-from solvers import MODELS, PRECISIONS, Scene, make_solver
+from solvers import DEFAULT_SOLVER, MODELS, PRECISIONS, Scene, make_solver, solver_class
 from solvers.gpu_device import device_backend, simulated
 from solvers.integrators import step_program
 
@@ -59,6 +59,8 @@ from .record import STEP_STAGES, step_seconds
 from .run import run
 from .spec import ALL_CORES, SERIAL, RunSpec
 from .store import store_name
+
+GPU_SOLVER = "linkedlist-gpu"  # the solver this check measures (its CUDA graph path, its kernels under ncu)
 
 H100_COMMIT = "bf587a5"  # the commit the H100 was measured at: asv compares the cards there
 GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
@@ -196,15 +198,15 @@ def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
             scene = Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision,
                           **plan.scene)
             fields = {}
-            for solver in ("linkedlist-cpu", "linkedlist-gpu"):
+            for solver in (DEFAULT_SOLVER, GPU_SOLVER):
                 path = out / f"compare_{solver}.npz"
                 rec = run(RunSpec(solver, scene), fields_path=path)
                 if rec.status != "ok":
                     raise RuntimeError(f"{solver} {model} {precision}: {rec.status} {rec.message}")
                 fields[solver] = dict(np.load(path))
                 path.unlink()
-            diff = {name: float(np.max(np.abs(fields["linkedlist-gpu"][name] - fields["linkedlist-cpu"][name]))
-                                / np.max(np.abs(fields["linkedlist-cpu"][name]))) for name in ("u", "drho")}
+            diff = {name: float(np.max(np.abs(fields[GPU_SOLVER][name] - fields[DEFAULT_SOLVER][name]))
+                                / np.max(np.abs(fields[DEFAULT_SOLVER][name]))) for name in ("u", "drho")}
             rows.append({"precision": precision, "model": model, "dx": plan.compare_dx, "steps": plan.compare_steps,
                          "max_rel_diff_u": diff["u"], "max_rel_diff_drho": diff["drho"]})
             print(f"compare {precision} {model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}", file=sys.stderr,
@@ -215,14 +217,14 @@ def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
 # ---------------------------------------------------------------- 3 and 5. the sweeps
 def gpu_specs(plan: Plan) -> list[RunSpec]:
     """The GPU timing sweep: linkedlist-gpu on the paper's full domain, every size, precision and model."""
-    return [RunSpec("linkedlist-gpu", Scene(dx=dx, steps=plan.gpu_steps(dx), model=model, precision=precision,
+    return [RunSpec(GPU_SOLVER, Scene(dx=dx, steps=plan.gpu_steps(dx), model=model, precision=precision,
                                             memory_limit_bytes=2**40, **plan.scene), preset="gpu")
             for dx in plan.gpu_dx for precision in PRECISIONS for model in plan.models]  # the GPU checks its memory
 
 
 def cpu_peer_specs(plan: Plan) -> list[RunSpec]:
     """linkedlist-cpu, lagrangian float64, one thread and every core, on this GPU's host: Table 6's CPU column."""
-    return [RunSpec("linkedlist-cpu", Scene(dx=dx, steps=plan.cpu_steps, **plan.scene), threads, preset="gpu")
+    return [RunSpec(DEFAULT_SOLVER, Scene(dx=dx, steps=plan.cpu_steps, **plan.scene), threads, preset="gpu")
             for dx in plan.cpu_dx for threads in (SERIAL, ALL_CORES)]
 
 
@@ -234,7 +236,7 @@ def run_and_release(spec, timeout, commit, machine, stream=sys.stderr) -> dict:
     try:
         return run_here(spec, timeout, commit, machine, stream)
     finally:
-        _cuda, cupy = device_backend() if spec.solver == "linkedlist-gpu" else (None, None)
+        _cuda, cupy = device_backend() if solver_class(spec.solver).device == "gpu" else (None, None)
         if cupy is not None:
             cupy.get_default_memory_pool().free_all_blocks()
 
@@ -246,7 +248,7 @@ def graph_vs_plain(dx: float, precision: str, steps: int, rounds: int, scene_ove
     from solvers.gpu_graph import CapturedSteps
 
     scene = Scene(dx=dx, precision=precision, model="lagrangian", memory_limit_bytes=2**40, **scene_overrides)
-    solver = make_solver("linkedlist-gpu")
+    solver = make_solver(GPU_SOLVER)
     solver.input(scene)
     solver.warmup()
     solver.init()
@@ -315,7 +317,7 @@ def ncu_command(plan: Plan, out: Path) -> list[str]:
     return ["ncu", "--clock-control", "none", "--section", "SpeedOfLight", "--section", "MemoryWorkloadAnalysis",
             "--kernel-name", "regex:kick|continuity|advance|cell_count|cell_begin|scatter|momentum",
             "--launch-skip", "40", "--launch-count", "8", "-o", str(out / "ncu_step"), "-f",
-            sys.executable, "-m", "pcabench.cli", "run", "--solver", "linkedlist-gpu", "--dx", str(plan.ncu_dx),
+            sys.executable, "-m", "pcabench.cli", "run", "--solver", GPU_SOLVER, "--dx", str(plan.ncu_dx),
             "--precision", "float32", "--steps", "8", "--quiet"]
 
 

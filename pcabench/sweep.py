@@ -14,8 +14,10 @@ reruns timeouts, skips and errors. A run predicted to take longer than the run b
 """
 from __future__ import annotations
 
+import abc
 import ctypes
 import json
+import math
 import os
 import signal
 import subprocess
@@ -31,7 +33,7 @@ from .predict import predicted_seconds
 from .profiles import MACHINE_ID_ENV, machine_id
 from .provenance import git_commit, host_id
 from .record import RunRecord, step_seconds
-from .spec import RunSpec, identity, row_identity
+from .spec import RunSpec, row_identity
 
 RETRIED = ("timeout", "skipped", "error")  # statuses --retry-failed runs again
 
@@ -142,63 +144,149 @@ def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float 
     return f"eta {total / 60:.1f} min ({how})"
 
 
-def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budget: float,
-          stream=sys.stderr, retry_failed: bool = False, runner=None) -> list[dict]:
-    """Run ``specs`` (skipping those already stored), one child process each (``runner``); the rows stored.
+class Executor(abc.ABC):
+    """Where a sweep's runs happen. The sweep loop (:func:`run_specs`) asks it to :meth:`start` up to
+    ``slots`` runs at a time and to :meth:`wait` for the next one to finish; resume, skip-by-prediction,
+    storing and progress are the loop's, the same for every executor."""
 
-    Before each run its time is predicted from this host's finished runs
-    (``predict.py``); a run predicted past ``run_budget`` is stored as
-    ``skipped`` with the prediction instead of being run into the wall.
-    """
-    store.check_writable(store_path)
-    with store.SweepLock(store_path):
-        return _sweep(specs, Path(store_path), run_budget, sweep_budget, stream, retry_failed, runner or run_child)
+    slots = 1  # runs in flight at once
+    whose = "this host's"  # whose timings the predictions come from, for the progress line
+
+    @abc.abstractmethod
+    def key(self, spec: RunSpec, commit: str) -> str:
+        """The spec's store key (:func:`~pcabench.spec.identity`) as this executor places runs."""
+
+    @abc.abstractmethod
+    def row_key(self, row: dict) -> str:
+        """:meth:`key` of a stored row."""
+
+    @abc.abstractmethod
+    def informs(self, row: dict) -> bool:
+        """Whether a stored row's timing predicts this executor's runs."""
+
+    @abc.abstractmethod
+    def start(self, spec: RunSpec, timeout: float, budget_cut: bool) -> None:
+        """Begin running ``spec`` with ``timeout`` seconds (the sweep's remaining budget if ``budget_cut``)."""
+
+    @abc.abstractmethod
+    def wait(self) -> tuple[RunSpec, dict | None]:
+        """The next finished run and its row; None when the sweep's budget ended it (nothing to store)."""
 
 
-def _sweep(specs, store_path, run_budget, sweep_budget, stream, retry_failed, runner) -> list[dict]:
-    profile, commit, host = machine_id(), git_commit(), host_id()
-    rows = store.read_rows(store_path) if store_path.exists() else []
-    done = {row_identity(r) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
-    mine = [r for r in rows if r.get("profile_id") == profile and r.get("host") == host]
-    t_start, stored, failed = time.perf_counter(), [], 0
-    specs = list(dict.fromkeys(s.resolved() for s in specs))  # a run given twice is run once
-    for i, spec in enumerate(specs, 1):
-        label = f"[{i}/{len(specs)}] {spec.label}"
-        if identity(spec.solver, spec.threads, spec.scene, spec.preset, profile, commit, host,
-                    spec.pair_loop) in done:
-            print(f"{label}: already stored", file=stream, flush=True)
-            continue
-        left = sweep_budget - (time.perf_counter() - t_start)
-        if left <= 0:
-            print(f"{label}: sweep budget spent, stopping (rerun to resume)", file=stream, flush=True)
-            break
-        seconds, why = predicted_seconds(spec, mine)
-        if seconds is not None and seconds > run_budget:
-            stored.append(store.append(failed_record(spec, "skipped", f"{why} > run budget {run_budget:.0f} s",
-                                                     profile), store_path))
-            print(f"{label}: skipped, {why}", file=stream, flush=True)
-            continue
-        print(f"{label}: running" + (f" (predicted {seconds:.0f} s)" if seconds is not None else ""),
-              file=stream, flush=True)
+class LocalExecutor(Executor):
+    """One run at a time on this machine, each by ``runner`` (a child process by default; ``run_here`` runs
+    in this process, keeping compiled kernels, for the GPU check)."""
+
+    def __init__(self, machine: str, host: str, commit: str, runner=None, stream=sys.stderr):
+        self.machine, self.host, self.commit, self.stream = machine, host, commit, stream
+        self.runner, self.pending = runner or run_child, []
+
+    def key(self, spec, commit):
+        return spec.key(self.machine, commit, self.host)
+
+    def row_key(self, row):
+        return row_identity(row)
+
+    def informs(self, row):
+        return row.get("profile_id") == self.machine and row.get("host") == self.host
+
+    def start(self, spec, timeout, budget_cut):
+        self.pending.append((spec, timeout, budget_cut))
+
+    def wait(self):
+        spec, timeout, budget_cut = self.pending.pop(0)
         t0 = time.perf_counter()
         try:
-            row = runner(spec, min(run_budget, left), commit, profile, stream)
+            return spec, self.runner(spec, timeout, self.commit, self.machine, self.stream)
         except subprocess.TimeoutExpired:
-            if left < run_budget:  # the sweep's budget ran out, not the run's: nothing to record
-                print(f"{label}: sweep budget spent during the run, not stored (rerun to resume)",
-                      file=stream, flush=True)
+            if budget_cut:  # the sweep's budget ran out, not the run's: nothing to record
+                return spec, None
+            return spec, store.to_row(failed_record(spec, "timeout", f"past the run budget of {timeout:.0f} s",
+                                                    self.machine, time.perf_counter() - t0))
+
+
+class StoreFile:
+    """The one store a local sweep writes."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def append(self, row: dict) -> dict:
+        return store.append(row, self.path)
+
+
+def run_specs(specs: list[RunSpec], executor: Executor, stores, rows: list[dict], run_budget: float,
+              sweep_budget: float = math.inf, stream=sys.stderr, retry_failed: bool = False) -> list[dict]:
+    """The sweep loop of every executor: ``specs`` not already in ``rows`` run by ``executor``, each row
+    appended to ``stores`` as it arrives; the rows stored.
+
+    A run given twice is run once; rows with ``retry_failed`` statuses in :data:`RETRIED` do not count as
+    done. Before a run starts its time is predicted from the finished runs that inform the executor
+    (``predict.py``, updated as runs finish); one predicted past ``run_budget`` is stored as ``skipped``.
+    No run starts after ``sweep_budget`` seconds; one the budget cuts short is not stored.
+    """
+    commit, machine = git_commit(), machine_id()
+    done = {executor.row_key(r) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
+    known = [r for r in rows if executor.informs(r)]
+    specs = list(dict.fromkeys(s.resolved() for s in specs))
+    labels = {s: f"[{i}/{len(specs)}] {s.label}" for i, s in enumerate(specs, 1)}
+    queue = []
+    for spec in specs:
+        if executor.key(spec, commit) in done:
+            print(f"{labels[spec]}: already stored", file=stream, flush=True)
+        else:
+            queue.append(spec)
+    t_start, stored, failed, running, n_todo = time.perf_counter(), [], 0, 0, len(queue)
+    while queue or running:
+        while queue and running < executor.slots:
+            spec, left = queue[0], sweep_budget - (time.perf_counter() - t_start)
+            if left <= 0:
+                print(f"{labels[spec]}: sweep budget spent, stopping (rerun to resume)", file=stream, flush=True)
+                queue.clear()
                 break
-            row = failed_record(spec, "timeout", f"past the run budget of {run_budget:.0f} s", profile,
-                                time.perf_counter() - t0)
-        row = store.append(row, store_path)
+            queue.pop(0)
+            seconds, why = predicted_seconds(spec, known)
+            if seconds is not None and seconds > run_budget:
+                stored.append(stores.append(store.to_row(failed_record(
+                    spec, "skipped", f"{why} > run budget {run_budget:.0f} s", machine))))
+                print(f"{labels[spec]}: skipped, {why}", file=stream, flush=True)
+                continue
+            print(f"{labels[spec]}: running" + (f" (predicted {seconds:.0f} s)" if seconds is not None else ""),
+                  file=stream, flush=True)
+            executor.start(spec, min(run_budget, left), left < run_budget)
+            running += 1
+        if not running:
+            break
+        spec, row = executor.wait()
+        running -= 1
+        if row is None:
+            print(f"{labels[spec]}: sweep budget spent during the run, not stored (rerun to resume)",
+                  file=stream, flush=True)
+            queue.clear()
+            continue
+        row = stores.append(row)
         stored.append(row)
-        mine.append(row)
+        known.append(row)
         failed += row["status"] != "ok"
-        step_ms = 1e3 * step_seconds(row["stages"], row["steps"])
-        mse = row.get("mse")
         made = [r for r in stored if r["status"] != "skipped"]
-        per_run = (time.perf_counter() - t_start) / len(made) if made else None
-        print(f"{label}: {row['status']}, step {step_ms:.2f} ms, MSE {'-' if mse is None else f'{mse:.4g}'}, "
-              f"{time.perf_counter() - t0:.1f} s | sweep: {i}/{len(specs)} done, {failed} not ok, "
-              f"{eta_text(specs[i:], mine, per_run)}", file=stream, flush=True)
+        per_run = (time.perf_counter() - t_start) / len(made) / executor.slots if made else None
+        where = f" on {row.get('profile_id')}/{row.get('host')}" if executor.slots > 1 else ""
+        mse = row.get("mse")
+        print(f"{labels[spec]}{where}: {row['status']}, step {1e3 * step_seconds(row['stages'], row['steps']):.2f} "
+              f"ms, MSE {'-' if mse is None else f'{mse:.4g}'} | sweep: {len(stored)}/{n_todo} done, "
+              f"{running} running, {failed} not ok, {eta_text(queue, known, per_run, executor.whose)}",
+              file=stream, flush=True)
     return stored
+
+
+def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budget: float,
+          stream=sys.stderr, retry_failed: bool = False, runner=None) -> list[dict]:
+    """Run ``specs`` on this machine (skipping those already stored), one child process each (``runner``),
+    into the store at ``store_path``; the rows stored (:func:`run_specs`)."""
+    store.check_writable(store_path)
+    with store.SweepLock(store_path):
+        store_path = Path(store_path)
+        rows = store.read_rows(store_path) if store_path.exists() else []
+        executor = LocalExecutor(machine_id(), host_id(), git_commit(), runner, stream)
+        return run_specs(specs, executor, StoreFile(store_path), rows, run_budget, sweep_budget, stream,
+                         retry_failed)

@@ -112,7 +112,7 @@ class LinkedListCPU(CellListSolver):
         """``auto``: ``list`` where the arrays and the pair list fit in the scene's memory limit, else ``gather``."""
         if requested != "auto":
             return requested
-        return "list" if cls.list_fits(scene) else "gather"
+        return "list" if "list" in cls.pair_loops and cls.list_fits(scene) else "gather"
 
     def check_scene(self, scene) -> None:
         if not isinstance(self.threads, int) or not 1 <= self.threads <= numba.config.NUMBA_NUM_THREADS:

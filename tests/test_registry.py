@@ -1,0 +1,131 @@
+"""The solver registry: built-in solvers found in solvers/, plug-ins through the ``pcabench.solvers`` entry points.
+
+The plug-in is the README's example ("Add your own solver"), installed into a
+temporary site folder with its dist-info, exactly as pip leaves an installed
+package: importlib.metadata finds it on ``sys.path`` (``PYTHONPATH`` for the
+command line's processes).
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import solvers
+from pcabench.run import run
+from pcabench.spec import RunSpec
+from solvers import ENTRY_POINT_GROUP, Scene, registry
+from solvers.interface import Solver
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def readme_example() -> str:
+    """The plug-in module of the README's section "Add your own solver"."""
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("### Add your own solver"):]
+    return re.search(r"```python\n# argsort_solver.py\n(.*?)```", section, re.S).group(1)
+
+
+def install(site: Path, module: str, source: str, entries: dict) -> Path:
+    """``module`` with ``source`` and a dist-info declaring ``entries`` ({name: object}) in ``site``."""
+    site.mkdir(parents=True, exist_ok=True)
+    (site / f"{module}.py").write_text(source)
+    info = site / f"{module}-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {module}\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(f"[{ENTRY_POINT_GROUP}]\n"
+                                           + "".join(f"{k} = {v}\n" for k, v in entries.items()))
+    return site
+
+
+@pytest.fixture
+def site(tmp_path, monkeypatch):
+    """A site folder on sys.path; the registry is rebuilt with it and again after the test."""
+    path = tmp_path / "site"
+    path.mkdir()
+    monkeypatch.syspath_prepend(str(path))
+    registry.cache_clear()
+    yield path
+    registry.cache_clear()
+    for name in [m for m in sys.modules if m in ("argsort_solver", "broken_solver")]:
+        del sys.modules[name]
+
+
+def test_the_builtin_solvers_are_found_and_state_what_they_can_do():
+    found = registry()
+    assert {"allpair-cpu", "linkedlist-cpu", "linkedlist-gpu"} <= set(found)
+    for name, cls in found.items():
+        assert issubclass(cls, Solver) and cls.name == name and cls.summary and cls.device in ("cpu", "gpu")
+        assert cls.pair_loops and cls.order >= 1 and "timing" in cls.resources
+    assert found["linkedlist-gpu"].resources.get("GPU") == 1 and found["linkedlist-gpu"].device == "gpu"
+    assert found["linkedlist-cpu"].threaded and not found["allpair-cpu"].threaded
+
+
+def test_finding_the_solvers_touches_no_gpu_library():
+    code = "import sys, solvers; solvers.registry(); print(any(m.startswith(('cupy', 'numba.cuda')) for m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_the_readme_plugin_is_found_and_matches_the_paper_cell_list_bit_for_bit(site, tmp_path):
+    install(site, "argsort_solver", readme_example(), {"argsort-cpu": "argsort_solver:ArgsortCellList"})
+    assert "argsort-cpu" in solvers.solver_names()
+    fields = {}
+    for name in ("argsort-cpu", "linkedlist-cpu"):
+        path = tmp_path / f"{name}.npz"
+        spec = RunSpec(name, Scene(dx=0.5, steps=20, model="lagrangian"), pair_loop="gather")
+        record = run(spec, fields_path=path)
+        assert record.status == "ok" and record.solver == name and record.pair_loop == "gather"
+        fields[name] = np.load(path)
+    for key in ("x", "y", "u", "v", "drho"):  # the same stable order by cell: the same sums
+        np.testing.assert_array_equal(fields["argsort-cpu"][key], fields["linkedlist-cpu"][key])
+
+
+def test_a_broken_or_clashing_plugin_is_left_out_with_one_warning(site):
+    install(site, "broken_solver", "import numpy\nNOT_A_SOLVER = 1\n",
+            {"nothing": "broken_solver:NOT_A_SOLVER", "missing": "broken_solver:Absent",
+             "linkedlist-cpu": "solvers.allpair_cpu:AllPairCPU"})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        found = registry()
+    messages = [str(w.message) for w in caught]
+    assert set(found) == {"allpair-cpu", "linkedlist-cpu", "linkedlist-gpu"}
+    assert found["linkedlist-cpu"].__name__ == "LinkedListCPU"  # a plug-in never replaces a built-in
+    assert len(messages) == 3 and all("left out" in m for m in messages), messages
+    assert any("is taken" in m for m in messages) and any("does not load" in m for m in messages)
+
+
+def test_a_plugin_runs_through_run_a_study_a_report_and_the_benchmarks(tmp_path):
+    site = install(tmp_path / "site", "argsort_solver", readme_example(),
+                   {"argsort-cpu": "argsort_solver:ArgsortCellList"})
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)]),
+           "PCABENCH_HOME": str(tmp_path / "home")}
+
+    def cli(*args):
+        return subprocess.run([sys.executable, "-m", "pcabench.cli", *args], capture_output=True, text=True,
+                              env=env, cwd=tmp_path, timeout=600)
+
+    assert "argsort-cpu" in cli("run", "--help").stdout  # in --solver's choices and the solvers' help
+    out = cli("run", "--solver", "argsort-cpu", "--dx", "1", "--steps", "5", "--json")
+    assert out.returncode == 0, out.stderr
+    assert json.loads(out.stdout)["solver"] == "argsort-cpu"
+    refused = cli("run", "--solver", "argsort-cpu", "--dx", "1", "--threads", "2")
+    assert refused.returncode == 2 and "argsort-cpu is serial" in refused.stderr
+    results, reports = tmp_path / "results", tmp_path / "reports"
+    out = cli("study", "--solver", "argsort-cpu", "linkedlist-cpu", "--pair-loop", "gather", "--dx", "1", "0.5",
+              "--steps", "5", "--results", str(results), "--reports", str(reports))
+    assert out.returncode == 0, out.stderr[-2000:]
+    rows = [json.loads(line) for f in results.glob("*.jsonl") for line in f.read_text().splitlines()]
+    assert {r["solver"] for r in rows} == {"argsort-cpu", "linkedlist-cpu"} and all(r["status"] == "ok" for r in rows)
+    assert "argsort-cpu" in "".join(p.read_text() for p in reports.rglob("report.md"))
+    code = "from benchmarks.common import solver_names; print(' '.join(solver_names('cpu')))"
+    names = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT)
+    assert "argsort-cpu" in names.stdout.split(), names.stderr
