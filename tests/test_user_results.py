@@ -177,3 +177,36 @@ def test_runs_compare_takes_a_machine_prefix_and_prints_no_index(tmp_path, capsy
     code, _, err = cli_main("runs", "--results", str(results), "--compare", "amd", "nowhere", capsys=capsys)
     assert code == 2 and len(err.strip().splitlines()) == 1 and "'nowhere'" in err, err
 
+
+# ---------------------------------------------------------------- asv's smoke run
+def test_asv_smoke_config_writes_only_to_ignored_scratch_and_selects_few_benchmarks(tmp_path):
+    asv_util = pytest.importorskip("asv.util")
+    from pcabench import asv_smoke
+
+    root = asv_smoke.ROOT
+    if not (root / ".git").exists():
+        pytest.skip("not a git checkout")
+    config = asv_smoke.scratch_config(asv_smoke.SCRATCH, name="pytest")
+    try:
+        conf = asv_util.load_json(str(config), js_comments=True)
+        git = ["git", "-C", str(root)]
+        ignored = subprocess.run([*git, "check-ignore", "--no-index", str(config), conf["results_dir"]],
+                                 capture_output=True, text=True).stdout.split()
+        assert ignored == [str(config), conf["results_dir"]], ignored  # both git-ignored
+        tracked = subprocess.run([*git, "ls-files", "--", conf["results_dir"]], capture_output=True, text=True)
+        assert tracked.stdout == "" and not conf["results_dir"].startswith(str(root / "reports"))
+        assert {k: v for k, v in conf.items() if k != "results_dir"} == \
+            {k: v for k, v in asv_util.load_json(str(root / "asv.conf.json"), js_comments=True).items()
+             if k != "results_dir"}
+    finally:
+        config.unlink()
+    # each pattern picks a few parameter sets of the committed suite's benchmarks, as asv matches them
+    import itertools
+    import re
+
+    suite = json.loads((root / "reports/asv/results/benchmarks.json").read_text())
+    names = [f"{name}({', '.join(p)})" for name, b in suite.items() if isinstance(b, dict)
+             for p in itertools.product(*b["params"])]
+    picked = [[n for n in names if re.search(pattern, n)] for pattern in asv_smoke.SELECTION]
+    assert all(picked) and sum(map(len, picked)) <= 6, picked
+    assert asv_smoke.main(["--results", str(root / "reports/asv/results")]) == 2
