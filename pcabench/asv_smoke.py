@@ -1,6 +1,6 @@
 """asv's smoke run: a few benchmarks, once each, in this environment, with every tracked file left as it is.
 
-    python -m pcabench.asv_smoke              # about a minute on two cores; results in .asv/smoke/results
+    python -m pcabench.asv_smoke              # about 30 s on two cores; prints the timings
     python -m pcabench.asv_smoke --check      # `asv check` first (CI)
 
 asv writes ``machine.json`` and ``benchmarks.json`` into its results folder
@@ -46,6 +46,11 @@ def main(argv=None) -> int:
     p.add_argument("--results", type=Path, default=SCRATCH,
                    help=f"the scratch results folder (default {SCRATCH}, git-ignored)")
     p.add_argument("--check", action="store_true", help="run `asv check` first")
+    def error(message):  # one line naming the option, no usage block
+        print(f"asv_smoke: error: {message}", file=sys.stderr)
+        sys.exit(2)
+
+    p.error = error
     args = p.parse_args(argv)
     if args.results.resolve().is_relative_to((ROOT / "reports").resolve()):
         print(f"asv_smoke: error: --results {args.results}: under reports/, where the committed results are; "
