@@ -334,13 +334,11 @@ def cmd_runs(args) -> int:
                 out = runs.compare(df, *args.compare)
             except KeyError as exc:
                 raise OptionError(exc.args[0]) from None
-            print(out.to_string(float_format=lambda v: f"{v:.4g}") if not out.empty else
-                  "no configuration was run by both")
+            print(runs.render(out) if not out.empty else "no configuration was run by both")
         else:
             out = runs.table(df, solver=args.solver, status=args.status, machine=args.machine, commit=args.commit,
                              model=args.model).tail(args.limit)
-            print(out.to_string(index=False, float_format=lambda v: f"{v:.4g}") if not out.empty else
-                  f"no stored runs match in {results}")
+            print(runs.render(out) if not out.empty else f"no stored runs match in {results}")
     return 0
 
 
@@ -498,7 +496,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--commit", help="a commit prefix")
     p.add_argument("--model")
     p.add_argument("--compare", nargs=2, metavar=("A", "B"),
-                   help="the runs both A and B made (machines, or commit prefixes): step times, ratio, errors")
+                   help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, ratio, errors")
     p.add_argument("--limit", type=positive_int("--limit"), default=200, help="the newest rows to print at most")
     p.set_defaults(func=cmd_runs)
 

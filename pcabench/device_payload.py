@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import json
 import os
 import shutil
 import signal
@@ -210,11 +209,11 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
             row(c, message=f"not run: {exc} {detail}".strip())
         return rows
     # asv writes machine.json and benchmarks.json into its results folder: a scratch copy of the config points
-    # it under ``out``, so the committed reports/asv/results stay as they are (as in .ci/run)
+    # it under ``out``, so the committed reports/asv/results stay as they are (as in the smoke run)
+    from .asv_smoke import scratch_config
+
     scratch = Path(out).resolve() / "asv-results"
-    config = root / ".asv-gpu-check.conf.json"
-    config.write_text((root / "asv.conf.json").read_text().replace(
-        '"results_dir": "reports/asv/results"', json.dumps({"results_dir": str(scratch)})[1:-1]))
+    config = scratch_config(scratch, root, "gpu-check")
     results = scratch / machine
     path = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
     for i, commit in enumerate(commits):

@@ -9,25 +9,59 @@ from __future__ import annotations
 import pandas as pd
 
 COLUMNS = ["machine", "commit", "solver", "threads", "pair_loop", "precision", "model", "integrator", "domain",
-           "protocol", "dx", "n_particles", "steps", "status", "step_ms", "mse", "timestamp"]
+           "protocol", "dx", "n_particles", "steps", "status", "step_ms", "mse", "timestamp", "note"]
+NOTE_WIDTH = 160  # characters of a failed run's message in the table's note column
 CONFIG = ["solver", "threads", "pair_loop", "scene_key"]  # the same run on two machines or commits
 
 
+def machines(names, key: str) -> list[str]:
+    """The machines of ``names`` that ``key`` names: itself if one is called so, else those it is a prefix of
+    (sorted; empty if none). The one rule for ``--machine`` and ``--compare``."""
+    names = sorted(set(names))
+    return [key] if key in names else [m for m in names if m.startswith(key)]
+
+
+def note(message: str, width: int = NOTE_WIDTH) -> str:
+    """``message`` on one line, cut at a word boundary past ``width`` characters (marked by " ...")."""
+    text = " ".join(message.split())
+    return text if len(text) <= width else text[:width].rsplit(" ", 1)[0] + " ..."
+
+
 def table(df: pd.DataFrame, **filters) -> pd.DataFrame:
-    """The runs of ``df`` (from ``store.load``) as a readable table, filtered by column prefix matches."""
+    """The runs of ``df`` (from ``store.load``) as a readable table, filtered by column prefix matches (a
+    machine by :func:`machines`). A run that made no step (skipped on its prediction, timed out, crashed
+    before a step) has no step time, steps or error (NA, shown as "-"), and its note says why."""
     if df.empty:
         return pd.DataFrame(columns=COLUMNS)
-    out = df.assign(step_ms=1e3 * df.t_step, commit=df.commit.astype(str).str[:7])
+    stepped = df.steps > 0
+    out = df.assign(step_ms=(1e3 * df.t_step).where(stepped), steps=df.steps.astype("Int64").where(stepped),
+                    mse=df.mse.where(stepped),
+                    commit=df.commit.astype(str).str[:7],
+                    note=(df.message if "message" in df else pd.Series("", index=df.index)).fillna("")
+                    .astype(str).map(note).where(df.status != "ok", ""))
     for column, value in filters.items():
         if value:
-            out = out[out[column].astype(str).str.startswith(str(value))]
+            hit = (out.machine.isin(machines(out.machine, str(value))) if column == "machine"
+                   else out[column].astype(str).str.startswith(str(value)))
+            out = out[hit]
     return out.sort_values(["machine", "timestamp"])[COLUMNS]
 
 
+def render(out: pd.DataFrame) -> str:
+    """``out`` (from :func:`table` or :func:`compare`) as text: no index column, "-" where nothing was measured."""
+    counts = [c for c in out if isinstance(out[c].dtype, pd.Int64Dtype)]  # steps: "<NA>" otherwise
+    out = out.astype({c: object for c in counts}).fillna({c: "-" for c in counts})
+    return out.to_string(index=False, na_rep="-", float_format=lambda v: f"{v:.4g}")
+
+
 def side(df: pd.DataFrame, key: str) -> tuple[str, pd.DataFrame]:
-    """The runs ``key`` names: a machine (exact) or else a commit (prefix); ('', empty) if neither."""
-    if key in set(df.machine):
-        return "machine", df[df.machine == key]
+    """The runs ``key`` names: a machine (by :func:`machines`) or else a commit (prefix); ('', empty) if neither.
+    A prefix of several machines is an error that names them."""
+    hit = machines(df.machine, key)
+    if len(hit) > 1:
+        raise KeyError(f"--compare: {key!r} is a prefix of several machines ({', '.join(hit)}): give more of one")
+    if hit:
+        return "machine", df[df.machine == hit[0]]
     hit = df[df.commit.astype(str).str.startswith(key)]
     return ("commit", hit) if not hit.empty else ("", hit)
 
@@ -39,7 +73,10 @@ def compare(df: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
     kind_b, rb = side(ok, b)
     for key, kind in ((a, kind_a), (b, kind_b)):
         if not kind:
-            raise KeyError(f"--compare: {key!r} is neither a machine nor a commit of a finished run in the store")
+            raise KeyError(f"--compare: {key!r} is neither a machine nor a commit of a finished run in the store "
+                           f"(machines: {', '.join(machines(df.machine, ''))})")
+    # a machine's columns are named by the machine, a prefix's included
+    a, b = (r.machine.iloc[0] if kind == "machine" else key for key, kind, r in ((a, kind_a, ra), (b, kind_b, rb)))
     newest = [c for c in CONFIG if c in ok]
     ra = ra.sort_values("timestamp").drop_duplicates(newest, keep="last")
     rb = rb.sort_values("timestamp").drop_duplicates(newest, keep="last")

@@ -14,7 +14,7 @@ from pcabench.sweep import sweep
 from solvers import Scene
 
 from .conftest import cli_main
-from .test_study import fixture_rows
+from .test_study import fixture_rows, row
 
 
 # ---------------------------------------------------------------- a user's runs are their own
@@ -141,3 +141,72 @@ def test_runs_lists_filters_and_compares(tmp_path):
         runs.compare(df, "machine-a", "nowhere")
     same = runs.compare(df, "machine-a", "abc")  # a machine against a commit it made: every run matches itself
     assert len(same) > 0 and (same["b / a"] == 1.0).all()
+
+
+def test_runs_shows_a_skipped_run_as_skipped_with_its_reason_and_no_numbers(tmp_path, capsys):
+    results = tmp_path / "results"
+    for r in fixture_rows():  # holds one skipped run: "predicted 999 s > run budget"
+        store.append(r, results / f"{r.profile_id}.jsonl")
+    code, out, err = cli_main("runs", "--results", str(results), "--status", "skipped", capsys=capsys)
+    header, *lines = out.strip().splitlines()
+    assert code == 0 and len(lines) == 1, out + err
+    cells = dict(zip(header.split(), lines[0].split(maxsplit=len(header.split()) - 1)))
+    assert cells["status"] == "skipped" and cells["note"] == "predicted 999 s > run budget", cells
+    assert cells["steps"] == cells["step_ms"] == cells["mse"] == "-", cells  # not 0 steps, 0.00 ms
+    code, out, _ = cli_main("runs", "--results", str(results), "--status", "ok", capsys=capsys)
+    assert code == 0 and "-  ok" not in out and "<NA>" not in out
+
+
+def test_runs_compare_takes_a_machine_prefix_and_prints_no_index(tmp_path, capsys):
+    results = tmp_path / "results"
+    for profile, ms in (("amd-epyc", 1.0), ("h100-80gb", 0.5), ("h200-141gb", 0.25)):
+        for dx in (1.0, 0.5):
+            r = row(profile=profile, step_ms=(ms, ms, ms), dx=dx)
+            store.append(r, results / f"{profile}.jsonl")
+    code, out, err = cli_main("runs", "--results", str(results), "--compare", "amd", "h", capsys=capsys)
+    assert code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert "--compare" in err and "h100-80gb" in err and "h200-141gb" in err, err  # "h": which one?
+    code, out, err = cli_main("runs", "--results", str(results), "--compare", "amd", "h1", capsys=capsys)
+    header, *lines = out.strip().splitlines()
+    assert code == 0 and len(lines) == 2, out + err
+    assert header.split()[0] == "solver" and all(line.split()[0] == "linkedlist-cpu" for line in lines), out
+    assert "step_ms amd-epyc" in header and "step_ms h100-80gb" in header, header
+    assert [float(line.split()[-4]) for line in lines] == [0.5, 0.5], out  # b / a
+    code, out, err = cli_main("runs", "--results", str(results), "--machine", "h", capsys=capsys)
+    assert code == 0 and {line.split()[0] for line in out.strip().splitlines()[1:]} == {"h100-80gb", "h200-141gb"}
+    code, _, err = cli_main("runs", "--results", str(results), "--compare", "amd", "nowhere", capsys=capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "'nowhere'" in err, err
+
+
+# ---------------------------------------------------------------- asv's smoke run
+def test_asv_smoke_config_writes_only_to_ignored_scratch_and_selects_few_benchmarks(tmp_path):
+    asv_util = pytest.importorskip("asv.util")
+    from pcabench import asv_smoke
+
+    root = asv_smoke.ROOT
+    if not (root / ".git").exists():
+        pytest.skip("not a git checkout")
+    config = asv_smoke.scratch_config(asv_smoke.SCRATCH, name="pytest")
+    try:
+        conf = asv_util.load_json(str(config), js_comments=True)
+        git = ["git", "-C", str(root)]
+        ignored = subprocess.run([*git, "check-ignore", "--no-index", str(config), conf["results_dir"]],
+                                 capture_output=True, text=True).stdout.split()
+        assert ignored == [str(config), conf["results_dir"]], ignored  # both git-ignored
+        tracked = subprocess.run([*git, "ls-files", "--", conf["results_dir"]], capture_output=True, text=True)
+        assert tracked.stdout == "" and not conf["results_dir"].startswith(str(root / "reports"))
+        assert {k: v for k, v in conf.items() if k != "results_dir"} == \
+            {k: v for k, v in asv_util.load_json(str(root / "asv.conf.json"), js_comments=True).items()
+             if k != "results_dir"}
+    finally:
+        config.unlink()
+    # each pattern picks a few parameter sets of the committed suite's benchmarks, as asv matches them
+    import itertools
+    import re
+
+    suite = json.loads((root / "reports/asv/results/benchmarks.json").read_text())
+    names = [f"{name}({', '.join(p)})" for name, b in suite.items() if isinstance(b, dict)
+             for p in itertools.product(*b["params"])]
+    picked = [[n for n in names if re.search(pattern, n)] for pattern in asv_smoke.SELECTION]
+    assert all(picked) and sum(map(len, picked)) <= 6, picked
+    assert asv_smoke.main(["--results", str(root / "reports/asv/results")]) == 2
