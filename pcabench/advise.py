@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from solvers import Scene
+from solvers import DEFAULT_SOLVER, Scene
 from solvers.dispersion import predict, stable_cfl
 
 from .reports.tables import comparable, default_numerics, latest
@@ -134,7 +134,7 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
         _, s, p = best
         out.update(kernel=getattr(s, "kernel", "gaussian"), h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,
                    predicted_error=p.predicted_error,
-                   study=(f"pcabench study --solver linkedlist-cpu --model {model} --t-end {t_end:g} --strip "
+                   study=(f"pcabench study --solver {DEFAULT_SOLVER} --model {model} --t-end {t_end:g} --strip "
                           f"--kernel {getattr(s, 'kernel', 'gaussian')} --h-factor {s.h_factor:g} --cfl {s.cfl:g} "
                           f"--dx {s.dx:g} {s.dx / 2:g}"))
     return out
