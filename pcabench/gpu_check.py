@@ -390,7 +390,10 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
     if rehearse:
-        os.environ["NUMBA_ENABLE_CUDASIM"] = "1"
+        from numba.core import config
+
+        os.environ["NUMBA_ENABLE_CUDASIM"] = "1"  # for the child processes (asv, pytest)
+        config.reload_config()  # and this one: numba read its settings when the solver registry imported it
     plan = plan or (REHEARSAL if rehearse else FULL)
     from . import profiles
     from .provenance import git_commit
