@@ -13,6 +13,7 @@ status and exit code 1; a solver that cannot run here (no GPU) exits 3.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import os
@@ -24,7 +25,7 @@ from pathlib import Path
 
 from solvers import INTEGRATORS, KERNELS, MODELS, PRECISIONS, SOLVERS, Scene, SceneError, SolverUnavailable
 
-from . import __version__, paths
+from . import __version__, memory, paths
 from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
@@ -128,8 +129,10 @@ ACCURACY_OPTIONS = {opt: key for opt, key in SCENE_OPTIONS.items() if opt not in
 
 
 def scene_from_args(args) -> Scene:
+    """The scene of the options, bounded by the memory this process may use (one line if it does not fit)."""
     given = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt) is not None}
-    return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height, **given)
+    return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height,
+                 memory_limit_bytes=memory.available_memory_bytes(), **given)
 
 
 def check_output_path(path, option: str) -> None:
@@ -227,13 +230,20 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     return name, preset(name)
 
 
+def bounded_spec(spec: RunSpec) -> RunSpec:
+    """``spec`` resolved with its scene bounded by the memory available here (a SceneError if it does not
+    fit), so that ``auto`` takes the pair list only where it fits."""
+    return dataclasses.replace(spec, scene=memory.bounded(spec.scene)).resolved()
+
+
 def check_specs(specs: list[RunSpec]) -> list[RunSpec]:
-    """Every spec resolved and checked by its solver before the first run (exits 2 or 3, not mid-sweep)."""
+    """Every spec resolved, its memory and its solver checked before the first run (exits 2 or 3, not
+    mid-sweep)."""
     from solvers import make_solver
 
     resolved, solvers = [], {}
     for spec in specs:
-        spec = spec.resolved()
+        spec = bounded_spec(spec)
         key = (spec.solver, spec.threads, spec.pair_loop)
         if key not in solvers:
             solvers[key] = make_solver(*key)
@@ -251,9 +261,9 @@ def cmd_study(args) -> int:
 
     name, specs = study_specs(args)
     if args.cluster:  # the workers check their own solvers (a GPU run needs a GPU worker, not a GPU here)
-        specs = [spec.resolved() for spec in specs]
+        specs = [bounded_spec(spec) for spec in specs]
     else:
-        check_specs(specs)
+        specs = check_specs(specs)
     run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
