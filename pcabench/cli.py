@@ -6,9 +6,9 @@
     pcabench profile [--save | --asv]
     pcabench gpu-check --out DIR
 
-Bad input ends with one line naming the parameter and its allowed range, and
-exit code 2; a run that fails (unstable, out of memory) is reported with its
-status and exit code 1; a solver that cannot run here (no GPU) exits 3.
+Library code raises exceptions; this module alone maps them to the exit
+codes of :data:`EXIT_HELP` (bad input is one line naming the parameter and its
+allowed range, never a traceback).
 """
 from __future__ import annotations
 
@@ -27,8 +27,20 @@ from solvers import INTEGRATORS, KERNELS, MODELS, PRECISIONS, SOLVERS, Scene, Sc
 
 from . import __version__, memory, paths
 from .progress import Progress
+from .errors import NoResults
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
+
+# exit codes: each one means one thing
+EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 2, 3, 4, 130
+EXIT_HELP = f"""exit codes:
+  {EXIT_OK}    ok
+  {EXIT_RUN_FAILED}    the run failed: unstable (with its step), out-of-memory or error, recorded, never a
+       traceback; `advise`: no stored run reaches --error; `gpu-check`: a stage failed
+  {EXIT_BAD_INPUT}    bad input: one line naming the parameter and its allowed range, before any work
+  {EXIT_UNAVAILABLE}    the solver cannot run here (no GPU)
+  {EXIT_NO_RESULTS}    no results: no stored runs to report or advise from (run `pcabench study` first)
+  {EXIT_INTERRUPTED}  interrupted"""
 
 SOLVER_HELP = """solvers:
   allpair-cpu     every pair tested (the paper's all-pair search), serial
@@ -50,7 +62,7 @@ class Parser(argparse.ArgumentParser):
     """argparse, but a usage error is one line naming the option, and exit code 2."""
 
     def error(self, message):
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 # ---------------------------------------------------------------- option types
@@ -210,7 +222,7 @@ def cmd_run(args) -> int:
               + (f" at step {record.failed_step}" if record.failed_step else ""))
         if record.message:
             print(f"message          {record.message.splitlines()[0]}")
-    return 0 if record.status == "ok" else 1
+    return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
 
 
 def study_specs(args) -> tuple[str, list[RunSpec]]:
@@ -374,8 +386,8 @@ def cmd_advise(args) -> int:
     results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
     df = store.load(results) if results is not None and Path(results).exists() else None
     if df is None or df.empty:
-        raise OptionError(f"no stored runs in {results}: run `pcabench study --front` first, "
-                          "or use --reference")
+        raise NoResults(f"no stored runs in {results}: run `pcabench study --front` first, "
+                        "or use --reference")
     machines = df.machine.value_counts()
     machine = args.machine or (machine_id() if machine_id() in machines else machines.index[0])
     if machine not in machines:
@@ -397,7 +409,7 @@ def cmd_advise(args) -> int:
                   f"dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); run:\n  {s['study']}")
         print(f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)" if s["paper_dx"] else
               f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)")
-        return 1
+        return EXIT_RUN_FAILED
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
           f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} of a predicted stable {out['stable_cfl']:.3g}, "
           f"dx {out['dx']:g}, {out['precision']}, {out['threads']} thread(s), {out['domain']} domain, "
@@ -437,7 +449,8 @@ def cmd_gpu_check(args) -> int:
 
 # ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="pcabench", description=__doc__.split("\n")[0])
+    parser = Parser(prog="pcabench", description=__doc__.split("\n")[0], epilog=EXIT_HELP,
+                    formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"pcabench {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     results_help = f"folder of results stores, *.jsonl (default: {paths.user_results()})"
@@ -564,14 +577,16 @@ def main(argv=None) -> int:
     try:
         return args.func(args)
     except (SceneError, OptionError, StoreError) as exc:
-        parser.exit(2, f"pcabench: error: {exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {exc}\n")
     except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
         where = f"{exc.filename}: " if exc.filename else ""
-        parser.exit(2, f"pcabench: error: {where}{exc.strerror or exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {where}{exc.strerror or exc}\n")
     except SolverUnavailable as exc:
-        parser.exit(3, f"pcabench: {exc}\n")
+        parser.exit(EXIT_UNAVAILABLE, f"pcabench: {exc}\n")
+    except NoResults as exc:
+        parser.exit(EXIT_NO_RESULTS, f"pcabench: {exc}\n")
     except KeyboardInterrupt:
-        parser.exit(130, "pcabench: interrupted\n")
+        parser.exit(EXIT_INTERRUPTED, "pcabench: interrupted\n")
     finally:
         warnings.formatwarning = shown
 
