@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from . import pairlist
-from .backend import cpu_pairs, cpu_updates
+from .backend import cpu_pairs, cpu_updates, use_threads
 from .celllist import CellListSolver
 from .scene import SceneError
 
@@ -91,6 +91,8 @@ class LinkedListCPU(CellListSolver):
     def input(self, scene) -> None:
         super().input(scene)
         self.pair_loop = self.choose_pair_loop(scene, self.requested_pair_loop)
+        if self.threads > 1:  # the count is decided: numba's pool set once here, not on every launch
+            use_threads(self.threads, decided=True)
 
     @staticmethod
     def list_fits(scene) -> bool:
@@ -132,7 +134,7 @@ class LinkedListCPU(CellListSolver):
 
     def launch(self, name: str, *args):
         if self.threads > 1:
-            numba.set_num_threads(self.threads)
+            use_threads(self.threads)  # a call into numba only if another solver set another count since
         return sweeps(self.scene.precision, self.scene.kernel, self.threads > 1)[name](*args)
 
     def sort_cells(self) -> None:
@@ -162,7 +164,7 @@ class LinkedListCPU(CellListSolver):
         if self.pairs is None:
             return super()._sweep(continuity, momentum)
         if self.threads > 1:
-            numba.set_num_threads(self.threads)
+            use_threads(self.threads)
         a = self.arrays
         if continuity:
             self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
