@@ -6,13 +6,14 @@
     pcabench profile [--save | --asv]
     pcabench gpu-check --out DIR
 
-Bad input ends with one line naming the parameter and its allowed range, and
-exit code 2; a run that fails (unstable, out of memory) is reported with its
-status and exit code 1; a solver that cannot run here (no GPU) exits 3.
+Library code raises exceptions; this module alone maps them to the exit
+codes of :data:`EXIT_HELP` (bad input is one line naming the parameter and its
+allowed range, never a traceback).
 """
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import os
@@ -24,10 +25,22 @@ from pathlib import Path
 
 from solvers import DEFAULT_SOLVER, INTEGRATORS, KERNELS, MODELS, PRECISIONS, Scene, SceneError, SolverUnavailable, registry
 
-from . import __version__, paths
+from . import __version__, memory, paths
 from .progress import Progress
+from .errors import NoResults
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
+
+# exit codes: each one means one thing
+EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 2, 3, 4, 130
+EXIT_HELP = f"""exit codes:
+  {EXIT_OK}    ok
+  {EXIT_RUN_FAILED}    the run failed: unstable (with its step), out-of-memory or error, recorded, never a
+       traceback; `advise`: no stored run reaches --error; `gpu-check`: a stage failed
+  {EXIT_BAD_INPUT}    bad input: one line naming the parameter and its allowed range, before any work
+  {EXIT_UNAVAILABLE}    the solver cannot run here (no GPU)
+  {EXIT_NO_RESULTS}    no results: no stored runs to report or advise from (run `pcabench study` first)
+  {EXIT_INTERRUPTED}  interrupted"""
 
 
 def solver_help() -> str:
@@ -55,7 +68,7 @@ class Parser(argparse.ArgumentParser):
     """argparse, but a usage error is one line naming the option, and exit code 2."""
 
     def error(self, message):
-        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 # ---------------------------------------------------------------- option types
@@ -137,8 +150,10 @@ ACCURACY_OPTIONS = {opt: key for opt, key in SCENE_OPTIONS.items() if opt not in
 
 
 def scene_from_args(args) -> Scene:
+    """The scene of the options, bounded by the memory this process may use (one line if it does not fit)."""
     given = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt) is not None}
-    return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height, **given)
+    return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height,
+                 memory_limit_bytes=memory.available_memory_bytes(), **given)
 
 
 def check_output_path(path, option: str) -> None:
@@ -184,8 +199,8 @@ def cmd_run(args) -> int:
     from .store import to_row
 
     scene = scene_from_args(args)
-    spec = RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto").resolved()
-    check_specs([spec])  # the solver can run here (a GPU for linkedlist-gpu), before anything is printed
+    # resolved once, and checked: the solver can run here (a GPU for a GPU solver), before anything is printed
+    spec, = check_specs([RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto")])
     if args.fields is not None:
         if args.fields.strip() and not args.fields.endswith(".npz"):
             args.fields += ".npz"  # as numpy.savez names it
@@ -215,7 +230,7 @@ def cmd_run(args) -> int:
               + (f" at step {record.failed_step}" if record.failed_step else ""))
         if record.message:
             print(f"message          {record.message.splitlines()[0]}")
-    return 0 if record.status == "ok" else 1
+    return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
 
 
 def study_specs(args) -> tuple[str, list[RunSpec]]:
@@ -235,13 +250,20 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     return name, preset(name)
 
 
+def bounded_spec(spec: RunSpec) -> RunSpec:
+    """``spec`` resolved with its scene bounded by the memory available here (a SceneError if it does not
+    fit), so that ``auto`` takes the pair list only where it fits."""
+    return dataclasses.replace(spec, scene=memory.bounded(spec.scene)).resolved()
+
+
 def check_specs(specs: list[RunSpec]) -> list[RunSpec]:
-    """Every spec resolved and checked by its solver before the first run (exits 2 or 3, not mid-sweep)."""
+    """Every spec resolved, its memory and its solver checked before the first run (exits 2 or 3, not
+    mid-sweep)."""
     from solvers import make_solver
 
     resolved, solvers = [], {}
     for spec in specs:
-        spec = spec.resolved()
+        spec = bounded_spec(spec)
         key = (spec.solver, spec.threads, spec.pair_loop)
         if key not in solvers:
             solvers[key] = make_solver(*key)
@@ -259,7 +281,7 @@ def cmd_study(args) -> int:
 
     name, specs = study_specs(args)
     if args.cluster:  # the workers check their own solvers (a GPU run needs a GPU worker, not a GPU here)
-        specs = [spec.resolved() for spec in specs]
+        specs = [bounded_spec(spec) for spec in specs]
     else:
         specs = check_specs(specs)
     run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
@@ -371,8 +393,8 @@ def cmd_advise(args) -> int:
     results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
     df = store.load(results) if results is not None and Path(results).exists() else None
     if df is None or df.empty:
-        raise OptionError(f"no stored runs in {results}: run `pcabench study --front` first, "
-                          "or use --reference")
+        raise NoResults(f"no stored runs in {results}: run `pcabench study --front` first, "
+                        "or use --reference")
     machines = df.machine.value_counts()
     machine = args.machine or (machine_id() if machine_id() in machines else machines.index[0])
     if machine not in machines:
@@ -394,7 +416,7 @@ def cmd_advise(args) -> int:
                   f"dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); run:\n  {s['study']}")
         print(f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)" if s["paper_dx"] else
               f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)")
-        return 1
+        return EXIT_RUN_FAILED
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
           f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} of a predicted stable {out['stable_cfl']:.3g}, "
           f"dx {out['dx']:g}, {out['precision']}, {out['threads']} thread(s), {out['domain']} domain, "
@@ -434,7 +456,8 @@ def cmd_gpu_check(args) -> int:
 
 # ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="pcabench", description=__doc__.split("\n")[0])
+    parser = Parser(prog="pcabench", description=__doc__.split("\n")[0], epilog=EXIT_HELP,
+                    formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"pcabench {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     results_help = f"folder of results stores, *.jsonl (default: {paths.user_results()})"
@@ -561,14 +584,16 @@ def main(argv=None) -> int:
     try:
         return args.func(args)
     except (SceneError, OptionError, StoreError) as exc:
-        parser.exit(2, f"pcabench: error: {exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {exc}\n")
     except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
         where = f"{exc.filename}: " if exc.filename else ""
-        parser.exit(2, f"pcabench: error: {where}{exc.strerror or exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {where}{exc.strerror or exc}\n")
     except SolverUnavailable as exc:
-        parser.exit(3, f"pcabench: {exc}\n")
+        parser.exit(EXIT_UNAVAILABLE, f"pcabench: {exc}\n")
+    except NoResults as exc:
+        parser.exit(EXIT_NO_RESULTS, f"pcabench: {exc}\n")
     except KeyboardInterrupt:
-        parser.exit(130, "pcabench: interrupted\n")
+        parser.exit(EXIT_INTERRUPTED, "pcabench: interrupted\n")
     finally:
         warnings.formatwarning = shown
 

@@ -513,7 +513,7 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
     try:
         for p in write_reports(Path(results), Path(reports)):
             print(f"wrote {p}", file=sys.stderr)
-    except (Exception, SystemExit) as exc:  # noqa: BLE001 - the tarball must still be written
+    except Exception as exc:  # noqa: BLE001 - the tarball must still be written
         state["stages"].append({"stage": "reports", "status": f"failed: {exc}", "seconds": 0.0})
     bundle(out, Path(results), Path(reports), profile["id"])
     budget.say(f"done; bring back {out / 'gpu_check.tar.gz'}")

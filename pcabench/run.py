@@ -14,14 +14,9 @@ from solvers.isothermal1d import isothermal_errors
 from solvers.integrators import step_program
 
 from .clock import clock_for
+from .memory import is_out_of_memory
 from .record import RunRecord
 from .spec import RunSpec
-
-
-def _is_oom(exc: BaseException) -> bool:
-    text = f"{type(exc).__name__} {exc}".lower()
-    return isinstance(exc, MemoryError) or "out of memory" in text or "outofmemory" in text \
-        or "cudaerrormemoryallocation" in text
 
 
 def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> RunRecord:
@@ -73,7 +68,7 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> Ru
     except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
         record.steps = step
         record.failed_step = step or None
-        record.status = "out-of-memory" if _is_oom(exc) else "error"
+        record.status = "out-of-memory" if is_out_of_memory(exc) else "error"
         record.message = f"{type(exc).__name__}: {exc}"
         if clock is not None:
             try:

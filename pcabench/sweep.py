@@ -26,9 +26,8 @@ import threading
 import time
 from pathlib import Path
 
-from solvers.scene import cgroup_memory_folders
-
 from . import store
+from .memory import cgroup_memory_folders
 from .predict import predicted_seconds
 from .profiles import MACHINE_ID_ENV, machine_id
 from .provenance import git_commit, host_id

@@ -1,7 +1,22 @@
 """The shared per-particle physics (solvers/pairs.py) compiled for numba's CPU target."""
 from __future__ import annotations
 
+import threading
 from functools import lru_cache
+
+_numba_threads = threading.local()  # the thread count this Python thread last gave numba through use_threads
+
+
+def use_threads(n: int, decided: bool = False) -> None:
+    """numba's thread count for the parallel loops launched from this Python thread (numba keeps it per
+    thread): set where a solver decides its count (``decided``: its input stage), and before a launch
+    only when another count was set since, as when two solvers alternate in one process; else nothing
+    but a thread-local read (numba.set_num_threads costs about 1 us a call)."""
+    if decided or getattr(_numba_threads, "n", None) != n:
+        import numba
+
+        numba.set_num_threads(n)
+        _numba_threads.n = n
 
 
 @lru_cache(maxsize=None)

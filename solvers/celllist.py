@@ -38,7 +38,8 @@ class CellListSolver(Solver):
 
     @abc.abstractmethod
     def count_neighbours(self) -> int:
-        """Neighbours within the cutoff summed over particles, at the current (sorted) positions."""
+        """Neighbours within the cutoff summed over particles, at the current positions, on a cell list of
+        its own: the particles, their order and the solver's cell list are left as they are."""
 
     def snp(self) -> None:
         """The cell list for the current positions: every step if particles move, once otherwise."""
@@ -66,8 +67,8 @@ class CellListSolver(Solver):
             self.launch("momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
 
     def mean_neighbours(self) -> float:
-        self.cells_valid = False
-        self.snp()
+        """Mean count of neighbours within the cutoff at the current positions; no side effect (the state
+        is not re-sorted: the count is the same in any particle order)."""
         return self.count_neighbours() / self.scene.n_particles
 
     def probe(self) -> "CellListSolver":

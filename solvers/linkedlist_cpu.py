@@ -26,7 +26,7 @@ import numba
 import numpy as np
 
 from . import pairlist
-from .backend import cpu_pairs, cpu_updates
+from .backend import cpu_pairs, cpu_updates, use_threads
 from .celllist import CellListSolver
 from .scene import SceneError
 
@@ -95,11 +95,15 @@ class LinkedListCPU(CellListSolver):
     def input(self, scene) -> None:
         super().input(scene)
         self.pair_loop = self.choose_pair_loop(scene, self.requested_pair_loop)
+        if self.threads > 1:  # the count is decided: numba's pool set once here, not on every launch
+            use_threads(self.threads, decided=True)
 
     @staticmethod
     def list_fits(scene) -> bool:
-        """Whether the particle arrays and the pair list fit in the scene's memory limit."""
-        return scene.memory_bytes() + pairlist.list_bytes(scene) <= scene.memory_limit()
+        """Whether the particle arrays and the pair list fit in the scene's memory limit (a scene that
+        states none: they do; the harness gives every scene the memory available before it resolves ``auto``)."""
+        limit = scene.memory_limit()
+        return limit is None or scene.memory_bytes() + pairlist.list_bytes(scene) <= limit
 
     @classmethod
     def memory_bytes(cls, scene, pair_loop: str = "auto") -> int:
@@ -140,7 +144,7 @@ class LinkedListCPU(CellListSolver):
 
     def launch(self, name: str, *args):
         if self.threads > 1:
-            numba.set_num_threads(self.threads)
+            use_threads(self.threads)  # a call into numba only if another solver set another count since
         return sweeps(self.scene.precision, self.scene.kernel, self.threads > 1)[name](*args)
 
     def sort_cells(self) -> None:
@@ -170,7 +174,7 @@ class LinkedListCPU(CellListSolver):
         if self.pairs is None:
             return super()._sweep(continuity, momentum)
         if self.threads > 1:
-            numba.set_num_threads(self.threads)
+            use_threads(self.threads)
         a = self.arrays
         if continuity:
             self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
@@ -178,4 +182,12 @@ class LinkedListCPU(CellListSolver):
             self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
 
     def count_neighbours(self) -> int:
-        return self.launch("neighbours", *self.geometry(), self.k)
+        """On a cell list of its own, over copies of the positions in its cell order (the state untouched)."""
+        s, a, n = self.scene, self.arrays, self.scene.n_particles
+        cell, sorted_cell, order = np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.int64)
+        begin = np.zeros(self.ncells + 1, np.uint32)
+        self.launch("cell_ids", a["lx"], a["ly"], a["sx"], a["sy"], cell, s.dx, -self.cw, s.height, self.cw,
+                    self.ch, self.ncx, self.ncy)
+        counting_sort(cell, self.ncells, begin, order, sorted_cell)
+        positions = [a[name][order] for name in ("lx", "ly", "sx", "sy")]
+        return int(self.launch("neighbours", sorted_cell, begin, self.ncx, self.ncy, *positions, self.k))

@@ -153,9 +153,22 @@ class LinkedListGPU(CellListSolver):
         self.coefficients_fresh = self.coefficients_fresh and "drho" not in names
 
     def count_neighbours(self) -> int:
-        counts = self.xp.zeros(self.scene.n_particles, self.xp.int32)
-        self.launch("neighbours", *self.geometry(), counts, self.k)
-        return int(counts.astype(self.xp.int64).sum())
+        """On a cell list of its own (the same three launches as SNP), over a copy of the positions
+        scattered into its cell order: the particle blocks and the solver's cell list untouched."""
+        from .gpu_kernels import scan_block
+
+        s, a, xp, n = self.scene, self.arrays, self.xp, self.scene.n_particles
+        src = xp.stack([a["lx"], a["ly"], a["sx"], a["sy"]])
+        dst = xp.empty_like(src)
+        cell, rank, cell_out, order = (xp.empty(n, xp.int32) for _ in range(4))
+        counts, begin = xp.zeros(self.ncells, xp.int32), xp.empty(self.ncells + 1, xp.uint32)
+        self.launch("cell_count", a["lx"], a["ly"], a["sx"], a["sy"], cell, rank, counts, s.dx, -self.cw, s.height,
+                    self.cw, self.ch, self.ncx, self.ncy)
+        self.launch("cell_begin", counts, begin, grid=(1, scan_block()))
+        self.launch("scatter", cell, rank, begin, src, dst, cell_out, order)
+        found = xp.zeros(n, xp.int32)
+        self.launch("neighbours", cell_out, begin, self.ncx, self.ncy, dst[0], dst[1], dst[2], dst[3], found, self.k)
+        return int(found.astype(xp.int64).sum())
 
     def to_host(self, arr) -> np.ndarray:
         return self.cupy.asnumpy(arr) if self.cupy is not None else np.asarray(arr)

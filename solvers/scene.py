@@ -9,12 +9,14 @@ Gaussian pulse of Mach 0.05, a Gaussian kernel with h = 2.13 dx truncated at
 
 A scene states its particle count and memory before anything is allocated
 (:meth:`Scene.memory_bytes`) and rejects nonsense with a message that names
-the parameter and the allowed range (:class:`SceneError`).
+the parameter and the allowed range (:class:`SceneError`). It is a pure value:
+it checks its arrays against ``memory_limit_bytes`` when it states one and
+never reads the machine (the harness sets that limit to the memory available,
+pcabench/memory.py, before any work).
 """
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import asdict, dataclass, field, replace
 
 from .kernel import KERNELS, SUPPORT
@@ -41,70 +43,6 @@ NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor", "kernel")
 
 class SceneError(ValueError):
     """A scene parameter is outside its allowed range."""
-
-
-def _read_int(path: str) -> int | None:
-    try:
-        with open(path) as f:
-            text = f.read().split()[0]
-        return None if text == "max" else int(text)
-    except (OSError, ValueError, IndexError):
-        return None
-
-
-CGROUP_MOUNT = "/sys/fs/cgroup"
-PROC_CGROUP = "/proc/self/cgroup"  # this process's cgroup in each hierarchy
-# cgroup v2 (the unified hierarchy at the mount) and v1 (its memory hierarchy): folder, limit, usage, events
-CGROUP_MEMORY = (("", "memory.max", "memory.current", "memory.events"),
-                 ("memory", "memory.limit_in_bytes", "memory.usage_in_bytes", "memory.oom_control"))
-
-
-def cgroup_memory_folders() -> list[tuple[str, str, str, str]]:
-    """``(folder, limit, usage, events)`` files of this process's memory cgroup and each of its ancestors,
-    v2 then v1, innermost first: every level's limit applies, and a nested one may be the smallest."""
-    own = {}
-    try:
-        with open(PROC_CGROUP) as f:
-            for line in f:
-                _, controllers, path = line.rstrip("\n").split(":", 2)
-                for sub, *_ in CGROUP_MEMORY:
-                    if (controllers == "") if sub == "" else (sub in controllers.split(",")):
-                        own[sub] = path
-    except (OSError, ValueError):
-        pass
-    out = []
-    for sub, limit, usage, events in CGROUP_MEMORY:
-        parts = [p for p in own.get(sub, "/").split("/") if p not in ("", ".", "..")]
-        for k in range(len(parts), -1, -1):
-            folder = os.path.join(CGROUP_MOUNT, sub, *parts[:k])
-            if os.path.isdir(folder):
-                out.append((folder, os.path.join(folder, limit), os.path.join(folder, usage),
-                            os.path.join(folder, events)))
-    return out
-
-
-def available_memory_bytes() -> int:
-    """Memory this process may still use, bytes: the smallest of the host's available memory
-    (MemAvailable) and, at every level of its cgroup (v2 memory.max, v1 memory.limit_in_bytes), the
-    limit less the usage."""
-    limits = []
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    limits.append(int(line.split()[1]) * 1024)
-    except (OSError, ValueError):
-        pass
-    for _, limit_path, usage_path, _ in cgroup_memory_folders():
-        limit = _read_int(limit_path)
-        if limit is not None and limit < 2**60:
-            limits.append(max(limit - (_read_int(usage_path) or 0), 0))
-    if not limits:
-        try:
-            limits.append(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-        except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
-            limits.append(16 * 2**30)
-    return min(limits)
 
 
 def bytes_per_particle(precision: str) -> int:
@@ -170,10 +108,13 @@ class Scene:
         # the particle count in floating point first: a tiny dx must not overflow an integer
         count = (self.x_max - self.x_min) / self.dx * (self.height_span / self.dx)
         if not count <= 2**31 - 1:
-            limit = self.memory_limit()
+            limit, smallest = self.memory_limit(), self.dx_for_particles(2**31 - 1)
+            if limit is None:
+                need(False, f"dx = {self.dx} m gives {count:.3g} particles: more than the 2^31-1 supported; "
+                            f"the smallest dx that fits is about {smallest:.3g} m")
             need(False, f"dx = {self.dx} m gives {count:.3g} particles: more than the 2^31-1 supported and the "
                         f"memory available ({limit / 2**30:.3g} GiB); the smallest dx that fits is about "
-                        f"{max(self.smallest_dx_fitting(limit), self.dx_for_particles(2**31 - 1)):.3g} m")
+                        f"{max(self.smallest_dx_fitting(limit), smallest):.3g} m")
         need(self.rho0 > 0, f"rho0 must be > 0 kg/m^3 (got {self.rho0})")
         need(self.c0 > 0, f"c0 must be > 0 m/s (got {self.c0})")
         need(0 < self.mach < 1, f"mach must be in (0, 1) (got {self.mach})")
@@ -215,11 +156,12 @@ class Scene:
              f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
              f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)")
         need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
-        limit = self.memory_limit()
-        need(self.memory_bytes() <= limit,
-             f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
-             f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
-             f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m")
+        limit = self.memory_limit()  # None: the scene states no limit (the harness gives it one)
+        if limit is not None:
+            need(self.memory_bytes() <= limit,
+                 f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
+                 f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
+                 f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m")
 
     # ------------------------------------------------------------ geometry
     @property
@@ -286,9 +228,11 @@ class Scene:
         return self.n_steps * self.dt
 
     # ------------------------------------------------------------ memory
-    def memory_limit(self) -> int:
-        """Memory a run of this scene may use, bytes: ``memory_limit_bytes``, else what is available now."""
-        return self.memory_limit_bytes if self.memory_limit_bytes is not None else available_memory_bytes()
+    def memory_limit(self) -> int | None:
+        """Memory a run of this scene may use, bytes: ``memory_limit_bytes``; None where the scene states
+        no limit (a scene never reads the machine: the harness, pcabench.memory.bounded, sets the limit
+        to what is available before any work)."""
+        return self.memory_limit_bytes
 
     def memory_bytes(self) -> int:
         """Upper bound of the memory the particle arrays need, bytes (a pair list, where used, comes on top)."""

@@ -90,3 +90,41 @@ def test_scene_states_particles_and_memory_before_allocating():
 
 def test_paper_particle_counts():
     assert [Scene(dx=d).n_particles for d in (1, 0.1, 0.05, 0.01)] == [1000, 100_000, 400_000, 10_000_000]
+
+
+def test_exit_codes_are_distinct_and_listed_in_the_help(tmp_path, capsys):
+    from pcabench import cli
+
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    codes = {}
+    code, _, err = cli_main("report", "--results", str(empty), "--out", str(tmp_path / "out"), capsys=capsys)
+    assert len(err.strip().splitlines()) == 1 and "no results" in err and "Traceback" not in err, err
+    codes["no results"] = code
+    code, _, err = cli_main("advise", "--error", "0.1", "--results", str(empty), capsys=capsys)
+    assert code == codes["no results"] and "no stored runs" in err and len(err.strip().splitlines()) == 1
+    codes["bad input"] = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "0", capsys=capsys)[0]
+    codes["ok"] = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "2", "--quiet",
+                           capsys=capsys)[0]
+    codes["run failed"] = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
+                                   "--model", "linear", "--quiet", capsys=capsys)[0]
+    assert codes == {"no results": cli.EXIT_NO_RESULTS, "bad input": 2, "ok": 0, "run failed": 1}
+    assert len(set(codes.values()) | {cli.EXIT_UNAVAILABLE}) == 5  # one meaning per code
+    assert not (tmp_path / "out").exists()  # refused before writing anything
+    help_text = cli.build_parser().format_help()
+    for code in codes.values():
+        assert f"\n  {code} " in help_text, help_text
+    assert "no results" in help_text and "the run failed" in help_text
+
+
+def test_library_code_never_raises_system_exit():
+    import pathlib
+    import re
+
+    root = pathlib.Path(__file__).resolve().parents[1]
+    for package in ("pcabench", "solvers"):
+        for path in (root / package).rglob("*.py"):
+            if path.name in ("cli.py", "__main__.py"):
+                continue
+            text = path.read_text()
+            assert not re.search(r"raise SystemExit|except[^\n]*SystemExit", text), path

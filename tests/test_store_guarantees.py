@@ -13,13 +13,12 @@ import warnings
 
 import pytest
 
-from pcabench import cli, store, sweep as sweep_module
+from pcabench import cli, memory, store, sweep as sweep_module
 from pcabench.profiles import machine_id
 from pcabench.record import RunRecord
 from pcabench.spec import RunSpec
 from pcabench.sweep import exit_status, sweep
 from solvers import Scene, SceneError
-from solvers import scene as scene_module
 
 
 def record(dx=1.0, status="ok", **kw):
@@ -210,18 +209,18 @@ def fake_cgroups(tmp_path, monkeypatch, proc_cgroup: str, files: dict) -> None:
     for rel, text in files.items():
         (tmp_path / "cg" / rel).parent.mkdir(parents=True, exist_ok=True)
         (tmp_path / "cg" / rel).write_text(text)
-    monkeypatch.setattr(scene_module, "CGROUP_MOUNT", str(tmp_path / "cg"))
-    monkeypatch.setattr(scene_module, "PROC_CGROUP", str(tmp_path / "proc_cgroup"))
+    monkeypatch.setattr(memory, "CGROUP_MOUNT", str(tmp_path / "cg"))
+    monkeypatch.setattr(memory, "PROC_CGROUP", str(tmp_path / "proc_cgroup"))
 
 
 def test_the_memory_check_uses_the_cgroup_limit(tmp_path, monkeypatch):
     fake_cgroups(tmp_path, monkeypatch, "0::/\n", {"memory.max": f"{1 << 30}\n", "memory.current": f"{256 << 20}\n"})
     limit = tmp_path / "cg" / "memory.max"
-    assert scene_module.available_memory_bytes() == (1 << 30) - (256 << 20)
+    assert memory.available_memory_bytes() == (1 << 30) - (256 << 20)
     with pytest.raises(SceneError, match="smallest dx that fits"):
-        Scene(dx=0.01)  # 10M particles: about 2.4 GB of arrays, more than the 0.75 GiB left in the cgroup
+        memory.bounded(Scene(dx=0.01))  # 10M particles: about 2.4 GB of arrays, more than the 0.75 GiB left
     limit.write_text("max\n")
-    assert scene_module.available_memory_bytes() > (1 << 30)  # no limit: the host's available memory
+    assert memory.available_memory_bytes() > (1 << 30)  # no limit: the host's available memory
 
 
 @pytest.mark.parametrize("command,args,words", [
@@ -425,9 +424,9 @@ def test_the_memory_check_sees_a_nested_cgroup_v1_limit_and_its_oom_kills(tmp_pa
         "memory/jobs/small/memory.limit_in_bytes": f"{512 << 20}\n",
         "memory/jobs/small/memory.usage_in_bytes": f"{12 << 20}\n",
         "memory/jobs/small/memory.oom_control": "oom_kill_disable 0\nunder_oom 0\noom_kill 2\n"})
-    assert scene_module.available_memory_bytes() == 500 << 20
+    assert memory.available_memory_bytes() == 500 << 20
     with pytest.raises(SceneError, match="smallest dx that fits"):
-        Scene(dx=0.02)  # 2.5M particles, about 0.56 GiB of arrays: more than the 0.49 GiB left
+        memory.bounded(Scene(dx=0.02))  # 2.5M particles, about 0.56 GiB of arrays: more than the 0.49 GiB left
     assert sweep_module.oom_kills() == 2  # so a kill by the nested limit is out-of-memory, not error
 
 
@@ -435,14 +434,14 @@ def test_pair_loop_list_is_checked_against_the_memory_available(monkeypatch, cap
     from solvers.pairlist import list_bytes
 
     scene = Scene(dx=0.1, steps=2)
-    monkeypatch.setattr(scene_module, "available_memory_bytes",
+    monkeypatch.setattr(memory, "available_memory_bytes",
                         lambda: scene.memory_bytes() + list_bytes(scene) // 2)
     with pytest.raises(SystemExit) as exc:
         cli.main(["run", "--solver", "linkedlist-cpu", "--dx", "0.1", "--steps", "2", "--pair-loop", "list"])
     err = capsys.readouterr().err
     assert exc.value.code == 2 and "pair list" in err and "--pair-loop gather" in err, err
     assert len(err.strip().splitlines()) == 1
-    assert RunSpec("linkedlist-cpu", scene).resolved().pair_loop == "gather"  # auto falls back
+    assert cli.check_specs([RunSpec("linkedlist-cpu", scene)])[0].pair_loop == "gather"  # auto falls back
 
 
 # ---------------------------------------------------------------- one line, never a traceback

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from pcabench import profiles, store
+from pcabench.errors import NoResults
 from pcabench.presets import INACCURATE_ABOVE
 from solvers import Scene
 
@@ -454,7 +455,7 @@ def summary(results_dir: Path, profile: str) -> str:
 def write_reports(results_dir: Path, reports_dir: Path) -> list[Path]:
     df_all = store.load(results_dir)
     if df_all.empty:
-        raise SystemExit(f"no results in {results_dir}: run `pcabench study --quick` first")
+        raise NoResults(f"no results in {results_dir}: run `pcabench study --quick` first")
     reports_dir = Path(reports_dir)
     reports_dir.mkdir(parents=True, exist_ok=True)
     # a machine's name becomes a folder: checked (store.validate made it so) so that nothing lands outside

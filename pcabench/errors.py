@@ -1,0 +1,11 @@
+"""The harness's errors that end a command: raised by library code, mapped to exit codes in cli.py only.
+
+Bad input is :class:`~pcabench.spec.OptionError` (a harness option) or
+:class:`~solvers.scene.SceneError` (a scene or solver parameter); a store that
+cannot be read or written is :class:`~pcabench.store.StoreError`.
+"""
+from __future__ import annotations
+
+
+class NoResults(Exception):
+    """There are no stored runs to work from (an empty or missing results folder)."""
