@@ -59,7 +59,7 @@ class LinkedListGPU(CellListSolver):
         if self.cupy is None:
             return
         free, _total = self.cupy.cuda.runtime.memGetInfo()
-        need = scene.memory_bytes()
+        need = self.memory_bytes(scene)
         if need > free:
             raise SceneError(
                 f"dx = {scene.dx} m needs {scene.n_particles:,} particles and about {need / 2**30:.3g} GiB "
