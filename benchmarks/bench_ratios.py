@@ -47,7 +47,7 @@ class TrackSpeedRatios:
                              for key, (precision, model, threads, loop) in (("base", BASE),
                                                                           (against, CONFIGS[against]))}
         except Unsupported as exc:
-            raise NotImplementedError(str(exc))
+            raise NotImplementedError(str(exc)) from None
 
     def track_speedup(self, dx, against):
         best = best_alternating(self.prepared)

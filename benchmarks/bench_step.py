@@ -17,7 +17,7 @@ class TimeStep(StageBenchmarks):
         try:
             self.p = Prepared(solver, precision, dx)
         except Unsupported as exc:
-            raise NotImplementedError(str(exc))
+            raise NotImplementedError(str(exc)) from None
 
 
 class TimeStepThreads:

@@ -23,11 +23,21 @@ import tempfile
 import warnings
 from pathlib import Path
 
-from solvers import DEFAULT_SOLVER, INTEGRATORS, KERNELS, MODELS, PRECISIONS, Scene, SceneError, SolverUnavailable, registry
+from solvers import (
+    DEFAULT_SOLVER,
+    INTEGRATORS,
+    KERNELS,
+    MODELS,
+    PRECISIONS,
+    Scene,
+    SceneError,
+    SolverUnavailable,
+    registry,
+)
 
 from . import __version__, memory, paths
-from .progress import Progress
 from .errors import NoResults
+from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
 
@@ -484,7 +494,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="CFL x integrator x h/dx, run length and float32: the stability map")
     g.add_argument("--front", nargs="?", const="quick", choices=("quick", "full"),
                    help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
-                        "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the predicted fastest, serial (quick: 296 runs; full: 2408)")
+                        "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the "
+                        "predicted fastest, serial (quick: 296 runs; full: 2408)")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
     m.add_argument("--solver", nargs="+", choices=registry())
     add_scene_options(m, many=True)
@@ -519,7 +530,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--commit", help="a commit prefix")
     p.add_argument("--model")
     p.add_argument("--compare", nargs=2, metavar=("A", "B"),
-                   help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, ratio, errors")
+                   help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, "
+                        "ratio, errors")
     p.add_argument("--limit", type=positive_int("--limit"), default=200, help="the newest rows to print at most")
     p.set_defaults(func=cmd_runs)
 

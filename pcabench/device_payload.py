@@ -263,7 +263,8 @@ def device_command(commit: str, budget_s: float = 450.0) -> str:
     return (f"set -o pipefail; {install} || echo 'gpu-check: the wheels did not install: no asv'; {path}; "
             f"export PCABENCH_HOME=/tmp/pcabench PCABENCH_COMMIT={commit} PYTHONUNBUFFERED=1; "
             "nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,memory.total --format=csv; "
-            f"python3 -m pcabench.cli gpu-check --out /tmp/check --budget {budget_s:.0f} 2>&1 | tee $OUT/gpu_check.log; "
+            f"python3 -m pcabench.cli gpu-check --out /tmp/check --budget {budget_s:.0f} "
+            "2>&1 | tee $OUT/gpu_check.log; "
             "rc=$?; cp /tmp/check/gpu_check.tar.gz /tmp/check/gpu_check.md $OUT/; exit $rc")
 
 

@@ -10,8 +10,8 @@ import math
 
 from solvers import SceneError, make_solver
 from solvers.analytic import errors as analytic_errors
-from solvers.isothermal1d import isothermal_errors
 from solvers.integrators import step_program
+from solvers.isothermal1d import isothermal_errors
 
 from .clock import clock_for
 from .memory import is_out_of_memory

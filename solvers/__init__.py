@@ -8,10 +8,18 @@ from __future__ import annotations
 
 from .interface import STAGES, Fields, Solver, SolverUnavailable
 from .kernel import KERNELS
-from .registry import (DEFAULT_SOLVER, ENTRY_POINT_GROUP, check_pair_loop, make_solver, registry, resolve_pair_loop, solver_class,
-                       solver_names)
+from .registry import (
+                       DEFAULT_SOLVER,
+                       ENTRY_POINT_GROUP,
+                       check_pair_loop,
+                       make_solver,
+                       registry,
+                       resolve_pair_loop,
+                       solver_class,
+                       solver_names,
+)
 from .scene import INTEGRATORS, MODELS, NUMERICS, PRECISIONS, Scene, SceneError
 
 __all__ = ["Scene", "SceneError", "Solver", "SolverUnavailable", "Fields", "STAGES", "MODELS", "INTEGRATORS",
-           "PRECISIONS", "KERNELS", "NUMERICS", "DEFAULT_SOLVER", "ENTRY_POINT_GROUP", "registry", "solver_names", "solver_class",
-           "check_pair_loop", "make_solver", "resolve_pair_loop"]
+           "PRECISIONS", "KERNELS", "NUMERICS", "DEFAULT_SOLVER", "ENTRY_POINT_GROUP", "registry", "solver_names",
+           "solver_class", "check_pair_loop", "make_solver", "resolve_pair_loop"]

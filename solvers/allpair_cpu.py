@@ -14,6 +14,7 @@ import numba
 from .backend import cpu_pairs, cpu_updates
 from .interface import Solver, tiny_scene
 
+
 @lru_cache(maxsize=None)
 def sweeps(precision: str, kernel: str) -> dict:
     """The all-pair interaction loops for ``precision`` and ``kernel`` (serial, as in the paper)."""

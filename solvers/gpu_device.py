@@ -36,8 +36,8 @@ def device_backend():
         import cupy
     except ImportError as exc:
         raise SolverUnavailable(
-            "linkedlist-gpu needs CuPy and a CUDA GPU: pip install -e \".[gpu-cuda13]\" (or .[gpu] for CUDA 12) on a machine "
-            "with an NVIDIA GPU (or set NUMBA_ENABLE_CUDASIM=1 to run its kernels in the simulator)"
+            "linkedlist-gpu needs CuPy and a CUDA GPU: pip install -e \".[gpu-cuda13]\" (or .[gpu] for CUDA 12) on a "
+            "machine with an NVIDIA GPU (or set NUMBA_ENABLE_CUDASIM=1 to run its kernels in the simulator)"
         ) from exc
     try:
         if cupy.cuda.runtime.getDeviceCount() < 1 or not cuda.is_available():

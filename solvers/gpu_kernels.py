@@ -12,8 +12,8 @@ from functools import lru_cache
 
 from numba import cuda, int32
 
-from .kernel import exp_neg_math
 from .gpu_device import device_backend, simulated
+from .kernel import exp_neg_math
 from .pairs import make_pairs
 
 SCAN_ITEMS = 4  # cells per thread in one pass of the cellBegin scan

@@ -31,7 +31,6 @@ from .celllist import CellListSolver
 from .scene import SceneError
 
 
-
 def _counting_sort(cell, ncells, begin, order, sorted_cell):
     """cellBegin and cellParticleOrder by a stable counting sort of ``cell``."""
     begin[:] = 0

@@ -118,7 +118,7 @@ class LinkedListGPU(CellListSolver):
         self.launch("cell_count", a["lx"], a["ly"], a["sx"], a["sy"], self.cell, self.rank, self.counts, s.dx,
                     -self.cw, s.height, self.cw, self.ch, self.ncx, self.ncy)
         self.launch("cell_begin", self.counts, self.begin, grid=(1, scan_block()))
-        (src, cell), (dst, cell_out) = self.blocks_of[self.current], self.blocks_of[1 - self.current]
+        (src, _), (dst, cell_out) = self.blocks_of[self.current], self.blocks_of[1 - self.current]
         self.launch("scatter", self.cell, self.rank, self.begin, src, dst, cell_out, self.order)
         self.set_state(1 - self.current)
         for name, arr in self.saved.items():  # two-stage integrators' copies (not in a Verlet step)

@@ -40,9 +40,9 @@ from functools import lru_cache
 import numba
 import numpy as np
 
+from .backend import cpu_pairs
 from .compress import PAD, compress_within
 from .denormals import flush_off, flush_on
-from .backend import cpu_pairs
 from .kernel import NONLIN, NY, RC2, RHO0, SPACING
 
 INDEX_BYTES = 4  # uint32 neighbour index per pair

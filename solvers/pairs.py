@@ -4,8 +4,8 @@
 (``numba.njit(inline="always")`` for the CPU solvers,
 ``numba.cuda.jit(device=True)`` for the GPU solver and its simulator), that
 backend's exp(-x) and one kernel's G (solvers/kernel.py, chosen at compile
-time), so that every solver evaluates exactly the same expressions. The functions call each other as closure variables: numba
-compiles them as constants of the caller.
+time), so that every solver evaluates exactly the same expressions. The functions call each other as
+closure variables: numba compiles them as constants of the caller.
 
 Positions are lattice coordinates (lx, ly: whole numbers held in the solver's
 float type) plus a displacement (sx, sy, m): r_ij = (lx_i - lx_j) dx +

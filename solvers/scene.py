@@ -121,7 +121,8 @@ class Scene:
         need(self.pulse_width > 0, f"pulse_width must be > 0 m (got {self.pulse_width})")
         need(0.5 <= self.h_factor <= 10, f"h_factor (h/dx) must be in [0.5, 10] (got {self.h_factor})")
         need(self.cutoff_factor >= 1.0,
-             f"cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core (got {self.cutoff_factor})")
+             "cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core "
+             f"(got {self.cutoff_factor})")
         need(self.cutoff_factor <= 5.0,
              f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7")
         need(self.kernel in KERNELS, f"kernel must be one of {', '.join(KERNELS)} (got {self.kernel!r})")

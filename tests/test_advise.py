@@ -7,8 +7,8 @@ import pytest
 
 from pcabench import store
 from pcabench.advise import advise
-from pcabench.sweep import failed_record
 from pcabench.spec import RunSpec
+from pcabench.sweep import failed_record
 from solvers import Scene
 
 from .conftest import cli_main

@@ -5,8 +5,7 @@ import numba
 import numpy as np
 import pytest
 
-from solvers import Scene, make_solver, resolve_pair_loop
-from solvers import compress, denormals, pairlist
+from solvers import Scene, compress, denormals, make_solver, pairlist, resolve_pair_loop
 from solvers.integrators import step_program
 
 from .conftest import strip_for

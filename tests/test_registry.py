@@ -70,7 +70,8 @@ def test_the_builtin_solvers_are_found_and_state_what_they_can_do():
 
 
 def test_finding_the_solvers_touches_no_gpu_library():
-    code = "import sys, solvers; solvers.registry(); print(any(m.startswith(('cupy', 'numba.cuda')) for m in sys.modules))"
+    code = ("import sys, solvers; solvers.registry(); "
+            "print(any(m.startswith(('cupy', 'numba.cuda')) for m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert out.stdout.strip() == "False"
 

@@ -13,7 +13,8 @@ import warnings
 
 import pytest
 
-from pcabench import cli, memory, store, sweep as sweep_module
+from pcabench import cli, memory, store
+from pcabench import sweep as sweep_module
 from pcabench.profiles import machine_id
 from pcabench.record import RunRecord
 from pcabench.spec import RunSpec
