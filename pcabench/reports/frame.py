@@ -4,7 +4,8 @@ The store loads records (:func:`pcabench.store.read_rows`); what a report
 derives from them lives here: stage times as ``t_<stage>`` (s), the scene's
 parameters as columns (at their defaults where a row predates them), the run's
 protocol (``protocol``: steps or a physical time; ``domain``: full or strip),
-the machine (a profile, and its host where several share it), ``t_step`` (s
+what ran (``device``; ``search``: linked list or all-pair; ``loop``: the pair
+loop), the machine (a profile, and its host where several share it), ``t_step`` (s
 per step) and ``t_solution`` (init + steps, s, no JIT or I/O).
 """
 from __future__ import annotations
@@ -43,6 +44,13 @@ def _flat(row: dict) -> dict:
     r.setdefault("preset", "")
     r.setdefault("pair_loop", "")  # rows from before the pair list: the gather loop
     r["threads"] = int(r.get("threads") or 1)
+    # what ran: the device, the neighbour search and the pair loop (a record that does not state its
+    # device or loop: its solver's name says the device; the linked list's loop before the pair list,
+    # and the GPU's, was the paper's gather loop)
+    solver = str(row.get("solver", ""))
+    r["device"] = row.get("device") or ("gpu" if solver.endswith("-gpu") else "cpu")
+    r["search"] = "all-pair" if r["pair_loop"] == "all-pairs" or solver.startswith("allpair") else "linked list"
+    r["loop"] = r["pair_loop"] or ("all pairs" if r["search"] == "all-pair" else "gather")
     return r
 
 
