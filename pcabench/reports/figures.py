@@ -111,10 +111,13 @@ def plain_log_ticks(ax, values, axis="x", spread=1.8):
 
 
 def nice_log_ticks(ax, values, axis="y"):
-    """Ticks 1, 2, 5 x 10^k covering ``values``, written plainly (20, 50, 100; never 2x10^1)."""
+    """Ticks 1, 2, 5 x 10^k (1 x 10^k over more than a decade and a half) covering ``values``, written
+    plainly (20, 50, 0.001; never 2x10^1), no minor labels."""
+    values = [v for v in values if v and np.isfinite(v) and v > 0]
     lo, hi = min(values), max(values)
+    mantissas = (1, 2, 5) if hi / lo < 30 else (1,)
     ticks = [m * 10.0 ** k for k in range(int(np.floor(np.log10(lo))) - 1, int(np.ceil(np.log10(hi))) + 1)
-             for m in (1, 2, 5)]
+             for m in mantissas]
     inside = [t for t in ticks if lo / 1.5 <= t <= hi * 1.5]
     plain_log_ticks(ax, inside or [lo, hi], axis=axis, spread=1.5)
     (ax.xaxis if axis == "x" else ax.yaxis).set_minor_locator(NullLocator())
@@ -160,6 +163,8 @@ def fig8(series, out: Path, pid: str):
                     ax.text(0.02, 0.02, f"paper (published): {mse_paper:g} at dx = {dx_paper:g}, off this axis",
                             transform=ax.transAxes, fontsize=7, color="0.35")
             plain_log_ticks(ax, dxs)
+            nice_log_ticks(ax, [e for s in series if s["protocol"] == protocol for e in s["mse"]]
+                           + ([mse_paper] if dx_paper in dxs else []))
             ax.set_title(protocol + (" (fixed physical time)" if protocol.startswith("t =")
                                      else " (the paper's protocol)"), fontsize=9)
     return path

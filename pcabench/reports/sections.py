@@ -113,10 +113,17 @@ def _table5_text(rows, ctx) -> list[str]:
     if not rows:
         return []
     allpair = any(r["search"] == "all-pair" for r in rows)
+    beside = []
+    if any(r["device"] == "gpu" for r in rows):
+        beside.append("beside a serial float64 GPU row its Table 5 (Tesla K20c, same N)")
+    if any(r["device"] == "cpu" and r["search"] == "linked list" for r in rows):
+        shares = P.cpu_shares()
+        beside.append(f"beside a serial float64 linked-list CPU row its Fig. 11 text (serial "
+                      f"{P.processor('paper-system-1', 'cpu')}, about {shares['snp']:g} % SNP and {shares['pi']:g} % "
+                      "PI at every N)")
     return ["## Table 5 and Fig. 11: share of a step", "",
-            "The paper's column compares like with like: beside a serial float64 GPU row its Table 5 (Tesla K20c, "
-            "same N), beside a serial float64 linked-list CPU row its Fig. 11 text (serial Xeon E5-2680, about "
-            "43 % SNP and 53 % PI at every N); '-' elsewhere."
+            f"The paper's column compares like with like: {', '.join(beside) or 'none of its shares is of these kinds'}"
+            "; '-' elsewhere."
             + (" An all-pair row has no neighbour search to time: it visits every pair of particles inside PI, "
                "so its SNP share is 0 % and the paper, whose shares are the linked list's, has none beside it."
                if allpair else ""), "",
@@ -132,11 +139,17 @@ def _table5_text(rows, ctx) -> list[str]:
 def _fig10_text(rows, ctx) -> list[str]:
     if not rows:
         return []
+    kinds = {(r["device"], r["search"]) for r in rows if r["precision"] == "float64"}
+    paper = []
+    if ("cpu", "linked list") in kinds:
+        paper.append(f"its serial CPU from Table 6 ({P.CONVERSION['Table 6']}) and the 400K step of its text, "
+                     "two series never joined (they come from different runs and do not lie on one line)")
+    if ("gpu", "linked list") in kinds:
+        paper.append("its K20c from Table 4 (one step)")
     return ["## Fig. 10: one step against N", "",
-            "One line per configuration and protocol. The paper's step times are "
-            "drawn beside our lines of the same kind only, one series per source, never joined: its serial CPU "
-            f"from Table 6 ({P.CONVERSION['Table 6']}) and the 400K step of its text (they come from different "
-            "runs and do not lie on one line), its K20c from Table 4 (one step).", ""]
+            "A panel per run length, a line per configuration (pair loop and threads in its label). "
+            + (f"The paper's step times are drawn beside our lines of the same kind only: {'; '.join(paper)}."
+               if paper else "The paper has no step times of these kinds."), ""]
 
 
 # ---------------------------------------------------------------- speed per particle-step and per pair
