@@ -38,7 +38,6 @@ import sys
 import warnings
 from pathlib import Path
 
-
 from solvers import Scene, SceneError
 from solvers.scene import MAX_STEPS
 
