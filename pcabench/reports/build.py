@@ -85,7 +85,7 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
                   "given here as printed and read as s):", "",
               md_table(["system", "card", "N", "CPU runtime (printed min, read as s)",
                         "GPU runtime (printed min, read as s)", "speedup per step"],
-                       [[r["system"], r["card"], f"{r['N']:,}", f"{r['cpu']:g}", f"{r['gpu']:g}", f"{r['speedup']:g}"]
+                       [[r["system"], r["card"], f"{r['N']:,}", str(r["cpu"]), str(r["gpu"]), str(r["speedup"])]
                         for r in P.table6()]), ""]
     lines += ["## GPU cards: one lagrangian step (SNP + PI + SU)", ""]
     if cards:

@@ -20,7 +20,7 @@ def pct(x) -> str:
     return fmt(None if x is None else 100 * x, ".2f") + (" %" if x is not None and np.isfinite(x) else "")
 
 
-def first_words(message: str, limit: int = 120) -> str:
+def first_words(message: str, limit: int = 200) -> str:
     """The message's first line, cut at a word boundary with an ellipsis if longer than ``limit``."""
     line = message.splitlines()[0] if message else ""
     return line if len(line) <= limit else line[:limit].rsplit(" ", 1)[0] + " ..."

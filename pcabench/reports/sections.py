@@ -211,7 +211,7 @@ def _fig9_text(rows, ctx) -> list[str]:
             md_table(["steps", "N", "all-pair ms/step", "linked list ms/step", "eta = t_AP / t_LL",
                       "all-pair status"],
                      [[r["steps"], f"{r['N']:,}", fmt(r["allpair_ms"], ".2f"), fmt(r["linkedlist_ms"], ".2f"),
-                       fmt(r["eta"], ".1f"), r["allpair_status"] + (f": {first_words(r['allpair_note'], 200)}"
+                       fmt(r["eta"], ".1f"), r["allpair_status"] + (f": {first_words(r['allpair_note'])}"
                                                                     if r["allpair_note"] else "")] for r in rows]),
             "",
             f"Paper (published, whole runs to the 10th step, drawn as {P.CONVERSION['Fig. 9 text']}): "
