@@ -111,11 +111,11 @@ def plain_log_ticks(ax, values, axis="x", spread=1.8):
 
 
 def nice_log_ticks(ax, values, axis="y"):
-    """Ticks 1, 2, 5 x 10^k (1 x 10^k over more than a decade and a half) covering ``values``, written
+    """Ticks 1, 2, 5 x 10^k (1 x 10^k over two decades or more) covering ``values``, written
     plainly (20, 50, 0.001; never 2x10^1), no minor labels."""
     values = [v for v in values if v and np.isfinite(v) and v > 0]
     lo, hi = min(values), max(values)
-    mantissas = (1, 2, 5) if hi / lo < 30 else (1,)
+    mantissas = (1, 2, 5) if hi / lo < 100 else (1,)
     ticks = [m * 10.0 ** k for k in range(int(np.floor(np.log10(lo))) - 1, int(np.ceil(np.log10(hi))) + 1)
              for m in mantissas]
     inside = [t for t in ticks if lo / 1.5 <= t <= hi * 1.5]
@@ -401,8 +401,9 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
             ax.plot([p["seconds"] for p in fp], [T.predicted_error(p) for p in fp], ls="none", marker="x", ms=6,
                     color="crimson", label="front runs, predicted (dispersion relation, linear part)")
             ax.set_title(f"{model}, t = {t_final:g} s ({len(here)} runs)", fontsize=9)
-            for axis in (ax.xaxis, ax.yaxis):  # a narrow log range labels its minor ticks too, and they collide
-                axis.set_minor_formatter(NullFormatter())
+            # plain ticks: a narrow log range would label its minor ticks too, and they collide
+            nice_log_ticks(ax, [p["seconds"] for p in here], axis="x")
+            nice_log_ticks(ax, [p["error"] for p in here] + [T.predicted_error(p) for p in fp], axis="y")
     return path
 
 

@@ -50,7 +50,7 @@ def _flat(row: dict) -> dict:
     solver = str(row.get("solver", ""))
     r["device"] = row.get("device") or ("gpu" if solver.endswith("-gpu") else "cpu")
     r["search"] = "all-pair" if r["pair_loop"] == "all-pairs" or solver.startswith("allpair") else "linked list"
-    r["loop"] = r["pair_loop"] or ("all pairs" if r["search"] == "all-pair" else "gather")
+    r["loop"] = r["pair_loop"] or ("all-pairs" if r["search"] == "all-pair" else "gather")
     return r
 
 
