@@ -53,7 +53,8 @@ def quick_records() -> list[RunRecord]:
             pair_loop=spec.pair_loop, steps_requested=s.n_steps, scene=s.as_dict(),
             mse_isothermal=mse / 2 if s.model == "lagrangian" else None,
             message="predicted 999 s > run budget 120 s" if status == "skipped" else "", profile_id=PROFILE,
-            commit="abc1234", preset="quick", host="host1", timestamp=f"2026-01-01T00:{i // 60:02d}:{i % 60:02d}+00:00"))
+            commit="abc1234", preset="quick", host="host1",
+            timestamp=f"2026-01-01T00:{i // 60:02d}:{i % 60:02d}+00:00"))
     return out
 
 

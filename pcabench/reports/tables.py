@@ -110,7 +110,8 @@ def table5(rows4) -> list[dict]:
             elif row["device"] == "cpu" and row["search"] == "linked list":
                 paper = ("Xeon, Fig. 11 text", [cpu[s] for s in STEP_STAGES])
         rows.append({"config": row["config"], "protocol": row["protocol"], "run": row["run"], "N": row["N"],
-                     "device": row["device"], "search": row["search"], **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": paper})
+                     "device": row["device"], "search": row["search"],
+                     **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": paper})
     return rows
 
 
