@@ -33,10 +33,11 @@ def label(r) -> str:
 
 
 def protocol(r) -> str:
-    """How a run was timed: its length (steps or t), domain, pair loop and threads, e.g.
+    """How a run was timed: its length (steps or t), domain, pair loop and CPU threads (or GPU), e.g.
     ``20 steps, full, gather, 1 thread``."""
     threads = int(r["threads"])
-    return f"{r['protocol']}, {r['domain']}, {r['loop']}, {threads} thread{'s' if threads > 1 else ''}"
+    where = "GPU" if r["device"] == "gpu" else f"{threads} thread{'s' if threads > 1 else ''}"
+    return f"{r['protocol']}, {r['domain']}, {r['loop']}, {where}"
 
 
 def latest(df: pd.DataFrame) -> pd.DataFrame:
