@@ -25,6 +25,7 @@ STABILITY_H = (1.0, 1.3)  # h/dx beside Scene's default
 # Above this relative RMS error a run that stayed bounded is classed inaccurate: twice the
 # error of Verlet at CFL 0.2 on the stability scene (10 % at dx = 0.25, t = 10 s).
 INACCURATE_ABOVE = 0.20
+QUICK_CFL = (0.2, 2.0, 5.0, 7.0)  # the quick study's stability map: stable, stable, near the limit, past it
 
 
 def _spec(solver=DEFAULT_SOLVER, threads=SERIAL, strip=False, pair_loop="auto", **scene) -> RunSpec:
@@ -54,6 +55,8 @@ def quick() -> list[RunSpec]:
         runs.append(_spec(dx=dx, t_end=10.0, model="linear", precision="float32", strip=True))
     runs.append(_spec(dx=0.2, t_end=10.0, model="linear"))
     runs.append(_spec(dx=0.2, t_end=10.0, model="lagrangian"))
+    # The stability map: Verlet on the stability scene at a few CFLs, up to past its limit
+    runs += [_spec(dx=STABILITY_DX, t_end=10.0, model="linear", strip=True, cfl=cfl) for cfl in QUICK_CFL]
     return runs
 
 

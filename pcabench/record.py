@@ -37,6 +37,7 @@ class RunRecord:
     failed_step: int | None
     threads: int = 1
     pair_loop: str = ""  # how the solver visited pairs: list, gather (the paper's) or all-pairs
+    device: str = ""  # where the solver's pair loops ran (its class's ``device``: cpu or gpu); "" in older rows
     steps_requested: int = 0
     mse_isothermal: float | None = None  # lagrangian only: relative RMS error of u against the isothermal solution
     scene: dict = field(default_factory=dict)
@@ -56,10 +57,13 @@ class RunRecord:
     def from_spec(cls, spec, machine: str = "", status: str = "error", message: str = "") -> "RunRecord":
         """The record of the resolved RunSpec ``spec`` on machine ``machine`` before any step: no times, no
         errors, provenance filled."""
+        from solvers import solver_class
+
         from .provenance import git_commit, host_id, package_versions
 
         nan, scene = float("nan"), spec.scene
-        return cls(solver=spec.solver, precision=scene.precision, model=scene.model, integrator=scene.integrator,
+        return cls(solver=spec.solver, device=solver_class(spec.solver).device, precision=scene.precision,
+                   model=scene.model, integrator=scene.integrator,
                    dx=scene.dx, n_particles=scene.n_particles, steps=0, t_end=0.0,
                    stages={s: 0.0 for s in STAGES}, jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan,
                    status=status, failed_step=None, threads=int(spec.threads), pair_loop=spec.pair_loop,

@@ -38,8 +38,6 @@ import sys
 import warnings
 from pathlib import Path
 
-import numpy as np
-
 from solvers import Scene, SceneError
 from solvers.scene import MAX_STEPS
 
@@ -398,45 +396,8 @@ def read_rows(paths) -> list[dict]:
 
 
 def load(paths):
-    """The stores ``paths`` as one tidy pandas DataFrame (stage times as columns t_<stage>)."""
-    import pandas as pd
+    """The stores ``paths`` as the reports' DataFrame: kept for callers of the store; the columns are
+    derived in :mod:`pcabench.reports.frame`, which is where to load them from."""
+    from .reports.frame import load as load_frame
 
-    from .spec import stored_parameters
-
-    rows = read_rows(paths)
-    flat = []
-    for row in rows:
-        r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions")}
-        for stage, seconds in (row.get("stages") or {}).items():
-            r[f"t_{stage}"] = seconds
-        scene = row.get("scene") or {}
-        scene = {**stored_parameters(scene), **scene}  # a parameter the row predates at its default (kernel)
-        for key in ("strip_height", "cutoff_factor", "kernel", "h_factor", "cfl", "t_final", "height"):
-            r[key] = scene.get(key)
-        r["kernel"] = scene.get("kernel") or "gaussian"  # rows from before the kernel option: the Gaussian
-        # how the run ends: the paper's fixed step count, or a fixed physical time
-        r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
-        r["domain"] = "strip" if scene.get("strip_height") else "full"
-        r["scene_key"] = json.dumps({k: v for k, v in scene.items() if k != "memory_limit_bytes"},
-                                    sort_keys=True)
-        r.setdefault("preset", "")
-        r.setdefault("pair_loop", "")  # rows from before the pair list: the gather loop
-        r["threads"] = int(r.get("threads") or 1)
-        flat.append(r)
-    df = pd.DataFrame(flat)
-    if not df.empty:
-        if "mse_isothermal" not in df:
-            df["mse_isothermal"] = np.nan  # rows from before it was measured
-        for col in ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal"):  # null -> NaN
-            if col in df:
-                df[col] = pd.to_numeric(df[col], errors="coerce")
-        if "host" not in df:
-            df["host"] = ""
-        df["host"] = df["host"].fillna("")
-        # one machine: a hardware profile, and its host where several hosts share the profile
-        hosts = df.groupby("profile_id")["host"].transform("nunique")
-        df["machine"] = np.where(hosts > 1, df["profile_id"] + "--" + df["host"], df["profile_id"])
-        step_total = sum(df[f"t_{s}"] for s in STEP_STAGES)
-        df["t_step"] = step_total / df["steps"].clip(lower=1)
-        df["t_solution"] = df["t_init"] + step_total  # s, without JIT and I/O
-    return df
+    return load_frame(paths)

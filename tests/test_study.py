@@ -12,8 +12,8 @@ import pytest
 
 from pcabench import store
 from pcabench.record import RunRecord
+from pcabench.reports import frame, write_reports
 from pcabench.reports import tables as T
-from pcabench.reports import write_reports
 from solvers import Scene
 
 SWEEP = ["--dx", "1", "0.5", "--solver", "linkedlist-cpu", "allpair-cpu", "--steps", "3", "--no-report"]
@@ -70,7 +70,7 @@ def test_bad_study_input_exits_2_before_any_run(tmp_path, args, words):
 def row(profile="machine-a", solver="linkedlist-cpu", threads=1, step_ms=(1.0, 4.0, 0.1), steps=10, mse=0.01,
         status="ok", failed_step=None, preset="", stamp=0, message="", **scene):
     """A stored run with chosen stage times (SNP, PI, SU in ms per step) and error."""
-    s = Scene(**scene)
+    s = Scene(**scene) if "t_end" in scene else Scene(steps=steps, **scene)
     stages = {"input": 0.001, "init": 0.002, "output": 0.003,
               **{k: v * steps / 1e3 for k, v in zip(("snp", "pi", "su"), step_ms)}}
     rec = RunRecord(solver=solver, precision=s.precision, model=s.model, integrator=s.integrator, dx=s.dx,
@@ -122,27 +122,30 @@ def results(tmp_path):
 
 
 def test_tables_from_a_fixed_results_file(results):
-    df = store.load(results)
+    df = frame.load(results)
     a = df[df.profile_id == "machine-a"]
-    t4 = {(r["config"], r["N"]): r for r in T.table4(a)}
-    assert t4[("linkedlist-cpu float64", 4000)]["pi"] == pytest.approx(16.0)
-    assert t4[("linkedlist-cpu float64", 1000)]["init"] == pytest.approx(2.0)
-    t5 = {(r["config"], r["N"]): r for r in T.table5(a)}
-    assert t5[("linkedlist-cpu float64 x2", 1000)]["snp"] == pytest.approx(100 * 0.5 / 2.55)
+    rows4 = T.table4(a)
+    t4 = {(r["config"], r["threads"], r["N"]): r for r in rows4}
+    assert t4[("linkedlist-cpu float64", 1, 4000)]["pi"] == pytest.approx(16.0)
+    assert t4[("linkedlist-cpu float64", 1, 1000)]["init"] == pytest.approx(2.0)
+    assert t4[("linkedlist-cpu float64", 1, 1000)]["protocol"] == "10 steps, full, gather, 1 thread"
+    t5 = {(r["config"], r["protocol"], r["N"]): r for r in T.table5(rows4)}
+    assert t5[("linkedlist-cpu float64", "10 steps, full, gather, 2 threads", 1000)]["snp"] == \
+        pytest.approx(100 * 0.5 / 2.55)
     six = {(r["gpu_profile"], r["N"], r["precision"]): r for r in T.table6(df)}
     assert six[("machine-a", 4000, "float32")]["speedup"] == pytest.approx(4 * 5.1 / 0.11)
     assert six[("machine-a", 4000, "float32")]["speedup_all_cores"] == pytest.approx(4 * 2.55 / 0.11)
     # machine-b has no CPU runs: its row names machine-a's CPU
     assert six[("machine-b", 1000, "float64")]["cpu_profile"] == "machine-a"
     assert six[("machine-b", 1000, "float64")]["speedup"] == pytest.approx(5.1 / 0.055)
-    fig9 = {r["N"]: r for r in T.fig9(a)}
+    fig9 = {r["N"]: r for r in T.fig9(a) if r["steps"] == 10}
     assert fig9[4000]["eta"] == pytest.approx((320 + 16 + 0.4) / (4 * 5.1))
     assert fig9[16000]["allpair_status"] == "skipped" and "predicted" in fig9[16000]["allpair_note"]
 
     series = {(s["model"], s["precision"], s["domain"]): s for s in T.error_series(a)}
     assert series[("linear", "float64", "strip")]["order"] == pytest.approx(2.0)
     assert series[("lagrangian", "float64", "strip")]["stops_falling"] == pytest.approx(0.2)
-    assert {b["verdict"] for b in T.accuracy_bars(a)} == {"met"}
+    assert {b["verdict"] for b in T.accuracy_bars(T.error_series(a))} == {"met"}
 
     points, limits = T.stability(a, inaccurate_above=0.15)
     lim = {x["config"].split(",")[0]: x for x in limits}
@@ -176,7 +179,8 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
         assert image.shape[0] > 100 and image.shape[1] > 100 and image.std() > 0, name
     a = (out / "machine-a" / "report.md").read_text()
     for words in ("Table 4", "Table 5", "Table 6", "Fig. 9", "Fig. 8", "fitted order 2.00", "stops falling at dx = 0.2",
-                  "Time to a given accuracy", "paper / fastest", "cost of each simplification", "accurate up to CFL", "bounded up to CFL", "skipped"):
+                  "Time to a given accuracy", "paper / fastest", "cost of each simplification", "accurate up to CFL",
+                  "bounded up to CFL", "skipped"):
         assert words in a, words
     cards = (out / "cards.md").read_text()
     assert "machine-b" in cards and "Tesla K20c" in cards and "Quadro M4000" in cards

@@ -1,12 +1,14 @@
-"""The report's PNG figures, drawn from the rows of ``tables.py``.
+"""The report's PNG figures, each drawn from the rows of its section (``tables.py``), never from the store.
 
 Each function draws one figure into ``out`` and returns its path, or None
-when the store holds no data for it. One variable per visual channel:
-colour for the solver configuration or card (never repeated within a figure),
-marker for precision, line style for measured (solid) against published
-(dashed, grey, hollow markers, "published" in the legend), facets for the
-protocol or the kind of run. Legends sit outside the data, and matplotlib's
-constrained layout keeps labels from overlapping.
+when the rows hold nothing for it. One variable per visual channel, and a title
+names a channel only where it varies (:func:`channels`): colour for the
+configuration or card, marker for precision, line style for the domain, facets
+for the protocol. The paper's numbers (:mod:`.paper`) are drawn in one style,
+grey, dashed, hollow markers, "published" in the legend, with the conversion
+they took, and only beside measured series of the same kind. Every label says
+the protocol of its series. Legends sit outside the data; constrained layout
+keeps labels from overlapping (tests/test_figures.py checks both).
 """
 from __future__ import annotations
 
@@ -14,8 +16,9 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
+from . import paper as P
 from . import tables as T
 
 CLASS_STYLE = {"stable": ("tab:green", "o"), "inaccurate": ("tab:orange", "s"), "unstable": ("tab:red", "X"),
@@ -25,6 +28,7 @@ STAGE_COLOURS = {"input": "tab:gray", "init": "tab:brown", "snp": "tab:blue", "p
                  "su": "tab:green", "output": "tab:purple"}
 PRECISION_MARKER = {"float64": "o", "float32": "s"}
 MODEL_COLOUR = {"linear": "tab:blue", "lagrangian": "tab:red", "fixed": "tab:green"}
+SEARCH_COLOUR = {"all-pair": "tab:red", "linked list": "tab:blue"}
 PAPER_MARKERS = {"paper-system-1": "^", "paper-system-2": "v", "paper-system-3": "D"}
 PUBLISHED = {"color": "0.35", "ls": "--", "mfc": "none", "lw": 1.2}  # the paper's numbers, always this style
 
@@ -38,12 +42,20 @@ def palette(n: int) -> list:
     return [cmap(i % cmap.N) for i in range(n)]
 
 
+def channels(**named) -> str:
+    """The title's key to the channels that vary: ``channels(colour=("model", {...}))`` -> "; colour: model"
+    when the set holds more than one value, else nothing (a channel that does not vary is not named)."""
+    parts = [f"{ch}: {what}" for ch, (what, values) in named.items() if len(set(values)) > 1]
+    return ("; " + ", ".join(parts)) if parts else ""
+
+
 @contextmanager
 def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, nrows: int = 1, logx=False,
            logy=False, size=None, legend="right", sharey=False):
     """A constrained-layout figure with ``nrows x ncols`` axes, labelled and gridded, saved to ``path`` on exit.
 
-    ``legend``: "right" puts one legend of every labelled series outside the axes, "none" draws none.
+    ``legend``: "right" puts one legend of every labelled series outside the axes, "below" one legend under
+    each axes (for panels whose series share styles), "none" draws none.
     """
     import matplotlib
 
@@ -63,81 +75,119 @@ def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, nro
     for ax in axes:
         if not ax.get_xlabel():
             ax.set_xlabel(xlabel)
-        if not ax.get_ylabel() and ax is axes[0]:
+        if not ax.get_ylabel() and ax.get_subplotspec().is_first_col():
             ax.set_ylabel(ylabel)
         ax.grid(True, which="major", alpha=0.3)
         for h, lab in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lab, h)
+        if legend == "below" and ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=7, frameon=False)
     if handles and legend == "right":
-        fig.legend(list(handles.values()), list(handles), loc="outside right center", fontsize=7, frameon=False)
-    fig.suptitle(title, fontsize=10)
+        labels = sorted(handles, key=lambda lab: "(published)" in lab)  # measured first, the paper's after
+        fig.legend([handles[lab] for lab in labels], labels, loc="outside right center", fontsize=7, frameon=False)
+    _suptitle(fig, title)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _suptitle(fig, title: str) -> None:
+    """The figure's title, wrapped to its width (a long title is never cut at the edges)."""
+    import textwrap
+
+    fig.suptitle(textwrap.fill(title, width=int(fig.get_figwidth() * 12.5)), fontsize=10)
 
 
 def plain_log_ticks(ax, values, axis="x", spread=1.8):
     """Major ticks at ``values`` written plainly (0.1, 0.05, ...), no minor labels, and no two ticks closer
     than a factor ``spread`` (so tick text never overlaps on a log axis)."""
-    from matplotlib.ticker import FixedLocator, NullFormatter
-
     kept = []
     for v in sorted(set(values)):
         if not kept or v / kept[-1] >= spread:
             kept.append(v)
-    values = kept
     target = ax.xaxis if axis == "x" else ax.yaxis
-    target.set_major_locator(FixedLocator(values))
+    target.set_major_locator(FixedLocator(kept))
     target.set_major_formatter(lambda v, _: f"{v:g}")
     target.set_minor_formatter(NullFormatter())
 
 
-def fig8(df, out: Path, pid: str):
-    series = T.error_series(df)
+def nice_log_ticks(ax, values, axis="y"):
+    """Ticks 1, 2, 5 x 10^k (1 x 10^k over two decades or more) covering ``values``, written
+    plainly (20, 50, 0.001; never 2x10^1), no minor labels."""
+    values = [v for v in values if v and np.isfinite(v) and v > 0]
+    lo, hi = min(values), max(values)
+    mantissas = (1, 2, 5) if hi / lo < 100 else (1,)
+    ticks = [m * 10.0 ** k for k in range(int(np.floor(np.log10(lo))) - 1, int(np.ceil(np.log10(hi))) + 1)
+             for m in mantissas]
+    inside = [t for t in ticks if lo / 1.5 <= t <= hi * 1.5]
+    plain_log_ticks(ax, inside or [lo, hi], axis=axis, spread=1.5)
+    (ax.xaxis if axis == "x" else ax.yaxis).set_minor_locator(NullLocator())
+
+
+def _published(ax, rows, marker, label, **style):
+    """The paper's rows (from :mod:`.paper`) as one published series: grey, dashed, hollow."""
+    pts = sorted((r["N"], r["ms"]) for r in rows)
+    ax.plot(*zip(*pts), marker=marker, **{**PUBLISHED, **style}, label=label)
+
+
+def fig8(series, out: Path, pid: str):
     if not series:
         return None
     protocols = sorted({s["protocol"] for s in series}, key=lambda p: (not p.startswith("t ="), p))
     path = out / "fig8_error_vs_dx.png"
-    with figure(path, f"Fig. 8: error against dx ({pid}); colour: model, marker: precision, "
-                f"line: domain", "dx (m)", "relative RMS error of u (paper's MSE)",
-                ncols=len(protocols), logx=True, logy=True, size=(5.2 * len(protocols) + 3.2, 4.4)) as axes:
+    models = [s["model"] for s in series]
+    precisions = [s["precision"] for s in series]
+    domains = [s["domain"] for s in series]
+    domain = "" if len(set(domains)) > 1 else f", {domains[0]} domain"
+    key = channels(colour=("model", models), marker=("precision", precisions), line=("domain", domains))
+    with figure(path, f"Fig. 8: error against dx ({pid}{domain}){key}", "dx (m)",
+                "relative RMS error of u (paper's MSE)", ncols=len(protocols), logx=True, logy=True,
+                size=(5.6 * len(protocols) + 0.6, 4.6 + 0.16 * max(sum(s["protocol"] == p for s in series)
+                                                                 for p in protocols)), legend="below") as axes:
         for ax, protocol in zip(axes, protocols):
             dxs = []
             for s in (s for s in series if s["protocol"] == protocol):
-                how = (f"stops falling at dx = {s['stops_falling']:g}" if s["stops_falling"]
-                       else f"fitted order {s['order']:.2f}")
                 f32 = s["precision"] == "float32"
                 ax.plot(s["dx"], s["mse"], color=MODEL_COLOUR.get(s["model"], "k"),
                         marker=PRECISION_MARKER[s["precision"]], ms=9 if f32 else 5, mfc="none" if f32 else None,
-                        ls="-" if s["domain"] == "strip" else ":", lw=1.2,
-                        label=f"{protocol}: {s['model']} {s['precision']} {s['domain']} ({how})")
+                        mew=1.4 if f32 else 1.0, ls="-" if s["domain"] == "strip" else ":", lw=1.2,
+                        zorder=3 if f32 else 2,  # float32 on top: where it tracks float64 it would hide under it
+                        label=f"{s['model']} {s['precision']}{'' if domain else ' ' + s['domain']}: {T.trend(s)}")
                 dxs += list(s["dx"])
+            dx_paper, mse_paper = P.fig8_point()
             if protocol == "100 steps":
-                ax.plot([0.004], [T.published()["text"]["fig8_mse_100_steps_dx_0.004"]], marker="^", ms=8,
-                        **PUBLISHED, label="paper, dx = 0.004, 100 steps (published)")
-                dxs.append(0.004)
+                if min(dxs) / dx_paper <= 4:  # drawn only near our runs; else named, not stretched to
+                    ax.plot([dx_paper], [mse_paper], marker="^", ms=9, mew=1.4, zorder=4, **PUBLISHED,
+                            label=f"paper, dx = {dx_paper:g}, 100 steps (published)")
+                    dxs.append(dx_paper)
+                else:
+                    ax.text(0.02, 0.02, f"paper (published): {mse_paper:g} at dx = {dx_paper:g}, off this axis",
+                            transform=ax.transAxes, fontsize=7, color="0.35")
             plain_log_ticks(ax, dxs)
+            nice_log_ticks(ax, [e for s in series if s["protocol"] == protocol for e in s["mse"]]
+                           + ([mse_paper] if dx_paper in dxs else []))
             ax.set_title(protocol + (" (fixed physical time)" if protocol.startswith("t =")
                                      else " (the paper's protocol)"), fontsize=9)
     return path
 
 
-def fig9(df, out: Path, pid: str):
-    rows = [r for r in T.fig9(df) if r["allpair_ms"] or r["linkedlist_ms"]]
-    if not any(r["allpair_ms"] for r in rows):
+def fig9(rows, out: Path, pid: str):
+    steps = T.fig9_steps(rows)
+    if steps is None:
         return None
-    text = T.published()["text"]
+    rows = [r for r in rows if r["steps"] == steps and (r["allpair_ms"] or r["linkedlist_ms"])]
     path = out / "fig9_allpair_vs_linkedlist.png"
-    colours = {"all-pair": "tab:red", "linked list": "tab:blue"}
-    with figure(path, f"Fig. 9: all-pair against linked list, serial CPU, float64 ({pid})", "particles N", "",
-                ncols=2, logx=True, logy=True, size=(13, 4.4)) as (a, b):
-        loop = T.FIG9_LOOP_NAMES[rows[0]["linkedlist_loop"]]
-        for key, name, label in (("allpair_ms", "all-pair", "all-pair (measured)"),
-                                 ("linkedlist_ms", "linked list", f"linked list, {loop} (measured)")):
+    loop = T.FIG9_LOOP_NAMES[rows[0]["linkedlist_loop"]]
+    pub = [r for r in P.step_times() if r["source"] == "Fig. 9 text"]
+    with figure(path, f"Fig. 9: all-pair against linked list, serial CPU, float64, {steps}-step runs ({pid})",
+                "particles N", "", ncols=2, logx=True, logy=True, size=(13, 4.4)) as (a, b):
+        for key, search, label in (("allpair_ms", "all-pair", "all-pair (measured)"),
+                                   ("linkedlist_ms", "linked list", f"linked list, {loop} (measured)")):
             pts = [(r["N"], r[key]) for r in rows if r[key]]
-            a.plot(*zip(*pts), marker="o", color=colours[name], label=label)
-        for name, key, marker in (("all-pair", "fig9_allpair_s", "^"), ("linked list", "fig9_linkedlist_s", "v")):
-            a.plot([int(n) for n in text[key]], [1e3 * v / 10 for v in text[key].values()], marker=marker,
-                   **dict(PUBLISHED, color=colours[name]), label=f"paper {name}, run / 10 steps (published)")
+            if pts:
+                a.plot(*zip(*pts), marker="o", color=SEARCH_COLOUR[search], label=label)
+        for search, marker in (("all-pair", "^"), ("linked list", "v")):
+            _published(a, [r for r in pub if r["search"] == search], marker,
+                       f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published)")
         skipped = [r["N"] for r in rows if r["allpair_status"] == "skipped"]
         for n in skipped:
             a.axvline(n, color="tab:gray", ls=":", lw=1)
@@ -147,55 +197,72 @@ def fig9(df, out: Path, pid: str):
         pts = [(r["N"], r["eta"]) for r in rows if r["eta"]]
         if pts:
             b.plot(*zip(*pts), marker="o", color="tab:purple", label="speedup eta (measured)")
-        b.plot([int(n) for n in text["fig9_allpair_s"]],
-               [text["fig9_allpair_s"][n] / text["fig9_linkedlist_s"][n] for n in text["fig9_allpair_s"]],
-               marker="^", **dict(PUBLISHED, color="tab:purple"), label="speedup eta (paper, published)")
+        ap = {r["N"]: r["ms"] for r in pub if r["search"] == "all-pair"}
+        ll = {r["N"]: r["ms"] for r in pub if r["search"] == "linked list"}
+        b.plot(sorted(ap), [ap[n] / ll[n] for n in sorted(ap)], marker="D", **PUBLISHED,
+               label="speedup eta (paper, published)")
         b.set_ylabel("eta = t_all-pair / t_linked-list")
         b.set_title("speedup (eq. 12)", fontsize=9)
     return path
 
 
-def fig10(df, out: Path, pid: str):
-    runs = T.paper_scene(df)
-    if runs.empty:
+def _run_order(run: str):
+    """Run lengths in order: "10 steps", "100 steps", then "t = 5 s", "t = 10 s"."""
+    words = run.split()
+    return (run.startswith("t ="), float(words[2] if run.startswith("t =") else words[0]))
+
+
+def fig10(series, out: Path, pid: str):
+    """One step against N: a panel per run length, a colour per configuration (solver, precision, pair loop,
+    threads), the paper's step times of the same kind in every panel."""
+    if not series:
         return None
     path = out / "fig10_runtime_vs_N.png"
-    groups = list(runs.groupby(["solver", "precision", "threads", "pair_loop"]))
-    colours = palette(len(groups) + 2)
-    with figure(path, f"Fig. 10: runtime per step against N ({pid}); paper's CPU beside our CPUs, "
-                f"its GPU beside our GPUs", "particles N", "one step SNP+PI+SU (ms)",
-                logx=True, logy=True, size=(10, 4.6)) as (ax,):
-        for colour, ((solver, precision, threads, loop), g) in zip(colours, groups):
-            g = g.sort_values("n_particles").drop_duplicates("n_particles", keep="last")
-            ax.plot(g.n_particles, 1e3 * g.t_step, marker=PRECISION_MARKER[precision], color=colour,
-                    label=T.label({"solver": solver, "precision": precision, "threads": threads,
-                                   "pair_loop": loop}))
-        has_gpu = (runs.solver == "linkedlist-gpu").any()
-        has_cpu = (runs.solver != "linkedlist-gpu").any()
-        if has_cpu:
-            pts = T.paper_cpu_step_ms()
-            ax.plot(list(pts), list(pts.values()), marker="v", **dict(PUBLISHED, color=colours[-2]),
-                    label="paper CPU (Xeon E5-2680, serial; published)")
-        if has_gpu:
-            t4 = T.published()["table4"]["rows"]
-            ax.plot([int(k) for k in t4], [sum(v[2:5]) for v in t4.values()], marker="^",
-                    **dict(PUBLISHED, color=colours[-1]), label="paper GPU (Tesla K20c, Table 4; published)")
+    runs = sorted({s["run"] for s in series}, key=_run_order)
+    configs = sorted({(s["config"], s["loop"], s["threads"]) for s in series})
+    colours = dict(zip(configs, palette(len(configs))))
+    kinds = {(s["device"], s["search"]) for s in series if s["precision"] == "float64"}
+    key = channels(colour=("configuration", configs), marker=("precision", [s["precision"] for s in series]))
+    ncols = min(len(runs), 2)
+    nrows = -(-len(runs) // ncols)
+    with figure(path, f"Fig. 10: one step against N ({pid}, full domain), a panel per run length{key}; grey "
+                "dashed: the paper's, same kind", "particles N", "one step SNP+PI+SU (ms)", ncols=ncols,
+                nrows=nrows, logx=True, logy=True, sharey=True, size=(4.6 * ncols + 4.6, 3.4 * nrows + 0.6)) as axes:
+        for ax in axes[len(runs):]:
+            ax.set_visible(False)
+        for ax, run in zip(axes, runs):
+            for s in (s for s in series if s["run"] == run):
+                c = (s["config"], s["loop"], s["threads"])
+                ax.plot(s["N"], s["ms"], marker=PRECISION_MARKER[s["precision"]], color=colours[c],
+                        label=f"{s['config']}, {s['loop']}, {s['threads']} thread{'s' if s['threads'] > 1 else ''}")
+            ax.set_title(f"runs to t = {run[4:]}" if run.startswith("t =") else f"runs of {run}", fontsize=9)
+            if ("cpu", "linked list") in kinds:
+                cpu = [r for r in P.step_times() if (r["system"], r["device"], r["search"]) ==
+                       ("paper-system-1", "cpu", "linked list")]
+                for source, marker in (("Table 6", "v"), ("text, 400K", "<")):
+                    pts = [r for r in cpu if r["source"] == source]
+                    _published(ax, pts, marker, f"paper CPU, {pts[0]['processor']}, serial linked list, {source}: "
+                               f"{pts[0]['conversion']} (published)", ls="--" if len(pts) > 1 else "none")
+            if ("gpu", "linked list") in kinds:
+                pts = [r for r in P.step_times() if r["device"] == "gpu" and r["source"] == "Table 4"]
+                _published(ax, pts, "^", f"paper GPU, {pts[0]['processor']}, Table 4: one step (published)")
     return path
 
 
 def _shares(path, title, xlabel, rows, published, stages):
-    """Horizontal stacked bars: our rows (config, N) above, the paper's (hatched) in their own panel below."""
-    ours = [(f"{r['config']}, N={r['N']:,}", r) for r in rows]
-    heights = [max(len(ours), 1), max(len(published), 1)]
+    """Horizontal stacked bars: our rows above, the paper's (hatched) in their own panel below, if any."""
+    ours = [(f"{r['config']}, {r['protocol']}, N={r['N']:,}", r) for r in rows]
+    panels = [(ours, None, "measured")] + ([(published, "//", "paper (published)")] if published else [])
+    heights = [max(len(items), 1) for items, _, _ in panels]
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 1, figsize=(10, 1.4 + 0.26 * sum(heights)), layout="constrained",
-                             gridspec_kw={"height_ratios": heights}, sharex=True)
-    for ax, items, hatch, name in ((axes[0], ours, None, "measured"),
-                                   (axes[1], published, "//", "paper (published)")):
+    fig, axes = plt.subplots(len(panels), 1, figsize=(10.5, 1.5 + 0.26 * sum(heights)), layout="constrained",
+                             gridspec_kw={"height_ratios": heights}, sharex=True, squeeze=False)
+    axes = list(axes.flat)
+    for ax, (items, hatch, name) in zip(axes, panels):
         left = np.zeros(len(items))
         for s in stages:
             vals = np.array([sh[s] for _, sh in items])
@@ -209,59 +276,80 @@ def _shares(path, title, xlabel, rows, published, stages):
         ax.set_xlim(0, 100)
         ax.set_title(name, fontsize=9, loc="left")
         ax.grid(True, axis="x", alpha=0.3)
-    axes[1].set_xlabel(xlabel)
+    axes[-1].set_xlabel(xlabel)
     fig.legend(loc="outside lower center", ncols=len(stages), fontsize=8, frameon=False)
-    fig.suptitle(title, fontsize=10)
+    _suptitle(fig, title)
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
 
 
-def fig11(df, out: Path, pid: str):
-    rows = T.table5(df)
+def _one_run(rows, prefer):
+    """The rows of one run length: ``prefer(runs)`` picks it among those present."""
+    runs = sorted({r["run"] for r in rows}, key=_run_order)
+    run = prefer(runs, rows)
+    return run, [r for r in rows if r["run"] == run]
+
+
+def fig11(rows, out: Path, pid: str):
+    """Shares of a step in runs of one length: the paper's 100 steps where measured, else the most common;
+    the paper's shares beside rows of the same kind only (``table5``'s ``paper``)."""
     if not rows:
         return None
-    text = T.published()["text"]["fig11_cpu_step_shares_pct"]
-    paper = [("paper CPU, serial (Fig. 11 text)", {"snp": text["snp"], "pi": text["pi"],
-                                                    "su": 100 - text["snp"] - text["pi"]})]
-    paper += [(f"paper GPU Tesla K20c, N={int(n):,} (Table 5)", dict(zip(T.STEP_STAGES, v)))
-              for n, v in sorted(T.published()["table5"]["rows"].items(), key=lambda kv: int(kv[0]))]
-    return _shares(out / "fig11_step_shares.png", f"Fig. 11 / Table 5: share of a step by stage ({pid})",
-                   "% of one step (SNP + PI + SU)", rows, paper, T.STEP_STAGES)
+    run, rows = _one_run(rows, lambda runs, rows: "100 steps" if "100 steps" in runs else
+                         max(runs, key=lambda x: sum(r["run"] == x for r in rows)))
+    paper = {}
+    for r in rows:
+        if r["paper"]:
+            source, values = r["paper"]
+            name = f"paper {source}" + (f", N={r['N']:,}" if "Table 5" in source else ", every N")
+            paper[name] = dict(zip(T.STEP_STAGES, values))
+    return _shares(out / "fig11_step_shares.png", f"Fig. 11 / Table 5: share of a step by stage, runs of {run} "
+                   f"({pid}; Table 5 has every run length)", "% of one step (SNP + PI + SU)", rows,
+                   list(paper.items()), T.STEP_STAGES)
 
 
-def fig13(df, out: Path, pid: str):
-    rows = T.one_step_shares(df)
+def fig13(rows, out: Path, pid: str):
+    """Shares of a run of one step, rebuilt from the shortest runs measured: input + init + their mean step +
+    output; the paper's K20c one-step runs (Table 4) beside GPU rows only."""
     if not rows:
         return None
-    paper = [(f"paper GPU Tesla K20c, N={int(n):,} (Table 4)", {s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)})
-             for n, v in sorted(T.published()["table4"]["rows"].items(), key=lambda kv: int(kv[0]))]
-    return _shares(out / "fig13_task_shares.png", f"Fig. 13: share of a one-step run by task ({pid})",
-                   "% of a one-step run", rows, paper, T.STAGES)
+    run, rows = _one_run(rows, lambda runs, rows: runs[0])
+    paper = []
+    if any(r["device"] == "gpu" for r in rows):
+        paper = [(f"paper GPU Tesla K20c, N={n:,} (Table 4, one-step run)",
+                  {s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)}) for n, v in P.table4().items()]
+    return _shares(out / "fig13_task_shares.png",
+                   f"Fig. 13: share of a one-step run by task ({pid}): input + init + one step + output, the step "
+                   f"being the mean step of runs of {run}", "% of a run of one step", rows, paper, T.STAGES)
 
 
-def fig14(df_all, out: Path, title: str):
-    rows = [r for r in T.table6(df_all) if r["same_machine"]]
+def fig14(rows, out: Path, title: str):
+    """Speedup per step of each GPU over its own host's CPU, beside the paper's three systems (Table 6)."""
+    rows = [r for r in rows if r["same_machine"]]
     path = out / "fig14_speedup_vs_N.png"
-    pub = T.table6_published()
-    keys = sorted({(r["gpu_profile"], r["precision"]) for r in rows})
+    pub = P.table6()
+    keys = sorted({(r["gpu_profile"], r["precision"], r["protocol"]) for r in rows})
     colours = palette(len(keys))
+    values = [r["speedup"] for r in pub] + [r["speedup"] for r in rows] + \
+        [r["speedup_all_cores"] for r in rows if r["speedup_all_cores"]]
     with figure(path, f"Fig. 14: GPU speedup per step over its own host's CPU ({title})", "particles N",
-                "speedup per step", logx=True, logy=True, size=(10, 4.6)) as (ax,):
-        for system in T.PAPER_SYSTEMS:
+                "speedup per step", logx=True, logy=True, size=(10.5, 4.6)) as (ax,):
+        for system in P.SYSTEMS:
             pts = [(r["N"], r["speedup"]) for r in pub if r["system"] == system]
             card = next(r["card"] for r in pub if r["system"] == system)
             ax.plot(*zip(*pts), marker=PAPER_MARKERS[system], **PUBLISHED,
-                    label=f"{system}: {card} vs one core of its host (published)")
-        for colour, (gp, prec) in zip(colours, keys):
-            pts = [r for r in rows if (r["gpu_profile"], r["precision"]) == (gp, prec)]
+                    label=f"{system}: {card} vs one core of its host, Table 6 (published)")
+        for colour, (gp, prec, how) in zip(colours, keys):
+            pts = [r for r in rows if (r["gpu_profile"], r["precision"], r["protocol"]) == (gp, prec, how)]
             ax.plot([r["N"] for r in pts], [r["speedup"] for r in pts], marker=PRECISION_MARKER[prec], color=colour,
-                    label=f"{gp} {prec} vs one core of its host")
+                    label=f"{gp} {prec} vs one core of its host, {how}")
             multi = [r for r in pts if r["speedup_all_cores"]]
             if multi:
                 ax.plot([r["N"] for r in multi], [r["speedup_all_cores"] for r in multi],
                         marker=PRECISION_MARKER[prec], color=colour, ls=":", mfc="none",
-                        label=f"{gp} {prec} vs all cores of its host")
+                        label=f"{gp} {prec} vs all cores of its host, {how}")
+        nice_log_ticks(ax, values)
         if not rows:
             ax.text(0.02, 0.95, "no GPU measured with its own host's CPU yet: only the paper's lines",
                     transform=ax.transAxes, fontsize=8, color="0.3")
@@ -278,10 +366,9 @@ def _groups(rows, keys):
 KERNEL_COLOURS = {"gaussian": "tab:blue", "wendland-c2": "tab:orange", "wendland-c4": "tab:green"}
 
 
-def speed_vs_accuracy(df, out: Path, pid: str):
+def speed_vs_accuracy(points, front, out: Path, pid: str):
     """Time to solution against error at the time most runs ended at, one panel per model: every run (colour:
     kernel; hollow: float32), the paper's method starred, each model's front, and the prediction beside it."""
-    points, front = T.speed_front(df)
     if not points:
         return None
     times = [p["t_final"] for p in points]
@@ -290,9 +377,12 @@ def speed_vs_accuracy(df, out: Path, pid: str):
               if sum((q["t_final"], q["model"]) == (t_main, m) for q in points) >= 4]
     if not panels:
         return None
+    here_all = [p for p in points if (p["t_final"], p["model"]) in panels]
+    key = channels(colour=("kernel", [p["kernel"] for p in here_all]),
+                   hollow=("float32", [p["precision"] for p in here_all]))
     path = out / "speed_vs_accuracy.png"
-    with figure(path, f"Time to solution against error ({pid}): every finished run; black line: the fastest run "
-                "to each error", "time to solution (s: init + steps, no JIT)",
+    with figure(path, f"Time to solution against error ({pid}){key}; black line: the fastest run to each error",
+                "time to solution (s: init + steps, no JIT)",
                 "relative RMS error of u at t (lagrangian: vs isothermal)",
                 ncols=len(panels), logx=True, logy=True, size=(5.2 * len(panels) + 3.8, 4.6)) as axes:
         for ax, (t_final, model) in zip(axes, panels):
@@ -311,13 +401,13 @@ def speed_vs_accuracy(df, out: Path, pid: str):
             ax.plot([p["seconds"] for p in fp], [T.predicted_error(p) for p in fp], ls="none", marker="x", ms=6,
                     color="crimson", label="front runs, predicted (dispersion relation, linear part)")
             ax.set_title(f"{model}, t = {t_final:g} s ({len(here)} runs)", fontsize=9)
-            for axis in (ax.xaxis, ax.yaxis):  # a narrow log range labels its minor ticks too, and they collide
-                axis.set_minor_formatter(NullFormatter())
+            # plain ticks: a narrow log range would label its minor ticks too, and they collide
+            nice_log_ticks(ax, [p["seconds"] for p in here], axis="x")
+            nice_log_ticks(ax, [p["error"] for p in here] + [T.predicted_error(p) for p in fp], axis="y")
     return path
 
 
-def stability_map(df, out: Path, pid: str, inaccurate_above: float):
-    points, limits = T.stability(df, inaccurate_above)
+def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
     if not points:
         return None
     configs = [lim["config"] for lim in limits]
@@ -342,18 +432,22 @@ def stability_map(df, out: Path, pid: str, inaccurate_above: float):
     return path
 
 
-def cards_figure(df_all, out: Path):
-    rows, pub = T.cards(df_all), T.cards_published()
+def cards_figure(rows, out: Path):
+    """One GPU step against N: each measured card and precision, beside the paper's three cards (grey)."""
+    pub = T.cards_published()
     path = out / "cards_step_vs_N.png"
     cards = sorted({p["card"] for p in rows})
     colours = dict(zip(cards, palette(len(cards))))
-    with figure(path, "GPU cards side by side: one lagrangian step (SNP+PI+SU) against N; colour: card, "
-                "marker: precision", "particles N", "one step (ms)", logx=True, logy=True, size=(10, 4.6)) as (ax,):
-        for (system, card, source), pts in _groups(pub, ("system", "card", "source")):
-            ax.plot([p["N"] for p in pts], [p["step_ms"] for p in pts], marker=PAPER_MARKERS[system],
-                    **dict(PUBLISHED, alpha=0.5 if "Table 6" in source else 1.0),
-                    label=f"{card} ({source}; published)")
-        for (profile, precision), pts in _groups(rows, ("profile", "precision")):
+    key = channels(colour=("card", cards), marker=("precision", [p["precision"] for p in rows]))
+    with figure(path, "GPU cards side by side: one lagrangian step (SNP+PI+SU) against N" + key
+                + "; grey dashed, marker by card: the paper's", "particles N", "one step (ms)", logx=True, logy=True,
+                size=(10.5, 4.6)) as (ax,):
+        for (system, card, source), pts in _groups(pub, ("system", "processor", "source")):
+            _published(ax, pts, PAPER_MARKERS[system], f"{card}, {source}: {pts[0]['conversion']} (published)")
+        for (_, precision, how), pts in _groups(rows, ("profile", "precision", "protocol")):
             ax.plot([p["N"] for p in pts], [p["step_ms"] for p in pts], marker=PRECISION_MARKER[precision],
-                    color=colours[pts[0]["card"]], label=f"{pts[0]['card']} {precision} (measured)")
+                    color=colours[pts[0]["card"]], label=f"{pts[0]['card']} {precision}, {how} (measured)")
+        if not rows:
+            ax.text(0.02, 0.95, "no GPU card measured yet: only the paper's", transform=ax.transAxes, fontsize=8,
+                    color="0.3")
     return path

@@ -1,9 +1,12 @@
-"""The numbers behind every table and figure, computed from the store's DataFrame.
+"""The numbers behind every table and figure, computed from the reports' DataFrame (``frame.load``).
 
-Pure functions: a DataFrame from ``store.load`` in, lists of dicts out (one
-per table row), so the values can be tested without drawing anything. Times
-are s in the store and ms per step in the tables; errors are the paper's
-relative RMS ("MSE") of u.
+Pure functions: a DataFrame in, lists of dicts out (one per table row), so the
+values can be tested without drawing anything. Times are s in the store and
+ms per step in the tables; errors are the paper's relative RMS ("MSE") of u.
+Every row names its protocol (:func:`protocol`: run length, domain, pair loop,
+threads), and rows of different protocols are never merged: a newest-run
+choice is always made within one protocol. The paper's numbers come from
+:mod:`.paper`, beside rows of the same kind only (device, search, serial, float64).
 """
 from __future__ import annotations
 
@@ -14,23 +17,27 @@ from pcabench import profiles
 from pcabench.record import STEP_STAGES
 from solvers import NUMERICS, STAGES, Scene
 
-PAPER_SYSTEMS = ("paper-system-1", "paper-system-2", "paper-system-3")
+from . import paper as P
+
 # The scene's numerics unless a study varies them (Scene's defaults: Verlet, CFL, h/dx, cutoff).
 DEFAULT_NUMERICS = {name: Scene.default(name) for name in NUMERICS}
 # The exact isothermal solution at Ma = 0.05 against the linear pulse (design 1b; solvers/isothermal1d.py).
 ISOTHERMAL_VS_LINEAR = {5.0: 0.051, 10.0: 0.098}
-
-
-def published(system: str = "paper-system-1") -> dict:
-    """The paper's published numbers for ``system`` (hardware_profiles/paper-system-*.json)."""
-    return profiles.load(system)["published"]
+# What makes two runs the same measurement: a newest-run choice is made within one of these.
+PROTOCOL = ["protocol", "domain", "loop", "threads"]
 
 
 def label(r) -> str:
-    """``solver precision``, ``xN`` for a multi-threaded run, and ``[list]`` or ``[gather]``, the pair loop
-    of a linked-list CPU run (rows made before the pair list have none: they used the gather loop)."""
-    loop = f" [{r['pair_loop']}]" if r["solver"] == "linkedlist-cpu" and r.get("pair_loop") else ""
-    return f"{r['solver']} {r['precision']}" + (f" x{int(r['threads'])}" if int(r["threads"]) > 1 else "") + loop
+    """``solver precision``: what ran (its protocol is :func:`protocol`)."""
+    return f"{r['solver']} {r['precision']}"
+
+
+def protocol(r) -> str:
+    """How a run was timed: its length (steps or t), domain, pair loop and CPU threads (or GPU), e.g.
+    ``20 steps, full, gather, 1 thread``."""
+    threads = int(r["threads"])
+    where = "GPU" if r["device"] == "gpu" else f"{threads} thread{'s' if threads > 1 else ''}"
+    return f"{r['protocol']}, {r['domain']}, {r['loop']}, {where}"
 
 
 def latest(df: pd.DataFrame) -> pd.DataFrame:
@@ -61,158 +68,186 @@ def _newest_per(df, keys):
     return df.sort_values("timestamp").drop_duplicates(keys, keep="last")
 
 
+def _paper_kind(r) -> bool:
+    """Whether the paper has a row of ``r``'s kind: serial (its CPU codes are single-thread) and float64."""
+    return int(r["threads"]) == 1 and r["precision"] == "float64"
+
+
 # ---------------------------------------------------------------- Tables 4, 5 and Figs. 11, 13
-def paper_cpu_step_ms() -> dict:
-    """The paper's serial CPU step (Xeon E5-2680), ms, by N: its 400K figure and Table 6's CPU runs / 100 steps
-    (read as s, as for its GPU column)."""
-    pub = published()
-    out = {int(n): 1e3 * cpu / 100 for n, (cpu, _gpu, _s) in pub["table6"]["rows"].items()}
-    out[400_000] = pub["text"]["cpu_vs_gpu_step_400k_ms"]["cpu"]
-    return dict(sorted(out.items()))
-
-
 def table4(df) -> list[dict]:
-    """Stage times by N: input, init, output in ms per run; SNP, PI, SU in ms per step.
-
-    ``paper`` is the paper's number for the same kind of processor: its K20c
-    stage times (Table 4) beside a GPU row, its serial CPU step beside a CPU row.
-    """
-    t4 = published()["table4"]["rows"]
-    cpu_ms = paper_cpu_step_ms()
+    """Stage times by configuration, protocol and N: input, init, output in ms per run; SNP, PI, SU in ms per
+    step. ``paper``: the paper's published numbers of the same kind at the same N (:func:`paper.same_kind`;
+    a GPU row also gets Table 4's stage times), [] where it has none."""
+    keys = ["solver", "precision", "n_particles", *PROTOCOL]
     rows = []
-    keys = ["solver", "precision", "threads", "pair_loop", "n_particles"]
-    for _, r in _newest_per(paper_scene(df), keys).sort_values(keys).iterrows():
-        row = {"config": label(r), "N": int(r.n_particles), "commit": str(r.commit)[:7]}
+    for _, r in _newest_per(paper_scene(df), keys).sort_values(["solver", "precision", "threads", "loop",
+                                                                 "steps", "n_particles"]).iterrows():
+        row = {"config": label(r), "protocol": protocol(r), "run": r.protocol, "steps": int(r.steps),
+               "N": int(r.n_particles),
+               "device": r.device, "search": r.search, "threads": int(r.threads), "commit": str(r.commit)[:7]}
         row.update({s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")})
         row.update(per_step_ms(r))
-        if r.solver == "linkedlist-gpu":
-            row["paper"], row["paper_kind"] = t4.get(str(int(r.n_particles))), "gpu"
-        else:
-            row["paper"], row["paper_kind"] = cpu_ms.get(int(r.n_particles)), "cpu"
+        row["paper"] = P.same_kind(r.device, r.search, r.n_particles) if _paper_kind(r) else []
+        row["paper_stages"] = (P.table4().get(int(r.n_particles)) if r.device == "gpu" and _paper_kind(r)
+                               else None)
         rows.append(row)
     return rows
 
 
-def table5(df) -> list[dict]:
-    """Each step stage's share of a step, %, with the paper's (GPU, Table 5) beside it."""
-    t5 = published()["table5"]["rows"]
-    cpu = published()["text"]["fig11_cpu_step_shares_pct"]
+def table5(rows4) -> list[dict]:
+    """Each step stage's share of a step, %, from Table 4's rows, with the paper's of the same kind: its K20c
+    (Table 5) beside a GPU row at the same N, its serial linked-list CPU (Fig. 11's text, every N) beside a
+    serial linked-list CPU row. An all-pair row has no search stage: its pair search is inside PI."""
+    t5, cpu = P.table5(), P.cpu_shares()
     rows = []
-    for row in table4(df):
+    for row in rows4:
         total = sum(row[s] for s in STEP_STAGES)
         if not total > 0:
             continue  # no timed step: no shares
-        if row["paper_kind"] == "gpu":  # Table 5 is the paper's GPU; its Fig. 11 text gives its serial CPU
-            paper = t5.get(str(row["N"]))
-        else:
-            paper = [cpu["snp"], cpu["pi"], 100 - cpu["snp"] - cpu["pi"]]
-        rows.append({"config": row["config"], "N": row["N"],
+        paper = None
+        if row["threads"] == 1 and row["config"].endswith("float64"):
+            if row["device"] == "gpu" and row["N"] in t5:
+                paper = ("K20c, Table 5", t5[row["N"]])
+            elif row["device"] == "cpu" and row["search"] == "linked list":
+                paper = ("Xeon, Fig. 11 text", [cpu[s] for s in STEP_STAGES])
+        rows.append({"config": row["config"], "protocol": row["protocol"], "run": row["run"], "N": row["N"],
+                     "device": row["device"], "search": row["search"],
                      **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": paper})
     return rows
 
 
-def one_step_shares(df) -> list[dict]:
-    """Fig. 13: each of the six stages' share of a one-step run, %: input + init + one step + output."""
+def one_step_shares(rows4) -> list[dict]:
+    """Fig. 13: each of the six stages' share of input + init + one step + output, %, one step being the mean
+    step of each run (its protocol says how many it made)."""
     rows = []
-    for row in table4(df):
+    for row in rows4:
         total = sum(row[s] for s in STAGES)
-        rows.append({"config": row["config"], "N": row["N"], **{s: 100 * row[s] / total for s in STAGES}})
+        rows.append({"config": row["config"], "protocol": row["protocol"], "run": row["run"], "steps": row["steps"],
+                     "N": row["N"], "device": row["device"],
+                     **{s: 100 * row[s] / total for s in STAGES}})
     return rows
 
 
 # ---------------------------------------------------------------- Table 6 and Fig. 14
 def table6(df_all) -> list[dict]:
-    """CPU (serial linked list, float64) against GPU per step at the same N, for each GPU profile.
+    """CPU (serial linked list, float64) against GPU per step at the same N and run length, per GPU profile.
 
     The CPU is taken from the same machine where it was measured there, else
-    from another measured machine, and the row says which.
+    from another measured machine, and the row says which. The all-cores CPU
+    row is the same machine's, same N and run length, most threads.
     """
     runs = paper_scene(df_all)
-    gpu = runs[runs.solver == "linkedlist-gpu"]
-    cpu = runs[(runs.solver == "linkedlist-cpu") & (runs.precision == "float64")]
+    gpu = runs[runs.device == "gpu"]
+    cpu = runs[(runs.device == "cpu") & (runs.search == "linked list") & (runs.precision == "float64")]
     rows = []
-    for _, g in _newest_per(gpu, ["profile_id", "precision", "n_particles"]) \
-            .sort_values(["profile_id", "n_particles", "precision"]).iterrows():
-        same_n = cpu[cpu.n_particles == g.n_particles]
+    for _, g in _newest_per(gpu, ["profile_id", "precision", "n_particles", *PROTOCOL]) \
+            .sort_values(["profile_id", "n_particles", "precision", "steps"]).iterrows():
+        same_n = cpu[(cpu.n_particles == g.n_particles) & (cpu.protocol == g.protocol)]
         serial = same_n[same_n.threads == 1]
         if serial.empty:
             continue
         here = serial[serial.profile_id == g.profile_id]
         c = (here if not here.empty else serial).sort_values("timestamp").iloc[-1]
         multi = same_n[(same_n.threads > 1) & (same_n.profile_id == c.profile_id)]
-        m = multi.sort_values("threads").iloc[-1] if not multi.empty else None
+        m = multi.sort_values(["threads", "timestamp"]).iloc[-1] if not multi.empty else None
         rows.append({"gpu_profile": g.profile_id, "cpu_profile": c.profile_id, "same_machine": c.profile_id ==
-                     g.profile_id, "N": int(g.n_particles),
-                     "precision": g.precision, "cpu_ms": 1e3 * c.t_step, "gpu_ms": 1e3 * g.t_step,
+                     g.profile_id, "N": int(g.n_particles), "protocol": f"{g.protocol}, {g.domain}",
+                     "cpu_loop": c.loop, "precision": g.precision, "cpu_ms": 1e3 * c.t_step, "gpu_ms": 1e3 * g.t_step,
                      "speedup": c.t_step / g.t_step,
                      "cpu_threads": None if m is None else int(m.threads),
                      "speedup_all_cores": None if m is None else m.t_step / g.t_step})
     return rows
 
 
-def table6_published() -> list[dict]:
-    rows = []
-    for system in PAPER_SYSTEMS:
-        prof = profiles.load(system)
-        for n, (cpu, gpu, speedup) in prof["published"]["table6"]["rows"].items():
-            rows.append({"system": system, "card": prof["gpu"]["name"], "N": int(n), "cpu": cpu, "gpu": gpu,
-                         "speedup": speedup})
-    return sorted(rows, key=lambda r: (r["system"], r["N"]))
-
-
 # ---------------------------------------------------------------- speed per particle and per pair
 def speed(df) -> list[dict]:
-    """ns per particle-step and per neighbour pair for every solver, model and size of the paper's domain.
+    """ns per particle-step and per neighbour pair for every solver, model, protocol and size of the paper's
+    domain.
 
     A neighbour pair counts once per sweep and direction: a Verlet step makes
     two sweeps over N x mean-neighbour pairs (the GPU check's ps/pair likewise).
+    An all-pair search visits every pair of particles, not the neighbours: no
+    ns per neighbour pair for it (None).
     """
     runs = default_numerics(latest(df[(df.status == "ok") & (df.domain == "full")]))
     rows = []
-    keys = ["solver", "threads", "pair_loop", "precision", "model", "n_particles"]
-    for _, r in _newest_per(runs, keys).sort_values(keys).iterrows():
+    keys = ["solver", "precision", "model", "n_particles", *PROTOCOL]
+    for _, r in _newest_per(runs, keys).sort_values(["solver", "threads", "loop", "precision", "model", "steps",
+                                                     "n_particles"]).iterrows():
         pairs = 2 * r.n_particles * r.mean_neighbours
-        rows.append({"config": label(r), "model": r.model, "N": int(r.n_particles), "commit": str(r.commit)[:7],
-                     "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
-                     "ns_per_pair": 1e9 * r.t_step / pairs if pairs > 0 else None,  # NaN neighbours: None
+        rows.append({"config": label(r), "protocol": protocol(r), "model": r.model, "N": int(r.n_particles),
+                     "commit": str(r.commit)[:7], "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
+                     "ns_per_pair": 1e9 * r.t_step / pairs if pairs > 0 and r.search == "linked list" else None,
                      "snp_pct": 100 * r.t_snp / (r.t_snp + r.t_pi + r.t_su)})
     return rows
 
 
-# ---------------------------------------------------------------- Fig. 9
+# ---------------------------------------------------------------- Figs. 9 and 10
 FIG9_LOOP_NAMES = {"gather": "the paper's gather loop", "list": "the pair list"}  # by ``linkedlist_loop``
 
 
 def fig9(df) -> list[dict]:
-    """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL.
+    """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL, by run
+    length (``steps``) and N: the two sides of a row always made the same number of steps.
 
-    One pair loop throughout: the paper's gather loop where it was measured ('' is a run from before the
-    pair list, which had only that loop), so that eta means what the paper's does; else the pair list.
-    Each row names it (``linkedlist_loop``).
+    One pair loop throughout: the paper's gather loop where it was measured, so
+    that eta means what the paper's does; else the pair list. Each row names it
+    (``linkedlist_loop``).
     """
     runs = paper_scene(df)
-    serial = runs[(runs.solver == "linkedlist-cpu") & (runs.threads == 1) & (runs.precision == "float64")]
-    gather = serial.pair_loop.isin(["gather", ""])
+    serial = runs[(runs.device == "cpu") & (runs.search == "linked list") & (runs.threads == 1)
+                  & (runs.precision == "float64")]
+    gather = serial.loop == "gather"
     loop = "gather" if gather.any() else "list"
-    ll = _newest_per(serial[gather] if gather.any() else serial[serial.pair_loop == "list"],
-                     ["n_particles"]).set_index("n_particles")
-    ap_all = latest(default_numerics(df[(df.solver == "allpair-cpu") & (df.model == "lagrangian")
-                                        & (df.domain == "full")]))
+    ll = _newest_per(serial[serial.loop == loop], ["steps", "n_particles"]).set_index(["steps", "n_particles"])
+    everything = latest(default_numerics(df[(df.model == "lagrangian") & (df.domain == "full")]))
+    ap_all = everything[everything.search == "all-pair"]
     rows = []
-    for n, g in ap_all.groupby("n_particles"):
+    # a run's length: the steps it made, or for a run that made none (skipped, timed out) the steps it asked for
+    asked = ap_all.steps_requested.fillna(ap_all.steps) if "steps_requested" in ap_all else ap_all.steps
+    length = ap_all.steps.where(ap_all.status == "ok", asked)
+    for (steps, n), g in ap_all.groupby([length.astype(int), "n_particles"]):
         ok = g[g.status == "ok"]
         r = (ok if not ok.empty else g).sort_values("timestamp").iloc[-1]
-        row = {"N": int(n), "allpair_ms": 1e3 * r.t_step if r.status == "ok" else None,
-               "allpair_status": r.status, "allpair_note": "" if r.status == "ok" else str(r.message)[:160],
-               "linkedlist_ms": 1e3 * ll.loc[n, "t_step"] if n in ll.index else None, "linkedlist_loop": loop}
+        key = (int(steps), n)
+        row = {"steps": int(steps), "N": int(n), "allpair_ms": 1e3 * r.t_step if r.status == "ok" else None,
+               "allpair_status": r.status, "allpair_note": "" if r.status == "ok" else str(r.message),
+               "linkedlist_ms": 1e3 * ll.loc[key, "t_step"] if key in ll.index else None, "linkedlist_loop": loop}
         row["eta"] = (row["allpair_ms"] / row["linkedlist_ms"]
                       if row["allpair_ms"] and row["linkedlist_ms"] else None)
         rows.append(row)
-    for n in ll.index:
-        if n not in {r["N"] for r in rows}:
-            rows.append({"N": int(n), "allpair_ms": None, "allpair_status": "not run", "allpair_note": "",
-                         "linkedlist_ms": 1e3 * ll.loc[n, "t_step"], "eta": None, "linkedlist_loop": loop})
-    return sorted(rows, key=lambda r: r["N"])
+    have = {(r["steps"], r["N"]) for r in rows}
+    ap_steps = {r["steps"] for r in rows}
+    for steps, n in ll.index:
+        if (steps, n) not in have and steps in ap_steps:  # a linked-list run length all-pair never ran is not Fig. 9
+            rows.append({"steps": int(steps), "N": int(n), "allpair_ms": None, "allpair_status": "not run",
+                         "allpair_note": "", "linkedlist_ms": 1e3 * ll.loc[(steps, n), "t_step"], "eta": None,
+                         "linkedlist_loop": loop})
+    return sorted(rows, key=lambda r: (r["steps"], r["N"]))
+
+
+def fig9_steps(rows) -> int | None:
+    """The run length Fig. 9 draws: the one with the most finished all-pair runs (then the paper's 10, then
+    the fewest steps)."""
+    counts = {}
+    for r in rows:
+        counts[r["steps"]] = counts.get(r["steps"], 0) + bool(r["allpair_ms"])
+    if not counts or not max(counts.values()):
+        return None
+    return max(counts, key=lambda s: (counts[s], s == P.FIG9_STEPS, -s))
+
+
+def runtime_series(df) -> list[dict]:
+    """Fig. 10: one step (SNP + PI + SU, ms) against N, one series per configuration and protocol."""
+    runs = paper_scene(df)
+    out = []
+    for _, g in runs.groupby(["solver", "precision", *PROTOCOL]):
+        g = g.sort_values(["n_particles", "timestamp"]).drop_duplicates("n_particles", keep="last")
+        r = g.iloc[0]
+        out.append({"config": label(r), "protocol": protocol(r), "run": r.protocol, "domain": r.domain,
+                    "loop": r.loop, "threads": int(r.threads), "precision": r.precision, "device": r.device,
+                    "search": r.search, "N": g.n_particles.astype(int).tolist(), "ms": (1e3 * g.t_step).tolist()})
+    return out
 
 
 # ---------------------------------------------------------------- Fig. 8 and the accuracy bars
@@ -245,6 +280,17 @@ def error_series(df) -> list[dict]:
     return sorted(out, key=lambda s: (s["protocol"], s["domain"], s["model"], s["precision"]))
 
 
+def trend(s) -> str:
+    """How a Fig. 8 series falls, in the words the figure's legend and the report both use."""
+    if s["protocol"].startswith("t ="):
+        if s["stops_falling"]:
+            return f"stops falling at dx = {s['stops_falling']:g}"
+        if s["model"] == "lagrangian":
+            return "has not yet stopped falling over these dx"
+        return f"fitted order {s['order']:.2f}"
+    return f"fitted order {s['order']:.2f} (apparent: each dx ends at a different time)"
+
+
 def stops_falling(dx, err, gain=0.75):
     """The dx below which refining no longer cuts the error by 25 % per halving, or None."""
     for i in range(len(dx) - 1):
@@ -254,9 +300,10 @@ def stops_falling(dx, err, gain=0.75):
     return None
 
 
-def accuracy_bars(df) -> list[dict]:
-    """The issue's bars: linear, Verlet, cutoff 3h, strip, t = 10 s: order >= 1 and < 2 % at dx = 0.05."""
-    series = [s for s in error_series(df) if s["model"] == "linear" and s["protocol"] == "t = 10 s"
+def accuracy_bars(series) -> list[dict]:
+    """The issue's bars, from Fig. 8's ``series``: linear, Verlet, cutoff 3h, strip, t = 10 s: order >= 1 and
+    < 2 % at dx = 0.05."""
+    series = [s for s in series if s["model"] == "linear" and s["protocol"] == "t = 10 s"
               and s["domain"] == "strip" and s["precision"] == "float64"]
     if not series:
         return [{"bar": "linear, t = 10 s, strip: order >= 1 and error < 2 % at dx = 0.05",
@@ -396,7 +443,7 @@ def simplifications(df) -> list[dict]:
     """What each simplification buys (time to solution) and costs (error), same runs otherwise."""
     runs = default_numerics(latest(df[df.status == "ok"]))
     rows = []
-    shared = ["solver", "threads", "model", "precision", "domain", "protocol", "dx"]
+    shared = ["solver", "threads", "loop", "model", "precision", "domain", "protocol", "dx"]
     for what, col, base, simple in SIMPLIFICATIONS:
         keys = [k for k in shared if k != col]
         for key, g in runs.groupby(keys):
@@ -407,7 +454,7 @@ def simplifications(df) -> list[dict]:
             ctx = dict(zip(keys, key))
             rows.append({"simplification": what,
                          "runs": " ".join(str(ctx[k]) for k in ("solver", "model", "precision", "domain", "protocol")
-                                          if k in ctx) + (f" x{ctx['threads']}" if ctx.get("threads", 1) > 1 else ""),
+                                          if k in ctx) + f", {ctx['loop']}, {ctx['threads']} thread(s)",
                          "dx": ctx["dx"], "N": (int(a.n_particles), int(b.n_particles)),
                          "seconds": (a.t_solution, b.t_solution), "speedup": a.t_solution / b.t_solution,
                          "mse": (a.mse, b.mse)})
@@ -427,12 +474,18 @@ def classify(r, inaccurate_above: float) -> str:
 
 
 def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
-    """The stability map's points and, per configuration, the largest CFL up to which every run is stable."""
-    runs = latest(df[df.preset == "stability"])
-    runs = runs[runs.protocol.str.startswith("t =")]
+    """The stability map's points and, per configuration, the largest CFL up to which every run is stable.
+
+    The runs of the stability preset, and a quick study's CFL sweep (three CFLs or more of one method).
+    """
+    runs = latest(df[df.preset.isin(["stability", "quick"]) & df.protocol.str.startswith("t =")
+                     & (df.model == "linear") & (df.domain == "strip")])
+    keys = ["integrator", "h_factor", "precision", "protocol", "dx"]
+    if not runs.empty:
+        sweeps = runs.groupby(keys + ["preset"]).cfl.transform("nunique")
+        runs = runs[(runs.preset == "stability") | (sweeps >= 3)]
     points, limits = [], []
-    for (integ, h, precision, protocol, dx), g in runs.groupby(["integrator", "h_factor", "precision", "protocol",
-                                                               "dx"]):
+    for (integ, h, precision, protocol, dx), g in runs.groupby(keys):
         g = g.sort_values("cfl")
         name = f"{integ}, h = {h:g} dx, {precision}, {protocol}"
         limit, bounded, first_bad, first_unbounded = None, None, None, None
@@ -476,16 +529,17 @@ def float32_vs_float64(df, tolerance: float = 0.10) -> list[dict]:
 
 # ---------------------------------------------------------------- cards side by side
 def cards(df_all) -> list[dict]:
-    """GPU step time by N for each measured card and precision (paper scene), ms."""
+    """GPU step time by N for each measured card, precision and protocol (paper scene), ms."""
     runs = paper_scene(df_all)
-    gpu = _newest_per(runs[runs.solver == "linkedlist-gpu"], ["profile_id", "precision", "n_particles"])
+    gpu = _newest_per(runs[runs.device == "gpu"], ["profile_id", "precision", "n_particles", *PROTOCOL])
     rows = []
-    for _, r in gpu.sort_values(["n_particles", "profile_id", "precision"]).iterrows():
+    for _, r in gpu.sort_values(["n_particles", "profile_id", "precision", "steps"]).iterrows():
         card = (profiles.stored().get(r.profile_id, {}).get("gpu") or {}).get("name", r.profile_id)
         per = per_step_ms(r)
         total = sum(per.values())
         pairs = 2 * r.n_particles * (r.mean_neighbours if np.isfinite(r.mean_neighbours or np.nan) else np.nan)
         rows.append({"profile": r.profile_id, "card": card, "precision": r.precision, "N": int(r.n_particles),
+                     "protocol": f"{r.protocol}, {r.domain}",
                      "step_ms": 1e3 * r.t_step, **{f"{s}_ms": v for s, v in per.items()},
                      **{f"{s}_pct": 100 * v / total if total else np.nan for s, v in per.items()},
                      "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
@@ -493,10 +547,11 @@ def cards(df_all) -> list[dict]:
     return rows
 
 
-def card_ceilings(df_all) -> list[dict]:
-    """Each measured card's ceilings from its profile (``pcabench gpu-check``: copy bandwidth, FMA rates)."""
+def card_ceilings(rows) -> list[dict]:
+    """Each measured card's ceilings (``rows``: :func:`cards`) from its profile (``pcabench gpu-check``: copy
+    bandwidth, FMA rates)."""
     out = []
-    for pid in sorted({r["profile"] for r in cards(df_all)}):
+    for pid in sorted({r["profile"] for r in rows}):
         prof = profiles.stored().get(pid, {})
         measured = prof.get("measured") or {}
         if measured:
@@ -505,19 +560,21 @@ def card_ceilings(df_all) -> list[dict]:
     return out
 
 
-def card_ratios(df_all) -> list[dict]:
-    """For every two measured cards: step-time ratio at each shared N and precision beside their ceiling ratios."""
-    rows, ceil = cards(df_all), {c["profile"]: c for c in card_ceilings(df_all)}
+def card_ratios(rows) -> list[dict]:
+    """For every two measured cards (``rows``: :func:`cards`): step-time ratio at each shared N, precision and
+    protocol beside their ceiling ratios."""
+    ceil = {c["profile"]: c for c in card_ceilings(rows)}
     out = []
     pids = sorted(ceil)
     for i, a in enumerate(pids):
         for b in pids[i + 1:]:
-            ta = {(r["precision"], r["N"]): r["step_ms"] for r in rows if r["profile"] == a}
-            tb = {(r["precision"], r["N"]): r["step_ms"] for r in rows if r["profile"] == b}
-            for precision, n in sorted(set(ta) & set(tb)):
+            ta = {(r["precision"], r["N"], r["protocol"]): r["step_ms"] for r in rows if r["profile"] == a}
+            tb = {(r["precision"], r["N"], r["protocol"]): r["step_ms"] for r in rows if r["profile"] == b}
+            for key in sorted(set(ta) & set(tb)):
+                precision, n, how = key
                 fma = "fp32_fma_tflops" if precision == "float32" else "fp64_fma_tflops"
                 out.append({"a": ceil[a]["card"], "b": ceil[b]["card"], "precision": precision, "N": n,
-                            "speed_ratio": tb[(precision, n)] / ta[(precision, n)],
+                            "protocol": how, "speed_ratio": tb[key] / ta[key],
                             "bandwidth_ratio": _ratio(ceil[a]["copy_bandwidth_tbs"], ceil[b]["copy_bandwidth_tbs"]),
                             "fma_ratio": _ratio(ceil[a][fma], ceil[b][fma])})
     return out
@@ -528,12 +585,7 @@ def _ratio(x, y):
 
 
 def cards_published() -> list[dict]:
-    """The paper's cards: K20c one step from Table 4 (ms), all three from Table 6 / 100 steps (read as s)."""
-    rows = []
-    for n, v in published()["table4"]["rows"].items():
-        rows.append({"system": "paper-system-1", "card": "Tesla K20c", "N": int(n), "step_ms": sum(v[2:5]),
-                     "source": "Table 4"})
-    for r in table6_published():
-        rows.append({"system": r["system"], "card": r["card"], "N": r["N"], "step_ms": 1e3 * r["gpu"] / 100,
-                     "source": "Table 6 / 100 steps, read as s"})
-    return rows
+    """The paper's cards, one step (ms) by N, one source per card: the K20c's Table 4 (measured per step),
+    the other two cards' Table 6 (:mod:`.paper` states the conversion)."""
+    return [r for r in P.step_times() if r["device"] == "gpu"
+            and r["source"] == ("Table 4" if r["system"] == "paper-system-1" else "Table 6")]

@@ -1,0 +1,76 @@
+"""The reports' DataFrame: the store's records, one row each, with the columns the tables read.
+
+The store loads records (:func:`pcabench.store.read_rows`); what a report
+derives from them lives here: stage times as ``t_<stage>`` (s), the scene's
+parameters as columns (at their defaults where a row predates them), the run's
+protocol (``protocol``: steps or a physical time; ``domain``: full or strip),
+what ran (``device``; ``search``: linked list or all-pair; ``loop``: the pair
+loop), the machine (a profile, and its host where several share it), ``t_step`` (s
+per step) and ``t_solution`` (init + steps, s, no JIT or I/O).
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+
+from pcabench import store
+from pcabench.record import STEP_STAGES
+from pcabench.spec import stored_parameters
+from solvers import registry
+
+SCENE_COLUMNS = ("strip_height", "cutoff_factor", "kernel", "h_factor", "cfl", "t_final", "height")
+NUMERIC = ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal")
+
+
+def load(paths) -> pd.DataFrame:
+    """The stores ``paths`` (files or folders of *.jsonl) as one DataFrame, one row per run."""
+    return frame(store.read_rows(paths))
+
+
+def _flat(row: dict) -> dict:
+    r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions")}
+    for stage, seconds in (row.get("stages") or {}).items():
+        r[f"t_{stage}"] = seconds
+    scene = row.get("scene") or {}
+    scene = {**stored_parameters(scene), **scene}  # a parameter the row predates at its default (kernel)
+    for key in SCENE_COLUMNS:
+        r[key] = scene.get(key)
+    r["kernel"] = scene.get("kernel") or "gaussian"  # rows from before the kernel option: the Gaussian
+    # how the run ends: the paper's fixed step count, or a fixed physical time
+    r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
+    r["domain"] = "strip" if scene.get("strip_height") else "full"
+    r["scene_key"] = json.dumps({k: v for k, v in scene.items() if k != "memory_limit_bytes"}, sort_keys=True)
+    r.setdefault("preset", "")
+    r.setdefault("pair_loop", "")  # rows from before the pair list: the gather loop
+    r["threads"] = int(r.get("threads") or 1)
+    # what ran: the device, the neighbour search and the pair loop (a record that does not state its
+    # device or loop: its solver's class says them, a solver no longer installed ran on the CPU; the
+    # linked list's loop before the pair list, and the GPU's, was the paper's gather loop)
+    cls = registry().get(str(row.get("solver", "")))
+    r["device"] = row.get("device") or (cls.device if cls else "cpu")
+    all_pairs = r["pair_loop"] == "all-pairs" or (cls is not None and cls.pair_loops == ("all-pairs",))
+    r["search"] = "all-pair" if all_pairs else "linked list"
+    r["loop"] = r["pair_loop"] or ("all-pairs" if all_pairs else "gather")
+    return r
+
+
+def frame(rows: list[dict]) -> pd.DataFrame:
+    """Stored records (dicts) as the reports' DataFrame."""
+    df = pd.DataFrame([_flat(row) for row in rows])
+    if df.empty:
+        return df
+    if "mse_isothermal" not in df:
+        df["mse_isothermal"] = np.nan  # rows from before it was measured
+    for col in NUMERIC:  # null -> NaN
+        if col in df:
+            df[col] = pd.to_numeric(df[col], errors="coerce")
+    df["host"] = df["host"].fillna("") if "host" in df else ""
+    # one machine: a hardware profile, and its host where several hosts share the profile
+    hosts = df.groupby("profile_id")["host"].transform("nunique")
+    df["machine"] = np.where(hosts > 1, df["profile_id"] + "--" + df["host"], df["profile_id"])
+    step_total = sum(df[f"t_{s}"] for s in STEP_STAGES)
+    df["t_step"] = step_total / df["steps"].clip(lower=1)
+    df["t_solution"] = df["t_init"] + step_total  # s, without JIT and I/O
+    return df

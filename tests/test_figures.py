@@ -1,0 +1,159 @@
+"""Every figure a report writes, read as a reader would (tests/figure_check.py), and the checker itself.
+
+The quick study's figures are drawn from records made from the quick preset's own run specs (the
+times and errors synthetic, the runs exactly those `study --quick` makes), so that the report of a
+quick study holds every section and figure the README promises, each passing the checks. The
+committed reference's figures pass them too.
+"""
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import pytest  # noqa: E402
+
+from pcabench import paths, presets, store  # noqa: E402
+from pcabench.record import RunRecord  # noqa: E402
+from pcabench.reports import write_reports  # noqa: E402
+
+from .figure_check import problems, record  # noqa: E402
+
+PROFILE = "laptop-cpu"
+
+
+def quick_records() -> list[RunRecord]:
+    """One record per run of `study --quick`, with times that grow with N (all-pair as N^2, skipped past
+    16K as a sweep would predict) and errors of the right shape (linear second order, the stability
+    scene stable to CFL 2, inaccurate near 5, unstable past it)."""
+    out = []
+    for i, spec in enumerate(presets.preset("quick")):
+        spec = spec.resolved()
+        s = spec.scene
+        n = s.n_particles
+        allpair = spec.solver.startswith("allpair")
+        step = 2e-7 * n * (n / 1000 if allpair else 1) * (0.6 if s.precision == "float32" else 1)
+        status, steps, failed = "ok", s.n_steps, None
+        if allpair and n > 16000:
+            status, steps = "skipped", 0
+        mse = {"linear": 0.016 * (s.dx / 0.1) ** 2, "fixed": 0.2, "lagrangian": 0.1 + s.dx / 10}[s.model]
+        if s.precision == "float32":
+            mse *= 1.02
+        if s.cfl >= 7:
+            status, steps, failed = "unstable", 12, 12
+        elif s.cfl >= 5:
+            mse = 0.3
+        stages = {"input": 1e-4, "init": 1e-6 * n, "output": 1e-6 * n,
+                  "snp": 0.3 * step * steps, "pi": 0.65 * step * steps, "su": 0.05 * step * steps}
+        out.append(RunRecord(
+            solver=spec.solver, precision=s.precision, model=s.model, integrator=s.integrator, dx=s.dx,
+            n_particles=n, steps=steps, t_end=s.t_final, stages=stages, jit_seconds=1.0, mse=mse, me=mse / 20,
+            mean_neighbours=120.0, status=status, failed_step=failed, threads=int(spec.threads),
+            pair_loop=spec.pair_loop, steps_requested=s.n_steps, scene=s.as_dict(),
+            mse_isothermal=mse / 2 if s.model == "lagrangian" else None,
+            message="predicted 999 s > run budget 120 s" if status == "skipped" else "", profile_id=PROFILE,
+            commit="abc1234", preset="quick", host="host1",
+            timestamp=f"2026-01-01T00:{i // 60:02d}:{i % 60:02d}+00:00"))
+    return out
+
+
+@pytest.fixture(scope="module")
+def quick_report(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("quick")
+    for rec in quick_records():
+        store.append(rec, tmp / "store" / f"{PROFILE}.jsonl")
+    with record() as found:
+        write_reports(tmp / "store", tmp / "reports")
+    return tmp / "reports", found
+
+
+def test_a_quick_study_writes_every_figure_and_section_the_readme_promises(quick_report):
+    out, found = quick_report
+    figures = {p.name for p in (out / PROFILE).glob("*.png")}
+    assert figures == {"fig8_error_vs_dx.png", "fig9_allpair_vs_linkedlist.png", "fig10_runtime_vs_N.png",
+                       "fig11_step_shares.png", "fig13_task_shares.png", "speed_vs_accuracy.png",
+                       "stability_map.png"}
+    text = (out / PROFILE / "report.md").read_text()
+    for heading in ("Table 4", "Table 5 and Fig. 11", "Fig. 10", "Speed per particle-step", "Fig. 9", "Fig. 8",
+                    "Time to a given accuracy", "The cost of each simplification", "Stability: where methods fail",
+                    "float32 against float64", "Runs that did not finish"):
+        assert f"## {heading}" in text, heading
+    assert len(found) == len(figures) + 2  # and the cards page's two
+
+
+def test_every_figure_of_a_quick_study_reads_right(quick_report):
+    _, found = quick_report
+    assert {name: p for name, p in found.items() if p} == {}
+
+
+def test_every_committed_reference_figure_reads_right(tmp_path):
+    if paths.checkout() is None:
+        pytest.skip("needs a source checkout")
+    with record() as found:
+        write_reports(paths.reference_results(), tmp_path)
+    assert found and {name: p for name, p in found.items() if p} == {}
+
+
+def test_a_row_never_mixes_protocols_and_the_paper_sits_beside_its_own_kind(quick_report):
+    out, _ = quick_report
+    text = (out / PROFILE / "report.md").read_text()
+    table4 = text.split("## Table 4")[1].split("\n## ")[0]
+    rows = [line for line in table4.splitlines() if line.startswith("| ") and "steps" in line]
+    assert rows and all(", full, " in r and "thread" in r for r in rows)  # run length, domain, loop, threads
+    for line in rows:
+        if "allpair" in line:
+            assert "linked list" not in line.split("|")[-2]
+    table5 = text.split("## Table 5")[1].split("\n## ")[0]
+    for line in table5.splitlines():
+        if line.startswith("| allpair"):
+            assert line.rstrip(" |").endswith("-"), line  # no linked-list shares beside an all-pair row
+    assert "K20c" not in text  # a CPU-only report has none of the paper's GPU numbers
+
+
+# ---------------------------------------------------------------- the checker can fail
+def _fig(**kw):
+    fig, ax = plt.subplots(figsize=kw.pop("size", (5, 3)), layout="constrained")
+    return fig, ax
+
+
+def test_the_checker_finds_each_fault():
+    cases = {}
+    fig, ax = _fig()
+    ax.plot([0, 1], [0, 1], "o-", label="data")
+    ax.legend(loc="center")  # over the line
+    cases["legend"] = fig
+    fig, ax = _fig()
+    ax.plot(range(40), range(40))
+    ax.set_xticks(range(40), [f"tick {i}" for i in range(40)])
+    cases["overlap"] = fig
+    fig, ax = _fig()
+    ax.plot([1, 2], [1, 2], color="grey", marker="o", label="a")
+    ax.plot([1, 2], [2, 3], color="grey", marker="s", label="b")
+    fig.suptitle("colour: solver")
+    cases["channel"] = fig
+    fig, ax = _fig()
+    ax.plot([1, 2], [1, 2], color="tab:blue", marker="o", label="a")
+    ax.plot([1, 2], [2, 3], color="tab:blue", marker="o", label="b")
+    fig.legend(loc="outside right center")
+    cases["alike"] = fig
+    fig, ax = _fig()
+    ax.plot([1, 2], [1, 2], color="tab:red", marker="^", label="paper all-pair (published)")
+    fig.legend(loc="outside right center")
+    cases["published"] = fig
+    fig, ax = _fig()
+    ax.set_yscale("log")
+    ax.plot([1, 2], [20, 60])
+    cases["log ticks"] = fig
+    fig, ax = _fig(size=(3, 2))
+    fig.suptitle("a title far too long for its figure, which a reader would find cut at both edges " * 2)
+    cases["cut"] = fig
+    for name, fig in cases.items():
+        assert problems(fig), name
+        plt.close(fig)
+    fig, ax = _fig()
+    ax.plot([1, 2], [1, 2], color="tab:blue", marker="o", label="measured")
+    ax.plot([1, 2], [2, 3], color="0.35", ls="--", marker="^", mfc="none", label="paper (published)")
+    fig.legend(loc="outside right center")
+    assert problems(fig) == []
+    plt.close(fig)
