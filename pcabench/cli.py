@@ -354,7 +354,7 @@ def cmd_runs(args) -> int:
     import pandas as pd
 
     from . import runs
-    from .store import load
+    from .reports.frame import load
 
     results = args.results or (paths.reference_results() if args.reference else paths.user_results())
     with warnings.catch_warnings():
@@ -394,14 +394,14 @@ def cmd_accuracy(args) -> int:
 
 
 def cmd_advise(args) -> int:
-    from . import store
     from .advise import advise
     from .profiles import machine_id
+    from .reports.frame import load as load_frame
 
     if not 0 < args.error <= 1:
         raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
     results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
-    df = store.load(results) if results is not None and Path(results).exists() else None
+    df = load_frame(results) if results is not None and Path(results).exists() else None
     if df is None or df.empty:
         raise NoResults(f"no stored runs in {results}: run `pcabench study --front` first, "
                         "or use --reference")

@@ -28,9 +28,9 @@ def note(message: str, width: int = NOTE_WIDTH) -> str:
 
 
 def table(df: pd.DataFrame, **filters) -> pd.DataFrame:
-    """The runs of ``df`` (from ``store.load``) as a readable table, filtered by column prefix matches (a
-    machine by :func:`machines`). A run that made no step (skipped on its prediction, timed out, crashed
-    before a step) has no step time, steps or error (NA, shown as "-"), and its note says why."""
+    """The runs of ``df`` (from :func:`pcabench.reports.frame.load`) as a readable table, filtered by column
+    prefix matches (a machine by :func:`machines`). A run that made no step (skipped on its prediction, timed
+    out, crashed before a step) has no step time, steps or error (NA, shown as "-"), and its note says why."""
     if df.empty:
         return pd.DataFrame(columns=COLUMNS)
     stepped = df.steps > 0

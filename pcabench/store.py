@@ -394,10 +394,3 @@ def read_rows(paths) -> list[dict]:
                     rows.append(row)
     return rows
 
-
-def load(paths):
-    """The stores ``paths`` as the reports' DataFrame: kept for callers of the store; the columns are
-    derived in :mod:`pcabench.reports.frame`, which is where to load them from."""
-    from .reports.frame import load as load_frame
-
-    return load_frame(paths)

@@ -7,6 +7,7 @@ import pytest
 
 from pcabench import store
 from pcabench.advise import advise
+from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
 from pcabench.sweep import failed_record
 from solvers import Scene
@@ -43,7 +44,7 @@ def results(tmp_path):
 
 
 def test_the_fastest_run_reaching_the_error_against_the_paper_method_on_the_same_domain(results):
-    df = store.load(results)
+    df = load_frame(results)
     out = advise(df, 0.01, 10.0)
     assert out["found"] and out["seconds"] == pytest.approx(2.0) and out["kernel"] == "wendland-c2"
     assert out["domain"] == "strip" and out["paper_seconds"] == pytest.approx(50.0)  # not the full domain's 900
@@ -55,10 +56,10 @@ def test_the_fastest_run_reaching_the_error_against_the_paper_method_on_the_same
 
 
 def test_lagrangian_is_judged_against_its_own_limit(results):
-    out = advise(store.load(results), 0.0125, 10.0, model="lagrangian")
+    out = advise(load_frame(results), 0.0125, 10.0, model="lagrangian")
     assert out["error_against"] == "the isothermal solution"
     assert out["seconds"] == pytest.approx(3.0) and out["paper_seconds"] == pytest.approx(80.0)
-    assert advise(store.load(results), 0.0105, 10.0, model="lagrangian")["found"] is False
+    assert advise(load_frame(results), 0.0105, 10.0, model="lagrangian")["found"] is False
 
 
 def test_advise_command_json_and_what_no_run_reaches(results, capsys):

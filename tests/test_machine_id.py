@@ -15,6 +15,7 @@ from pcabench import cli, profiles, store
 from pcabench.provenance import git_commit
 from pcabench.reports import tables as T
 from pcabench.reports import write_reports
+from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
 from pcabench.sweep import run_child
 from solvers import Scene
@@ -91,12 +92,13 @@ def test_table6_finds_a_gpu_and_the_cpu_of_its_own_host(machine, tmp_path):
     mid, results, _ = machine
     path = results / store.store_name(mid)
     cpu = store.read_rows(path)[0]
-    gpu = dict(cpu, solver="linkedlist-gpu", pair_loop="", stages={k: v / 10 for k, v in cpu["stages"].items()},
+    gpu = dict(cpu, solver="linkedlist-gpu", device="gpu", pair_loop="gather",
+               stages={k: v / 10 for k, v in cpu["stages"].items()},
                run_id="a-gpu-run-on-this-machine")  # as a GPU sweep here would store it
     merged = tmp_path / "results"
     store.append(cpu, merged / path.name)
     store.append(gpu, merged / path.name)
-    [row] = T.table6(store.load(merged))
+    [row] = T.table6(load_frame(merged))
     assert (row["gpu_profile"], row["cpu_profile"], row["same_machine"]) == (mid, mid, True)
     assert row["speedup"] == pytest.approx(10)
     write_reports(merged, tmp_path / "reports")

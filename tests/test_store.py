@@ -4,6 +4,7 @@ from __future__ import annotations
 import pytest
 
 from pcabench import store
+from pcabench.reports.frame import load as load_frame
 from pcabench.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
@@ -19,7 +20,7 @@ def test_append_read_merge_and_torn_line(tmp_path):
     with open(a, "a") as f:
         f.write('{"solver": "linkedlist-cpu", "trunc')  # a run killed mid-write
     with pytest.warns(store.StoreWarning, match="a.jsonl:3: not JSON"):  # the torn line is named, then skipped
-        df = store.load([a, b])
+        df = load_frame([a, b])
     assert len(df) == 2
     assert set(df["profile_id"]) == {"machine-a", "machine-b"}
     assert row["status"] == "ok" and df["t_step"].gt(0).all()

@@ -9,6 +9,7 @@ import subprocess
 import pytest
 
 from pcabench import __version__, cli, paths, runs, store
+from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
 from pcabench.sweep import sweep
 from solvers import Scene
@@ -131,7 +132,7 @@ def test_runs_lists_filters_and_compares(tmp_path):
     results = tmp_path / "results"
     for r in fixture_rows():
         store.append(r, results / f"{r.profile_id}.jsonl")
-    df = store.load(results)
+    df = load_frame(results)
     gpu = runs.table(df, solver="linkedlist-gpu", machine="machine-a")
     assert set(gpu.solver) == {"linkedlist-gpu"} and set(gpu.machine) == {"machine-a"} and len(gpu) == 2
     both = runs.compare(df, "machine-a", "machine-b")
