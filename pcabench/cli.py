@@ -394,6 +394,7 @@ def cmd_accuracy(args) -> int:
 
 
 def cmd_advise(args) -> int:
+    from . import runs
     from .advise import advise
     from .profiles import machine_id
     from .reports.frame import load as load_frame
@@ -406,9 +407,14 @@ def cmd_advise(args) -> int:
         raise NoResults(f"no stored runs in {results}: run `pcabench study --front` first, "
                         "or use --reference")
     machines = df.machine.value_counts()
-    machine = args.machine or (machine_id() if machine_id() in machines else machines.index[0])
-    if machine not in machines:
-        raise OptionError(f"--machine {machine!r}: the stores hold {', '.join(machines.index)}")
+    if args.machine:
+        named = runs.machines(machines.index, args.machine)  # a machine's name, or a prefix of one
+        if len(named) != 1:
+            why = f"names {', '.join(named)}" if named else f"is none of {', '.join(sorted(machines.index))}"
+            raise OptionError(f"--machine {args.machine!r} {why}: give one machine (or a prefix of one)")
+        machine = named[0]
+    else:
+        machine = machine_id() if machine_id() in machines else machines.index[0]
     out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain)}
     if args.json:
         print(json.dumps(out, sort_keys=True, default=str))

@@ -73,3 +73,16 @@ def test_advise_command_json_and_what_no_run_reaches(results, capsys):
     assert rc == 1 and "none of the 0 stored runs" in out and "pcabench study" in out
     rc, out, err = cli_main("advise", "--error", "2", "--results", str(results), capsys=capsys)
     assert rc == 2 and "--error" in err and "Traceback" not in err
+
+
+def test_advise_takes_a_machine_prefix_as_runs_does(results, capsys):
+    other = results / store.store_name("mach-two", "h")
+    for r in store.read_rows(results):
+        store.append(dict(r, profile_id="mach-two", run_id=r["run_id"] + "-2"), other)
+    for given, meant in (("mach", "mach-two"), ("m", "m")):  # a prefix of one machine; an exact name wins
+        rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", given,
+                                "--json", capsys=capsys)
+        assert rc == 0 and json.loads(out)["machine"] == meant, err
+    rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", "zz",
+                            capsys=capsys)
+    assert rc == 2 and "--machine 'zz'" in err and len(err.strip().splitlines()) == 1
