@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import json
 import sys
+import warnings
+
+from solvers.registry import PluginWarning
 
 from .profiles import machine_id
 from .progress import Progress
@@ -27,6 +30,7 @@ def run_spec(spec: RunSpec) -> dict:
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    warnings.filterwarnings("ignore", category=PluginWarning)  # the sweep (the parent) said it once
     print(json.dumps(run_spec(RunSpec.from_json(argv[0])), sort_keys=True), flush=True)
     return 0
 

@@ -294,6 +294,7 @@ def cmd_study(args) -> int:
         specs = [bounded_spec(spec) for spec in specs]
     else:
         specs = check_specs(specs)
+    specs = list(dict.fromkeys(specs))  # resolved, two specs may be one run (auto is list here): counted once
     run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
@@ -595,11 +596,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
     shown = warnings.formatwarning
     warnings.formatwarning = lambda message, *_, **__: f"pcabench: warning: {message}\n"  # one line each
     try:
+        parser = build_parser()  # finds the solvers: a plug-in left out is one warning line
+        args = parser.parse_args(argv)
         return args.func(args)
     except (SceneError, OptionError, StoreError) as exc:
         parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {exc}\n")

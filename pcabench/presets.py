@@ -159,17 +159,25 @@ def matrix(solvers=(DEFAULT_SOLVER,), dxs=(), threads=(SERIAL,), steps=(None,), 
 
     ``scene_lists`` maps Scene parameters (precision, model, integrator, cfl,
     h_factor, cutoff_factor, kernel) to lists; a parameter not given keeps Scene's
-    default. ``steps`` and ``t_ends`` are lists too (give one of them; neither
-    means the paper's 100 steps).
+    default. ``steps`` and ``t_ends`` are lists too (give one of them; neither means the paper's 100
+    steps). A pair loop or thread count that some solver of the matrix has is given to those that have it
+    (the others run their own loop, serially); one that none has is bad input, named by the solver's
+    check. A run the product names twice is listed once.
     """
     names = sorted(scene_lists)
     ends = [{"steps": n} for n in steps if n is not None] + [{"t_end": t} for t in t_ends if t is not None] or [{}]
+    classes = [solver_class(name) for name in solvers]
+    offered_loops = {loop for cls in classes for loop in cls.pair_loops}
+    any_threaded = any(cls.threaded for cls in classes)
     runs = []
     for solver, dx, nthreads, loop, end, *values in itertools.product(
             solvers, sorted(dxs, reverse=True), threads, pair_loops, ends, *(scene_lists[k] for k in names)):
         scene = dict(zip(names, values), dx=dx, **end)
-        if len(solver_class(solver).pair_loops) == 1:
-            loop = "auto"  # a solver with one pair loop runs it whatever the matrix asks
+        cls = solver_class(solver)
+        if loop not in cls.pair_loops and loop in offered_loops:
+            loop = "auto"  # a loop another solver of the matrix has: this one runs its own
+        if nthreads != SERIAL and not cls.threaded and any_threaded:
+            nthreads = SERIAL  # threads another solver of the matrix uses: this one runs serially
         spec = _spec(solver, threads=nthreads, strip=strip, pair_loop=loop, **scene)
         runs.append(RunSpec(spec.solver, spec.scene, spec.threads, "matrix", spec.pair_loop))
-    return runs
+    return list(dict.fromkeys(runs))

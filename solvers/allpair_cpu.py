@@ -49,6 +49,7 @@ class AllPairCPU(Solver):
     summary = "every pair tested (the paper's all-pair search), serial"
     pair_loops = ("all-pairs",)
     pair_loop = "all-pairs"
+    search = "all-pair"
     order = 2.0
 
     def snp(self) -> None:

@@ -73,6 +73,8 @@ class Solver(abc.ABC):
     pair_loops: tuple = ("gather",)  # how it can visit pairs (gather, list, all-pairs); the first is its default
     threaded: bool = False  # runs on more than one CPU thread (--threads N|all); else serial
     serial_why: str = "as in the paper"  # why a serial solver is serial, for the one-line refusal
+    search: str = "linked list"  # the neighbour search in the paper's words (linked list, all-pair): the reports
+    # set the paper's numbers only beside the same search
     order: float = 1.0  # step time ~ N^order (1: a cell list; 2: every pair tested): the predictor's prior
     resources: dict = {"timing": 1}  # what one run takes on a Dask worker: one timed run per worker at a time
     xp = np

@@ -12,8 +12,9 @@ Two places are searched, once per process:
   once installed, the solver appears in ``pcabench run --solver``, studies,
   reports, asv and pytest-benchmark with no edit to pcabench.
 
-Names are unique: an entry point that repeats a built-in name, or does not
-name a Solver subclass, is left out with one warning.
+Names are unique: an entry point that repeats a taken name, does not load, or
+does not name a Solver subclass with a ``name`` of its own is left out with one
+:class:`PluginWarning`.
 """
 from __future__ import annotations
 
@@ -61,20 +62,33 @@ def _builtin() -> list[type[Solver]]:
     return found
 
 
+class PluginWarning(UserWarning):
+    """A plug-in solver left out, or registered under another name than its entry point's."""
+
+
 def _plugins(taken: set) -> list[type[Solver]]:
     found = []
     for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
         where = f"entry point {entry.name!r} of group {ENTRY_POINT_GROUP} ({entry.value})"
+
+        def warn(what: str, where: str = where) -> None:
+            warnings.warn(f"{where}{what}", PluginWarning, stacklevel=3)
+
         try:
             cls = entry.load()
         except Exception as exc:  # noqa: BLE001 - a broken plug-in must not take pcabench down
-            warnings.warn(f"{where} left out: it does not load ({type(exc).__name__}: {exc})", stacklevel=2)
+            warn(f" left out: it does not load ({type(exc).__name__}: {exc})")
             continue
-        if not (inspect.isclass(cls) and issubclass(cls, Solver) and cls.name) or inspect.isabstract(cls):
-            warnings.warn(f"{where} left out: not a concrete Solver subclass with a name", stacklevel=2)
+        if not (inspect.isclass(cls) and issubclass(cls, Solver)) or inspect.isabstract(cls):
+            warn(" left out: not a concrete Solver subclass")
+        elif not cls.__dict__.get("name"):  # a subclass of a built-in inherits its name: not its own
+            warn(" left out: the class sets no name of its own" + (f" (it would inherit {cls.name!r})"
+                                                                    if cls.name else ""))
         elif cls.name in taken:
-            warnings.warn(f"{where} left out: the solver name {cls.name!r} is taken", stacklevel=2)
+            warn(f" left out: the solver name {cls.name!r} is taken")
         else:
+            if entry.name != cls.name:
+                warn(f": registered as {cls.name!r}, its class's name")
             found.append(cls)
             taken.add(cls.name)
     return found
@@ -104,7 +118,9 @@ def check_pair_loop(name: str, requested: str) -> None:
     """SceneError unless solver ``name`` offers ``requested`` (or it is ``auto``)."""
     offered = solver_class(name).pair_loops
     if requested != "auto" and requested not in offered:
-        raise SceneError(f"pair_loop: {name} offers auto, {', '.join(offered)} (got {requested!r})")
+        has = f"one pair loop, {offered[0]}: give auto" if len(offered) == 1 else \
+            f"the pair loops {', '.join(offered)}: give one of them or auto"
+        raise SceneError(f"--pair-loop: {name} has {has} (got {requested!r})")
 
 
 def resolve_pair_loop(name: str, scene, requested: str = "auto") -> str:

@@ -27,11 +27,16 @@ from solvers.interface import Solver
 ROOT = Path(__file__).resolve().parents[1]
 
 
+NAME = "readme-argsort"  # the README's solver under a name no user's installed copy of it can hold
+
+
 def readme_example() -> str:
-    """The plug-in module of the README's section "Add your own solver"."""
+    """The plug-in module of the README's section "Add your own solver" (named :data:`NAME`)."""
     text = (ROOT / "README.md").read_text()
     section = text[text.index("### Add your own solver"):]
-    return re.search(r"```python\n# argsort_solver.py\n(.*?)```", section, re.S).group(1)
+    code = re.search(r"```python\n# argsort_solver.py\n(.*?)```", section, re.S).group(1)
+    assert 'name = "argsort-cpu"' in code
+    return code.replace('name = "argsort-cpu"', f'name = "{NAME}"')
 
 
 def install(site: Path, module: str, source: str, entries: dict) -> Path:
@@ -77,36 +82,43 @@ def test_finding_the_solvers_touches_no_gpu_library():
 
 
 def test_the_readme_plugin_is_found_and_matches_the_paper_cell_list_bit_for_bit(site, tmp_path):
-    install(site, "argsort_solver", readme_example(), {"argsort-cpu": "argsort_solver:ArgsortCellList"})
-    assert "argsort-cpu" in solvers.solver_names()
+    install(site, "argsort_solver", readme_example(), {NAME: "argsort_solver:ArgsortCellList"})
+    assert NAME in solvers.solver_names()
     fields = {}
-    for name in ("argsort-cpu", "linkedlist-cpu"):
+    for name in (NAME, "linkedlist-cpu"):
         path = tmp_path / f"{name}.npz"
         spec = RunSpec(name, Scene(dx=0.5, steps=20, model="lagrangian"), pair_loop="gather")
         record = run(spec, fields_path=path)
         assert record.status == "ok" and record.solver == name and record.pair_loop == "gather"
         fields[name] = np.load(path)
     for key in ("x", "y", "u", "v", "drho"):  # the same stable order by cell: the same sums
-        np.testing.assert_array_equal(fields["argsort-cpu"][key], fields["linkedlist-cpu"][key])
+        np.testing.assert_array_equal(fields[NAME][key], fields["linkedlist-cpu"][key])
+
+
+BROKEN = ("import numpy\nfrom solvers.linkedlist_cpu import LinkedListCPU\nNOT_A_SOLVER = 1\n\n\n"
+          "class NoName(LinkedListCPU):\n    pass\n\n\nclass Renamed(LinkedListCPU):\n    name = 'renamed-cpu'\n")
+BROKEN_ENTRIES = {"nothing": "broken_solver:NOT_A_SOLVER", "missing": "broken_solver:Absent",
+                  "linkedlist-cpu": "solvers.allpair_cpu:AllPairCPU", "noname": "broken_solver:NoName",
+                  "other-key": "broken_solver:Renamed"}
 
 
 def test_a_broken_or_clashing_plugin_is_left_out_with_one_warning(site):
-    install(site, "broken_solver", "import numpy\nNOT_A_SOLVER = 1\n",
-            {"nothing": "broken_solver:NOT_A_SOLVER", "missing": "broken_solver:Absent",
-             "linkedlist-cpu": "solvers.allpair_cpu:AllPairCPU"})
+    install(site, "broken_solver", BROKEN, BROKEN_ENTRIES)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         found = registry()
-    messages = [str(w.message) for w in caught]
-    assert set(found) == {"allpair-cpu", "linkedlist-cpu", "linkedlist-gpu"}
+    mine = [str(w.message) for w in caught if "broken_solver" in str(w.message) or "allpair_cpu" in str(w.message)]
+    assert not {"nothing", "missing", "noname", "other-key"} & set(found) and "renamed-cpu" in found
     assert found["linkedlist-cpu"].__name__ == "LinkedListCPU"  # a plug-in never replaces a built-in
-    assert len(messages) == 3 and all("left out" in m for m in messages), messages
-    assert any("is taken" in m for m in messages) and any("does not load" in m for m in messages)
+    assert len(mine) == 5, mine
+    for words in ("does not load", "not a concrete Solver subclass", "is taken",
+                  "no name of its own (it would inherit 'linkedlist-cpu')", "registered as 'renamed-cpu'"):
+        assert sum(words in m for m in mine) == 1, (words, mine)
 
 
 def test_a_plugin_runs_through_run_a_study_a_report_and_the_benchmarks(tmp_path):
-    site = install(tmp_path / "site", "argsort_solver", readme_example(),
-                   {"argsort-cpu": "argsort_solver:ArgsortCellList"})
+    site = install(tmp_path / "site", "argsort_solver", readme_example(), {NAME: "argsort_solver:ArgsortCellList"})
+    install(site, "broken_solver", BROKEN, {"missing": "broken_solver:Absent"})  # one broken plug-in beside it
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)]),
            "PCABENCH_HOME": str(tmp_path / "home")}
 
@@ -114,19 +126,28 @@ def test_a_plugin_runs_through_run_a_study_a_report_and_the_benchmarks(tmp_path)
         return subprocess.run([sys.executable, "-m", "pcabench.cli", *args], capture_output=True, text=True,
                               env=env, cwd=tmp_path, timeout=600)
 
-    assert "argsort-cpu" in cli("run", "--help").stdout  # in --solver's choices and the solvers' help
-    out = cli("run", "--solver", "argsort-cpu", "--dx", "1", "--steps", "5", "--json")
+    helped = cli("run", "--help")
+    assert NAME in helped.stdout  # in --solver's choices and the solvers' help
+    assert helped.stderr.splitlines() == [  # the broken one: one line, no source line
+        f"pcabench: warning: entry point 'missing' of group {ENTRY_POINT_GROUP} (broken_solver:Absent) left out: "
+        "it does not load (AttributeError: module 'broken_solver' has no attribute 'Absent')"]
+    out = cli("run", "--solver", NAME, "--dx", "1", "--steps", "5", "--json")
     assert out.returncode == 0, out.stderr
-    assert json.loads(out.stdout)["solver"] == "argsort-cpu"
-    refused = cli("run", "--solver", "argsort-cpu", "--dx", "1", "--threads", "2")
-    assert refused.returncode == 2 and "argsort-cpu is serial" in refused.stderr
+    assert json.loads(out.stdout)["solver"] == NAME
+    for option, words in ((("--threads", "2"), f"{NAME} is serial"), (("--pair-loop", "list"), "--pair-loop: ")):
+        refused = cli("run", "--solver", NAME, "--dx", "1", *option)
+        assert refused.returncode == 2 and words in refused.stderr.splitlines()[-1], refused.stderr
     results, reports = tmp_path / "results", tmp_path / "reports"
-    out = cli("study", "--solver", "argsort-cpu", "linkedlist-cpu", "--pair-loop", "gather", "--dx", "1", "0.5",
-              "--steps", "5", "--results", str(results), "--reports", str(reports))
+    # the matrix: the plug-in takes the loop and thread count it has; each run once
+    out = cli("study", "--solver", NAME, "linkedlist-cpu", "--pair-loop", "list", "gather", "--threads", "1", "2",
+              "--dx", "1", "--steps", "5", "--results", str(results), "--reports", str(reports))
     assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stderr.count("left out") == 1  # said once, by the sweep, not again by each run's process
     rows = [json.loads(line) for f in results.glob("*.jsonl") for line in f.read_text().splitlines()]
-    assert {r["solver"] for r in rows} == {"argsort-cpu", "linkedlist-cpu"} and all(r["status"] == "ok" for r in rows)
-    assert "argsort-cpu" in "".join(p.read_text() for p in reports.rglob("report.md"))
+    assert sorted((r["solver"], r["pair_loop"], r["threads"]) for r in rows) == sorted(
+        [(NAME, "gather", 1)] + [("linkedlist-cpu", loop, n) for loop in ("list", "gather") for n in (1, 2)])
+    assert all(r["status"] == "ok" for r in rows) and "5 runs on" in out.stderr
+    assert NAME in "".join(p.read_text() for p in reports.rglob("report.md"))
     code = "from benchmarks.common import solver_names; print(' '.join(solver_names('cpu')))"
     names = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=ROOT)
-    assert "argsort-cpu" in names.stdout.split(), names.stderr
+    assert NAME in names.stdout.split(), names.stderr

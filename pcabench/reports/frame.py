@@ -50,9 +50,8 @@ def _flat(row: dict) -> dict:
     # linked list's loop before the pair list, and the GPU's, was the paper's gather loop)
     cls = registry().get(str(row.get("solver", "")))
     r["device"] = row.get("device") or (cls.device if cls else "cpu")
-    all_pairs = r["pair_loop"] == "all-pairs" or (cls is not None and cls.pair_loops == ("all-pairs",))
-    r["search"] = "all-pair" if all_pairs else "linked list"
-    r["loop"] = r["pair_loop"] or ("all-pairs" if all_pairs else "gather")
+    r["search"] = cls.search if cls else "all-pair" if r["pair_loop"] == "all-pairs" else "linked list"
+    r["loop"] = r["pair_loop"] or ("all-pairs" if r["search"] == "all-pair" else "gather")
     return r
 
 
