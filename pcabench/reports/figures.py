@@ -234,7 +234,7 @@ def fig10(series, out: Path, pid: str):
             for s in (s for s in series if s["run"] == run):
                 c = (s["config"], s["loop"], s["threads"])
                 ax.plot(s["N"], s["ms"], marker=PRECISION_MARKER[s["precision"]], color=colours[c],
-                        label=f"{s['config']}, {s['loop']}, {s['threads']} thread{'s' if s['threads'] > 1 else ''}")
+                        label=f"{s['config']}, {s['loop']}, {T.where(s['threads'], s['device'])}")
             ax.set_title(f"runs to t = {run[4:]}" if run.startswith("t =") else f"runs of {run}", fontsize=9)
             if ("cpu", "linked list") in kinds:
                 cpu = [r for r in P.step_times() if (r["system"], r["device"], r["search"]) ==

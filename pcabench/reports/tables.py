@@ -32,12 +32,16 @@ def label(r) -> str:
     return f"{r['solver']} {r['precision']}"
 
 
+def where(threads, device: str) -> str:
+    """What ran the pairs: ``GPU``, or the CPU threads (``1 thread``, ``2 threads``)."""
+    threads = int(threads)
+    return "GPU" if device == "gpu" else f"{threads} thread{'s' if threads > 1 else ''}"
+
+
 def protocol(r) -> str:
     """How a run was timed: its length (steps or t), domain, pair loop and CPU threads (or GPU), e.g.
     ``20 steps, full, gather, 1 thread``."""
-    threads = int(r["threads"])
-    where = "GPU" if r["device"] == "gpu" else f"{threads} thread{'s' if threads > 1 else ''}"
-    return f"{r['protocol']}, {r['domain']}, {r['loop']}, {where}"
+    return f"{r['protocol']}, {r['domain']}, {r['loop']}, {where(r['threads'], r['device'])}"
 
 
 def latest(df: pd.DataFrame) -> pd.DataFrame:
@@ -454,7 +458,7 @@ def simplifications(df) -> list[dict]:
             ctx = dict(zip(keys, key))
             rows.append({"simplification": what,
                          "runs": " ".join(str(ctx[k]) for k in ("solver", "model", "precision", "domain", "protocol")
-                                          if k in ctx) + f", {ctx['loop']}, {ctx['threads']} thread(s)",
+                                          if k in ctx) + f", {ctx['loop']}, {where(ctx['threads'], a.device)}",
                          "dx": ctx["dx"], "N": (int(a.n_particles), int(b.n_particles)),
                          "seconds": (a.t_solution, b.t_solution), "speedup": a.t_solution / b.t_solution,
                          "mse": (a.mse, b.mse)})
