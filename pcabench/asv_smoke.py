@@ -12,7 +12,6 @@ hold) whose results folder is a scratch one; the README, ``.ci/run`` and
 """
 from __future__ import annotations
 
-import argparse
 import json
 import subprocess
 import sys
@@ -41,16 +40,13 @@ def scratch_config(results: Path, root: Path = ROOT, name: str = "smoke") -> Pat
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m pcabench.asv_smoke", description=__doc__.split("\n")[0])
+    from .cli import Parser  # the command line's parser: a usage error is one line, exit code 2
+
+    p = Parser(prog="python -m pcabench.asv_smoke", description=__doc__.split("\n")[0])
     p.add_argument("--machine", help="asv's machine name (default: `pcabench profile --asv`, which writes it)")
     p.add_argument("--results", type=Path, default=SCRATCH,
                    help=f"the scratch results folder (default {SCRATCH}, git-ignored)")
     p.add_argument("--check", action="store_true", help="run `asv check` first")
-    def error(message):  # one line naming the option, no usage block
-        print(f"asv_smoke: error: {message}", file=sys.stderr)
-        sys.exit(2)
-
-    p.error = error
     args = p.parse_args(argv)
     if args.results.resolve().is_relative_to((ROOT / "reports").resolve()):
         print(f"asv_smoke: error: --results {args.results}: under reports/, where the committed results are; "

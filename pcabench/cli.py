@@ -124,6 +124,20 @@ def threads_option(text):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def add_method_options(p: argparse.ArgumentParser, many: bool = False) -> None:
+    """The numerical method's options (integrator, kernel, cutoff, h/dx, CFL), with Scene's defaults."""
+    n = {"nargs": "+"} if many else {}
+    d = Scene.default
+    p.add_argument("--integrator", choices=INTEGRATORS, **n, help=f"default {d('integrator')}")
+    p.add_argument("--kernel", choices=KERNELS, **n,
+                   help=f"SPH kernel (default {d('kernel')}, truncated at --cutoff; the Wendland kernels are cut "
+                        f"at their compact support 2h)")
+    p.add_argument("--cutoff", type=number("--cutoff"), **n,
+                   help=f"the Gaussian's cutoff in units of h (default {d('cutoff_factor'):g})")
+    p.add_argument("--h-factor", type=number("--h-factor"), **n, help=f"h / dx (default {d('h_factor'):g})")
+    p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
+
+
 def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     """The scene's options, with Scene's defaults; ``many``: each takes a list (a study's matrix)."""
     n = {"nargs": "+"} if many else {}
@@ -135,14 +149,7 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     end.add_argument("--steps", type=positive_int("--steps"), **n, help="number of steps (default 100, the paper's)")
     end.add_argument("--t-end", type=number("--t-end"), **n, help="physical end time, s")
     p.add_argument("--model", choices=MODELS, **n, help=f"default {d('model')}")
-    p.add_argument("--integrator", choices=INTEGRATORS, **n, help=f"default {d('integrator')}")
-    p.add_argument("--kernel", choices=KERNELS, **n,
-                   help=f"SPH kernel (default {d('kernel')}, truncated at --cutoff; the Wendland kernels are cut "
-                        f"at their compact support 2h)")
-    p.add_argument("--cutoff", type=number("--cutoff"), **n,
-                   help=f"the Gaussian's cutoff in units of h (default {d('cutoff_factor'):g})")
-    p.add_argument("--h-factor", type=number("--h-factor"), **n, help=f"h / dx (default {d('h_factor'):g})")
-    p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
+    add_method_options(p, many)
     threaded = ", ".join(name for name, cls in registry().items() if cls.threaded)
     loops = {name: cls.pair_loops for name, cls in registry().items() if len(cls.pair_loops) > 1}
     p.add_argument("--threads", type=threads_option, **n,
@@ -548,12 +555,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "with no simulation (for fixed and lagrangian: their linear part).")
     p.add_argument("--dx", type=number("--dx"), required=True, help="lattice spacing, m")
     p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical end time, s (default 10)")
-    p.add_argument("--kernel", choices=KERNELS, help="default gaussian")
-    p.add_argument("--h-factor", type=number("--h-factor"), help=f"h / dx (default {Scene.default('h_factor'):g})")
-    p.add_argument("--cutoff", type=number("--cutoff"),
-                   help=f"Gaussian cutoff in units of h (default {Scene.default('cutoff_factor'):g})")
-    p.add_argument("--cfl", type=number("--cfl"), help=f"dt * c0 / dx (default {Scene.default('cfl'):g})")
-    p.add_argument("--integrator", choices=INTEGRATORS, help=f"default {Scene.default('integrator')}")
+    add_method_options(p)
     p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")
     p.set_defaults(func=cmd_accuracy)
 

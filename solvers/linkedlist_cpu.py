@@ -97,12 +97,12 @@ class LinkedListCPU(CellListSolver):
         if self.threads > 1:  # the count is decided: numba's pool set once here, not on every launch
             use_threads(self.threads, decided=True)
 
-    @staticmethod
-    def list_fits(scene) -> bool:
+    @classmethod
+    def list_fits(cls, scene) -> bool:
         """Whether the particle arrays and the pair list fit in the scene's memory limit (a scene that
         states none: they do; the harness gives every scene the memory available before it resolves ``auto``)."""
         limit = scene.memory_limit()
-        return limit is None or scene.memory_bytes() + pairlist.list_bytes(scene) <= limit
+        return limit is None or cls.memory_bytes(scene, "list") <= limit
 
     @classmethod
     def memory_bytes(cls, scene, pair_loop: str = "auto") -> int:
