@@ -72,3 +72,27 @@ class TrackStageShare:
                 seconds[s].append(time.perf_counter() - t0)
         median = {s: float(np.median(v)) for s, v in seconds.items()}
         return 100 * median[stage] / sum(median.values())
+
+
+class TrackSceneError:
+    """Each scene's primary error at t = 10 s, linear model, Verlet, the paper's method: the plane pulse on a
+    strip at dx 0.4 (u), the 2D acoustic pulse on its 40 m periodic square at dx 0.5 (drho). A change that
+    breaks one scene's accuracy shows across commits; commits before the scene registry skip."""
+
+    params = [["plane-pulse", "acoustic-pulse"]]
+    param_names = ["scene"]
+    unit = "relative RMS"
+    timeout = 300
+
+    def setup(self, scene):
+        try:
+            self.scene = Scene(dx=0.4, t_end=10.0, model="linear", strip_height=thinnest_strip(0.4)) \
+                if scene == "plane-pulse" else Scene(dx=0.5, t_end=10.0, model="linear", name=scene)
+        except TypeError:  # a commit before the scene registry
+            raise NotImplementedError(f"no scene {scene} at this commit") from None
+
+    def track_scene_error(self, scene):
+        record = run(self.scene, "linkedlist-cpu")
+        if record.status != "ok":
+            raise RuntimeError(f"{record.status}: {record.message}")
+        return record.mse

@@ -38,6 +38,10 @@ def command(r, t_end: float) -> str:
     """The ``pcabench run`` command line that reproduces stored run ``r``."""
     s = scene_of(r)
     parts = [f"pcabench run --solver {r['solver']} --dx {s['dx']:g} --t-end {t_end:g} --model {r['model']}"]
+    if r.get("scene", Scene.default("name")) != Scene.default("name"):
+        parts.append(f"--scene {r['scene']}")
+    if "mach" in r and not np.isclose(float(r["mach"]), Scene.default("mach")):
+        parts.append(f"--mach {float(r['mach']):g}")
     for option, key in (("--kernel", "kernel"), ("--h-factor", "h_factor"), ("--cutoff", "cutoff_factor"),
                         ("--cfl", "cfl"), ("--integrator", "integrator")):
         value = s[key]
@@ -71,7 +75,8 @@ def paper_configuration(df):
     return d[d["kernel"].fillna("gaussian") == "gaussian"] if "kernel" in d else d
 
 
-def advise(df, error: float, t_end: float, model: str = "linear", domain: str | None = None) -> dict:
+def advise(df, error: float, t_end: float, model: str = "linear", domain: str | None = None,
+           scene: str = Scene.default("name")) -> dict:
     """The fastest stored run reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``, if given),
     the fastest run of the paper's configuration reaching it that compares with it, and the ratio. Like is
     compared with like (``tables.comparable``): the same kind of domain (a strip holds fewer particles than
@@ -86,7 +91,9 @@ def advise(df, error: float, t_end: float, model: str = "linear", domain: str | 
            "error_against": "the isothermal solution" if column == "mse_isothermal" else "the linear pulse"}
     if hits.empty:
         out["found"] = False
-        out["suggestion"] = suggest(error, t_end, model)
+        out["suggestion"] = suggest(error, t_end, model) if scene == Scene.default("name") else {
+            "note": f"no prediction search for the {scene} scene yet: run its front",
+            "paper_dx": None, "smallest_dx_searched": None, "front": f"pcabench study --front --scene {scene}"}
         return out
     best = hits.iloc[0]
     scene = Scene(t_end=t_end, model=model, memory_limit_bytes=2**62,

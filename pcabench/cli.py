@@ -24,6 +24,7 @@ import warnings
 from pathlib import Path
 
 from solvers import (
+    DEFAULT_SCENE,
     DEFAULT_SOLVER,
     INTEGRATORS,
     KERNELS,
@@ -33,6 +34,9 @@ from solvers import (
     SceneError,
     SolverUnavailable,
     registry,
+    scene_kind,
+    scene_names,
+    scenes,
 )
 
 from . import __version__, memory, paths
@@ -138,10 +142,27 @@ def add_method_options(p: argparse.ArgumentParser, many: bool = False) -> None:
     p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
 
 
+def add_problem_options(p: argparse.ArgumentParser, many: bool = False) -> None:
+    """The problem's options: the scene kind and its physical parameters, with Scene's defaults."""
+    n = {"nargs": "+"} if many else {}
+    d = Scene.default
+    p.add_argument("--scene", choices=scene_names(), **n,
+                   help=f"the problem (default {DEFAULT_SCENE}): " + "; ".join(
+                       f"{name}: {kind.summary}" for name, kind in scenes().items()))
+    p.add_argument("--mach", type=number("--mach"), **n, help=f"the pulse's amplitude as a Mach number "
+                   f"(default {d('mach'):g})")
+    p.add_argument("--pulse-width", type=number("--pulse-width"), **n,
+                   help=f"the pulse's width, m (default {d('pulse_width'):g})")
+    if not many:
+        p.add_argument("--domain-size", type=number("--domain-size"),
+                       help="side of a square scene's domain, m (acoustic-pulse: default 40)")
+
+
 def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     """The scene's options, with Scene's defaults; ``many``: each takes a list (a study's matrix)."""
     n = {"nargs": "+"} if many else {}
     d = Scene.default
+    add_problem_options(p, many)
     p.add_argument("--dx", type=number("--dx"), required=not many, **n,
                    help="lattice spacing, m (paper: 1 .. 0.004; 0.1 is 100K particles)")
     p.add_argument("--precision", choices=PRECISIONS, **n, help=f"default {d('precision')}")
@@ -162,15 +183,27 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
 
 
 SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
-                 "kernel": "kernel", "h_factor": "h_factor", "cfl": "cfl"}
-ACCURACY_OPTIONS = {opt: key for opt, key in SCENE_OPTIONS.items() if opt not in ("precision", "model")}  # the method
+                 "kernel": "kernel", "h_factor": "h_factor", "cfl": "cfl", "scene": "name", "mach": "mach",
+                 "pulse_width": "pulse_width"}
+# the method and the problem
+ACCURACY_OPTIONS = {opt: key for opt, key in SCENE_OPTIONS.items() if opt not in ("precision", "model")}
+
+
+def domain_of(args) -> dict:
+    """The domain ``--domain-size`` asks for (nothing when not given), for the scene named."""
+    if getattr(args, "domain_size", None) is None:
+        return {}
+    try:
+        return scene_kind(args.scene or DEFAULT_SCENE).sized_domain(args.domain_size)
+    except ValueError as exc:
+        raise OptionError(str(exc)) from None
 
 
 def scene_from_args(args) -> Scene:
     """The scene of the options, bounded by the memory this process may use (one line if it does not fit)."""
     given = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt) is not None}
     return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height,
-                 memory_limit_bytes=memory.available_memory_bytes(), **given)
+                 memory_limit_bytes=memory.available_memory_bytes(), **given, **domain_of(args))
 
 
 def check_output_path(path, option: str) -> None:
@@ -230,6 +263,8 @@ def cmd_run(args) -> int:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
         out["kernel"] = scene.kernel
+        out["scene"] = scene.name
+        out["errors"] = record.errors
         out["mse_isothermal"] = record.mse_isothermal
         out["message"] = record.message
         print(json.dumps(to_row(out), allow_nan=False))  # standard JSON: null, never NaN
@@ -239,10 +274,13 @@ def cmd_run(args) -> int:
         print(f"steps            {record.steps} (t = {record.t_end:.6g} s)")
         print(f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)")
         print(f"mean neighbours  {record.mean_neighbours:.2f}")
-        print(f"MSE (rel. RMS)   {record.mse:.6g}")
-        print(f"ME (max, m/s)    {record.me:.6g}")
+        primary = scene.kind.primary
+        print(f"MSE (rel. RMS)   {record.mse:.6g}" + ("" if primary == "u" else f" of {primary}"))
+        print(f"ME (max)         {record.me:.6g} {'m/s' if primary == 'u' else 'kg/m^3' if primary == 'drho' else ''}")
+        for name, value in record.errors.items():
+            print(f"{name.replace('_', ' '):<17}{value:.6g}")
         if record.mse_isothermal is not None:
-            print(f"MSE against the isothermal solution (lagrangian's own limit) {record.mse_isothermal:.6g}")
+            print(f"MSE against the isothermal solution (the equations lagrangian solves) {record.mse_isothermal:.6g}")
         print(f"status           {record.status}"
               + (f" at step {record.failed_step}" if record.failed_step else ""))
         if record.message:
@@ -259,12 +297,15 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
         return "matrix", matrix(args.solver or [DEFAULT_SOLVER], args.dx, threads=args.threads or [SERIAL],
                                 steps=args.steps or [None], t_ends=args.t_end or [None], strip=args.strip,
                                 pair_loops=args.pair_loop or ["auto"], **lists)
-    if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")) \
-            or args.strip:
+    scene = args.scene or [DEFAULT_SCENE]
+    if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")
+           if opt != "scene") or args.strip:
         raise OptionError("--dx is needed to build a matrix from the scene options (or use a preset alone)")
     name = "paper" if args.paper else "stability" if args.stability else \
         {None: "quick", "quick": "front", "full": "front-full"}[args.front]
-    return name, preset(name)
+    if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not name.startswith("front")):
+        raise OptionError("--scene with a preset: one scene, with --front (the other presets are the paper's scene)")
+    return name, preset(name, scene[0])
 
 
 def bounded_spec(spec: RunSpec) -> RunSpec:
@@ -351,7 +392,7 @@ def cmd_report(args) -> int:
         results, reports = results or paths.reference_results(), reports or paths.reference_reports()
     results, reports = results or paths.user_results(), reports or paths.user_reports()
     check_folder(reports, "--out" if args.out else "--reference" if args.reference else home_option())
-    for p in write_reports(Path(results), Path(reports)):
+    for p in write_reports(Path(results), Path(reports), scene=args.scene):
         print(f"wrote {p}", file=sys.stderr)
     return 0
 
@@ -368,6 +409,8 @@ def cmd_runs(args) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("default")
         df = load(results)
+    if args.scene and not df.empty:
+        df = df[df.scene == args.scene]
     with pd.option_context("display.max_columns", None, "display.width", 200):
         if args.compare:
             try:
@@ -386,18 +429,23 @@ def cmd_accuracy(args) -> int:
     from solvers.dispersion import predict
 
     given = {key: getattr(args, opt) for opt, key in ACCURACY_OPTIONS.items() if getattr(args, opt) is not None}
-    scene = Scene(dx=args.dx, t_end=args.t_end, model="linear", memory_limit_bytes=2**62, **given)
+    scene = Scene(dx=args.dx, t_end=args.t_end, model="linear", memory_limit_bytes=2**62, **given, **domain_of(args))
     p = predict(scene)
     if args.json:
         print(json.dumps({"scene": scene.as_dict(), **p.as_dict()}, sort_keys=True))
         return 0
     print(f"{scene.describe()}\n"
-          f"predicted relative RMS error of u at t = {p.t_end:.4g} s: {p.predicted_error:.4g} (max error "
-          f"{p.predicted_me:.3g} m/s)\n"
+          f"predicted relative RMS error of {scene.kind.primary} at t = {p.t_end:.4g} s: {p.predicted_error:.4g} "
+          f"(max error {p.predicted_me:.3g} {'m/s' if scene.kind.primary == 'u' else 'kg/m^3'})\n"
           f"largest stable CFL (dt c0 / dx) for {scene.integrator}: {p.stable_cfl:.4g}"
           f"{' (grows at any step)' if p.stable_cfl == 0 else ''}\n"
           f"phase speed error at k = 1/w: lattice {100 * p.lattice_phase_error:+.3f} %, with the step "
-          f"{100 * p.step_phase_error:+.3f} %")
+          f"{100 * p.step_phase_error:+.3f} %"
+          + ("" if p.lattice_phase_error_diagonal is None else
+             f" along the lattice's axis; along its diagonal {100 * p.lattice_phase_error_diagonal:+.3f} % and "
+             f"{100 * p.step_phase_error_diagonal:+.3f} %"))
+    for name, value in (p.measures or {}).items():
+        print(f"predicted {name.replace('_', ' ')}: {value:.4g}")
     return 0
 
 
@@ -411,9 +459,16 @@ def cmd_advise(args) -> int:
         raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
     results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
     df = load_frame(results) if results is not None and Path(results).exists() else None
+    if df is not None and not df.empty:
+        import numpy as np
+
+        mach = Scene.default("mach") if args.mach is None else args.mach
+        df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach)]
     if df is None or df.empty:
-        raise NoResults(f"no stored runs in {results}: run `pcabench study --front` first, "
-                        "or use --reference")
+        raise NoResults(f"no stored runs of the {args.scene} scene at --mach "
+                        f"{Scene.default('mach') if args.mach is None else args.mach:g} in {results}: run "
+                        f"`pcabench study --front{'' if args.scene == DEFAULT_SCENE else ' --scene ' + args.scene}` "
+                        "first, or use --reference")
     machines = df.machine.value_counts()
     if args.machine:
         named = runs.machines(machines.index, args.machine)  # a machine's name, or a prefix of one
@@ -423,16 +478,22 @@ def cmd_advise(args) -> int:
         machine = named[0]
     else:
         machine = machine_id() if machine_id() in machines else machines.index[0]
-    out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain)}
+    out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain,
+                                        args.scene)}
     if args.json:
         print(json.dumps(out, sort_keys=True, default=str))
         return 0
-    head = (f"{args.model} to a relative RMS error of u <= {args.error:g} (against {out['error_against']}) at "
+    primary = scene_kind(args.scene).primary
+    head = (f"{args.scene}, {args.model} to a relative RMS error of {primary} <= {args.error:g} "
+            f"(against {out['error_against']}) at "
             f"t = {args.t_end:g} s on {machine}"
             + (f", {args.domain} domain" if args.domain else ""))
     if not out["found"]:
         s = out["suggestion"]
         print(f"{head}: none of the {out['runs_considered']} stored runs reaches it.")
+        if "front" in s:
+            print(f"{s['note']}:\n  {s['front']}")
+            return EXIT_RUN_FAILED
         if "study" not in s:
             print("no method of the searched grid is predicted to reach it")
         else:
@@ -533,6 +594,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the committed reference: reports/results -> reports/ of the checkout")
     p.add_argument("--results", type=folder("--results"), help=results_help)
     p.add_argument("--out", type=folder("--out"), help=reports_help)
+    p.add_argument("--scene", choices=scene_names(), help="only this scene's runs (default: every scene)")
     p.set_defaults(func=cmd_report)
 
     p = sub.add_parser("runs", help="list and filter stored runs, or compare two machines or commits")
@@ -543,6 +605,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--machine", help="a machine (profile id, or profile--host), or a prefix of one")
     p.add_argument("--commit", help="a commit prefix")
     p.add_argument("--model")
+    p.add_argument("--scene", help="only the runs of this scene (plane-pulse, acoustic-pulse, ...)")
     p.add_argument("--compare", nargs=2, metavar=("A", "B"),
                    help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, "
                         "ratio, errors")
@@ -555,6 +618,7 @@ def build_parser() -> argparse.ArgumentParser:
                                    "with no simulation (for fixed and lagrangian: their linear part).")
     p.add_argument("--dx", type=number("--dx"), required=True, help="lattice spacing, m")
     p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical end time, s (default 10)")
+    add_problem_options(p)
     add_method_options(p)
     p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")
     p.set_defaults(func=cmd_accuracy)
@@ -566,6 +630,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--error", type=number("--error"), required=True, help="relative RMS error of u, e.g. 0.01")
     p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical time, s (default 10)")
     p.add_argument("--model", choices=MODELS, default="linear", help="default linear")
+    p.add_argument("--scene", choices=scene_names(), default=DEFAULT_SCENE, help=f"default {DEFAULT_SCENE}")
+    p.add_argument("--mach", type=number("--mach"), help="only runs at this amplitude (default: the scene's "
+                   f"{Scene.default('mach'):g})")
     p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
     p.add_argument("--results", help=results_help)
     p.add_argument("--machine", help="a machine (profile id) of the stores; default this one, else the first")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import itertools
 
-from solvers import DEFAULT_SOLVER, Scene, solver_class
+from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, solver_class
 
 from .spec import ALL_CORES, SERIAL, RunSpec
 
@@ -126,9 +126,42 @@ FAST_METHODS = (dict(kernel="wendland-c2", h_factor=2.0, dx=0.1, cfl=2.5),
                 dict(kernel="gaussian", h_factor=1.4, dx=0.1, cfl=2.3))
 
 
-def front(size: str = "quick") -> list[RunSpec]:
+# The 2D acoustic pulse's front (40 m periodic square, t = 10 s, serial): no strip (the pulse spreads in y), so
+# fewer and coarser runs; the paper's method at dx 0.1 beside them. CFL 3 is past the stable step of h = 1.3 dx.
+FRONT_2D = {
+    "quick": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0),
+                  dx=(0.5, 0.25, 0.125), precision=("float64",), model=("linear", "lagrangian")),
+    "full": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.0, 1.3, 1.6, 2.13),
+                 cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0), dx=(0.5, 0.25, 0.125, 0.1), precision=("float64", "float32"),
+                 model=("linear", "lagrangian")),
+}
+PAPER_METHOD_2D_DX = (0.2, 0.1)
+# Which model a scene needs: the paper's method at these amplitudes, linear against lagrangian, scored against
+# the isothermal physics (its error floor for `linear` grows with the amplitude).
+MODEL_MACH = (0.005, 0.05, 0.15)
+MODEL_DX = {DEFAULT_SCENE: (0.2, 0.1), "acoustic-pulse": (0.25,)}
+
+
+def model_needs(scene: str) -> list[RunSpec]:
+    """Linear against lagrangian at several amplitudes, the paper's method, t = 10 s (a strip where it serves)."""
+    strip = scene == DEFAULT_SCENE
+    return [_spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model, mach=mach, strip=strip)
+            for dx in MODEL_DX.get(scene, (0.25,)) for mach in MODEL_MACH for model in ("linear", "lagrangian")]
+
+
+def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     """Time to solution against error at t = 10 s: the product of FRONT[size] on the strip, smallest N first;
-    then the paper's scene with its method and the predicted fastest ones, serial, in the same sweep."""
+    then the paper's scene with its method and the predicted fastest ones, serial, in the same sweep. Another
+    scene: its own product (FRONT_2D) on its own domain, the paper's method beside it, and which model it
+    needs at several amplitudes."""
+    if scene != DEFAULT_SCENE:
+        axes = FRONT_2D[size]
+        names = [k for k in axes if k != "dx"]
+        runs = [_spec(name=scene, dx=dx, t_end=FRONT_T_END, **dict(zip(names, values)))
+                for dx in sorted(axes["dx"], reverse=True) for values in itertools.product(*(axes[k] for k in names))]
+        runs += [_spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model)
+                 for model in ("linear", "lagrangian") for dx in PAPER_METHOD_2D_DX]
+        return runs + model_needs(scene)
     axes = FRONT[size]
     names = [k for k in axes if k != "dx"]
     runs = [_spec(dx=dx, t_end=FRONT_T_END, strip=True, **dict(zip(names, values)))
@@ -136,21 +169,23 @@ def front(size: str = "quick") -> list[RunSpec]:
     for model in ("linear", "lagrangian"):
         runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in FAST_METHODS]
         runs.append(_spec(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model=model))
-    return runs
+    return runs + model_needs(scene)
 
 
-def front_full() -> list[RunSpec]:
-    return front("full")
+def front_full(scene: str = DEFAULT_SCENE) -> list[RunSpec]:
+    return front("full", scene)
 
 
 PRESETS = {"quick": quick, "paper": paper, "stability": stability, "front": front, "front-full": front_full}
 
 
-def preset(name: str) -> list[RunSpec]:
-    """The run matrix of preset ``name``, each spec carrying the preset's name."""
+def preset(name: str, scene: str = DEFAULT_SCENE) -> list[RunSpec]:
+    """The run matrix of preset ``name`` (the fronts on ``scene``), each spec carrying the preset's name."""
     if name not in PRESETS:
         raise ValueError(f"preset must be one of {', '.join(PRESETS)} (got {name!r})")
-    return [RunSpec(s.solver, s.scene, s.threads, name, s.pair_loop) for s in PRESETS[name]()]
+    make = PRESETS[name]
+    specs = make(scene=scene) if name.startswith("front") else make()
+    return [RunSpec(s.solver, s.scene, s.threads, name, s.pair_loop) for s in specs]
 
 
 def matrix(solvers=(DEFAULT_SOLVER,), dxs=(), threads=(SERIAL,), steps=(None,), t_ends=(None,),

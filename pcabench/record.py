@@ -30,8 +30,8 @@ class RunRecord:
     t_end: float  # physical time reached, s
     stages: dict  # input, init, snp, pi, su, output -> total seconds
     jit_seconds: float
-    mse: float  # relative RMS error of u (the paper's "MSE")
-    me: float  # max |u - u_the|, m/s
+    mse: float  # relative RMS error of the scene's primary field (u for the paper's scene: the paper's "MSE")
+    me: float  # its max error, in its unit (m/s for u)
     mean_neighbours: float
     status: str
     failed_step: int | None
@@ -39,7 +39,9 @@ class RunRecord:
     pair_loop: str = ""  # how the solver visited pairs: list, gather (the paper's) or all-pairs
     device: str = ""  # where the solver's pair loops ran (its class's ``device``: cpu or gpu); "" in older rows
     steps_requested: int = 0
-    mse_isothermal: float | None = None  # lagrangian only: relative RMS error of u against the isothermal solution
+    mse_isothermal: float | None = None  # relative RMS error of the primary field against the isothermal solution
+    # (every model since the scene registry; lagrangian only before)
+    errors: dict = field(default_factory=dict)  # the scene's other error measures (solvers/scenes/), by name
     scene: dict = field(default_factory=dict)
     message: str = ""
     profile_id: str = ""

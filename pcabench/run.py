@@ -9,9 +9,7 @@ from __future__ import annotations
 import math
 
 from solvers import SceneError, make_solver
-from solvers.analytic import errors as analytic_errors
 from solvers.integrators import step_program
-from solvers.isothermal1d import isothermal_errors
 
 from .clock import clock_for
 from .memory import is_out_of_memory
@@ -58,10 +56,11 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> Ru
         record.t_end = fields.t
         if record.status != "unstable":
             record.status = "ok"
-            err = analytic_errors(scene, fields.x, fields.u, fields.t)
-            record.mse, record.me = err.mse, err.me
-            if scene.model == "lagrangian":
-                record.mse_isothermal = isothermal_errors(scene, fields.x, fields.u, fields.t).mse
+            measures = scene.kind.errors(scene, fields)  # against the scene's exact linear solution
+            record.mse, record.me = measures.pop("mse"), measures.pop("me")
+            record.errors = measures
+            if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
+                record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
             record.mean_neighbours = solver.mean_neighbours()
     except SceneError:
         raise  # bad input is the caller's to report, not a run result

@@ -113,9 +113,10 @@ class RunSpec:
         s = self.scene
         threads = f" x{self.threads}" if self.threads not in (SERIAL, str(SERIAL)) else ""
         loop = f" [{self.pair_loop}]" if self.pair_loop not in ("auto", "all-pairs") else ""
-        changed = {k: v for k, v in scene_parameters(s).items() if v != Scene.default(k) and k != "dx"}
+        changed = {k: v for k, v in scene_parameters(s).items() if v != s.default_of(k) and k not in ("dx", "name")}
+        scene = "" if s.name == Scene.default("name") else f" {s.name}"
         extra = " ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in changed.items())
-        return f"{self.solver}{threads}{loop} dx={s.dx:g} N={s.n_particles:,}" + (f" {extra}" if extra else "")
+        return f"{self.solver}{threads}{loop}{scene} dx={s.dx:g} N={s.n_particles:,}" + (f" {extra}" if extra else "")
 
     def to_json(self) -> str:
         return json.dumps({"solver": self.solver, "threads": self.threads, "scene": scene_parameters(self.scene),

@@ -19,7 +19,9 @@ from .registry import (
                        solver_names,
 )
 from .scene import INTEGRATORS, MODELS, NUMERICS, PRECISIONS, Scene, SceneError
+from .scenes import DEFAULT_SCENE, SceneKind, scene_kind, scene_names, scenes
 
 __all__ = ["Scene", "SceneError", "Solver", "SolverUnavailable", "Fields", "STAGES", "MODELS", "INTEGRATORS",
            "PRECISIONS", "KERNELS", "NUMERICS", "DEFAULT_SOLVER", "ENTRY_POINT_GROUP", "registry", "solver_names",
-           "solver_class", "check_pair_loop", "make_solver", "resolve_pair_loop"]
+           "solver_class", "check_pair_loop", "make_solver", "resolve_pair_loop", "DEFAULT_SCENE", "SceneKind",
+           "scene_kind", "scene_names", "scenes"]

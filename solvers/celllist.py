@@ -23,7 +23,7 @@ class CellListSolver(Solver):
     """Cell-list neighbour search and gather sweeps; subclasses sort cells and launch kernels."""
 
     def after_init(self) -> None:
-        self.cw, self.ch, self.ncx, self.ncy = cell_grid(self.scene)
+        self.cw, self.ch, self.ncx, self.ncy, self.x_grid, self.width = cell_grid(self.scene)
         self.ncells = self.ncx * self.ncy
         self.cells_valid = False
         self.allocate_cells()
@@ -49,10 +49,15 @@ class CellListSolver(Solver):
         self.cells_valid = True
 
     def cell_ids(self) -> None:
-        """particleIndex of every particle, into ``self.cell``."""
-        s, a = self.scene, self.arrays
-        self.launch("cell_ids", a["lx"], a["ly"], a["sx"], a["sy"], self.cell, s.dx, -self.cw, s.height, self.cw,
-                    self.ch, self.ncx, self.ncy)
+        """particleIndex of every particle, into ``self.cell`` (a particle past a periodic seam has its lattice
+        coordinates moved by a period first: the same position)."""
+        self.launch("cell_ids", *self.grid_arguments(self.arrays["lx"], self.arrays["ly"], self.arrays["sx"],
+                                                     self.arrays["sy"], self.cell))
+
+    def grid_arguments(self, lx, ly, sx, sy, cell) -> tuple:
+        """The arguments of the cell-index kernels for positions ``lx, ly, sx, sy`` and output ``cell``."""
+        s = self.scene
+        return (lx, ly, sx, sy, cell, s.dx, self.x_grid, self.width, s.height, self.cw, self.ch, self.ncx, self.ncy)
 
     def geometry(self) -> tuple:
         """The arguments every stencil kernel starts with: cells and positions."""

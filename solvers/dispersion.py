@@ -49,13 +49,22 @@ def lattice_offsets(scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return a[keep].astype(float), b[keep].astype(float), kernel.gradient_factor(name, r[keep], scene.h)
 
 
+SYMBOL_CHUNK = 1 << 21  # wavenumbers x neighbours evaluated at once (16 MiB of phases)
+
+
 def symbol(scene, kx, ky=0.0) -> tuple[np.ndarray, np.ndarray]:
-    """(D_x, D_y) at wavenumbers (kx, ky), 1/m (arrays broadcast together)."""
+    """(D_x, D_y) at wavenumbers (kx, ky), 1/m (arrays broadcast together), in chunks of wavenumbers."""
     a, b, g = lattice_offsets(scene)
     kx, ky = np.broadcast_arrays(np.asarray(kx, float), np.asarray(ky, float))
-    phase = np.multiply.outer(kx, a * scene.dx) + np.multiply.outer(ky, b * scene.dx)
-    weight = -scene.dx**2 * np.sin(phase) * g
-    return weight @ (a * scene.dx), weight @ (b * scene.dx)
+    shape, kx, ky = kx.shape, kx.ravel(), ky.ravel()
+    out_x, out_y = np.empty(kx.size), np.empty(kx.size)
+    step = max(1, SYMBOL_CHUNK // max(a.size, 1))
+    for lo in range(0, kx.size, step):
+        part = slice(lo, lo + step)
+        phase = np.multiply.outer(kx[part], a * scene.dx) + np.multiply.outer(ky[part], b * scene.dx)
+        weight = -scene.dx**2 * np.sin(phase) * g
+        out_x[part], out_y[part] = weight @ (a * scene.dx), weight @ (b * scene.dx)
+    return out_x.reshape(shape), out_y.reshape(shape)
 
 
 def largest_symbol(scene, points: int = 161) -> float:
@@ -171,7 +180,8 @@ def stable_cfl(scene) -> float:
 
 @dataclass(frozen=True)
 class Prediction:
-    """The predicted relative RMS error of u at the run's final time and the largest stable CFL."""
+    """The predicted relative RMS error of the scene's primary field at the run's final time and the largest
+    stable CFL."""
 
     predicted_error: float
     predicted_me: float
@@ -179,13 +189,23 @@ class Prediction:
     t_end: float
     lattice_phase_error: float  # c0 D(k)/k - 1 at the pulse's wavenumber k = 1 / pulse width: the lattice's lag
     step_phase_error: float  # the same with the integrator's step: phase speed / c0 - 1 (lag + the step's lead)
+    # along the lattice's diagonal (2D scenes; the two above are along its axis)
+    lattice_phase_error_diagonal: float | None = None
+    step_phase_error_diagonal: float | None = None
+    measures: dict | None = None  # the scene's other error measures, predicted (2D scenes)
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
 
 
 def predict(scene) -> Prediction:
-    """The error of the scene's run predicted from the dispersion relation (linear part; see the module)."""
+    """The error of the scene's run predicted from the dispersion relation (linear part; see the module), by
+    the scene kind's own prediction (solvers/scenes/)."""
+    return scene.kind.predict(scene)
+
+
+def predict_plane(scene) -> Prediction:
+    """The plane pulse's prediction: the lattice row's spectrum evolved mode by mode (waves along x)."""
     x, u, t = predicted_velocity(scene)
     err = analytic_errors(scene, x, u, t)
     k = 1.0 / scene.pulse_width
@@ -201,3 +221,53 @@ def step_phase_angle(integrator: str, z: float) -> float:
     eig = np.linalg.eigvals(step_matrices(integrator, [z], 1.0, 1.0, 1.0)[0])
     angles = np.abs(np.angle(eig[np.abs(eig) > 0.5]))  # the auxiliary rates' eigenvalues are 0
     return float(angles[np.argmin(np.abs(angles - z))])  # the physical mode: nearest the exact phase z
+
+
+def phase_errors(scene, angle: float) -> tuple[float, float]:
+    """(lattice, with the step) phase speed errors, c / c0 - 1, of the scene's method for a plane wave of
+    wavenumber 1 / pulse width travelling at ``angle`` rad to the lattice's x axis."""
+    k = 1.0 / scene.pulse_width
+    dxs, dys = symbol(scene, np.array([k * math.cos(angle)]), np.array([k * math.sin(angle)]))
+    d = float(math.hypot(dxs[0], dys[0]))
+    step = step_phase_angle(scene.integrator, scene.c0 * d * scene.dt) / (scene.c0 * k * scene.dt)
+    return d / k - 1.0, step - 1.0
+
+
+def predicted_fields_2d(scene) -> tuple:
+    """(x, y, drho, u, v, t) on the scene's periodic lattice (arrays (ny, nx)) at the run's final time, every
+    lattice Fourier mode evolved by the integrator's own step matrix with the symbol D(k): the `linear`
+    model's exact discrete solution (u's part along D(k) is the 1D problem with d = |D(k)|; the part across
+    it has no rate and stays)."""
+    xs = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx
+    ys = scene.y_lo + (np.arange(scene.ny) + 0.5) * scene.dx
+    x, y = np.meshgrid(xs, ys)
+    u0, v0, drho0 = scene.kind.initial_fields(scene, x, y, np)
+    kx, ky = np.meshgrid(2.0 * math.pi * np.fft.fftfreq(scene.nx, d=scene.dx),
+                         2.0 * math.pi * np.fft.fftfreq(scene.ny, d=scene.dx))
+    dx_, dy_ = symbol(scene, kx, ky)
+    d = np.hypot(dx_, dy_)
+    safe = np.where(d > 0, d, 1.0)
+    ex, ey = np.where(d > 0, dx_ / safe, 0.0), np.where(d > 0, dy_ / safe, 0.0)
+    u_hat, v_hat = np.fft.fft2(u0), np.fft.fft2(v0)
+    along, across = ex * u_hat + ey * v_hat, -ey * u_hat + ex * v_hat
+    modes = ModeSolver(d.ravel(), np.fft.fft2(drho0).ravel(), along.ravel(), scene.rho0, scene.c0, scene.dt)
+    evolve(modes, scene.integrator, scene.n_steps)
+    along = modes.u.reshape(d.shape)
+    u = np.fft.ifft2(ex * along - ey * across).real
+    v = np.fft.ifft2(ey * along + ex * across).real
+    return x, y, np.fft.ifft2(modes.drho.reshape(d.shape)).real, u, v, modes.t
+
+
+def predict_2d(scene, kind) -> Prediction:
+    """The error of a periodic 2D scene's run predicted with no simulation (exact for `linear`), scored with
+    the scene's own measures against its exact reference; phase errors along the axis and the diagonal."""
+    from .interface import Fields
+
+    x, y, drho, u, v, t = predicted_fields_2d(scene.replace(model="linear"))
+    fields = Fields(x=x.ravel(), y=y.ravel(), u=u.ravel(), v=v.ravel(), drho=drho.ravel(), t=t)
+    measures = kind.errors(scene.replace(model="linear"), fields)
+    axis, diagonal = phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4)
+    return Prediction(predicted_error=measures.pop("mse"), predicted_me=measures.pop("me"),
+                      stable_cfl=stable_cfl(scene), t_end=t, lattice_phase_error=axis[0], step_phase_error=axis[1],
+                      lattice_phase_error_diagonal=diagonal[0], step_phase_error_diagonal=diagonal[1],
+                      measures=measures)

@@ -37,10 +37,11 @@ def kernels(precision: str, kernel: str = "gaussian"):
     # cell_begin: cellBegin by an exclusive scan of the counts (one block), which also zeroes the counts for
     # the next search; scatter: every per-particle array into cell order in one pass.
     @jit
-    def cell_count(lx, ly, sx, sy, cell, rank, counts, dx, x_grid, height, cw, ch, ncx, ncy):
+    def cell_count(lx, ly, sx, sy, cell, rank, counts, dx, x_grid, width, height, cw, ch, ncx, ncy):
         i = cuda.grid(1)
         if i < lx.shape[0]:
-            c = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, height, cw, ch, ncx, ncy)
+            P.wrap_at(i, lx, ly, sx, sy, dx, width, height)
+            c = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, width, height, cw, ch, ncx, ncy)
             cell[i] = c
             rank[i] = cuda.atomic.add(counts, c, 1)
 

@@ -70,6 +70,7 @@ class Solver(abc.ABC):
     models: tuple = MODELS
     integrators: tuple = INTEGRATORS
     kernels: tuple = kernel.KERNELS
+    boundaries: tuple = ("free-x", "periodic-y")  # the boundary kinds it can run (solvers/scenes/base.py)
     pair_loops: tuple = ("gather",)  # how it can visit pairs (gather, list, all-pairs); the first is its default
     threaded: bool = False  # runs on more than one CPU thread (--threads N|all); else serial
     serial_why: str = "as in the paper"  # why a serial solver is serial, for the one-line refusal
@@ -113,6 +114,10 @@ class Solver(abc.ABC):
                               ("integrator", cls.integrators), ("kernel", cls.kernels)):
             if getattr(scene, what) not in offered:
                 raise SceneError(f"{what}: {cls.name} offers {', '.join(offered)} (got {getattr(scene, what)!r})")
+        missing = sorted(set(scene.boundaries) - set(cls.boundaries))
+        if missing:
+            raise SceneError(f"--scene {scene.name}: {cls.name} cannot run its {', '.join(missing)} boundaries "
+                             f"(it supports {', '.join(cls.boundaries)})")
 
     # ------------------------------------------------------------ stages
     def input(self, scene: Scene) -> None:
@@ -136,15 +141,14 @@ class Solver(abc.ABC):
         lx = (ids % s.nx).astype(dt)
         ly = (ids // s.nx).astype(dt)
         x = s.x_lo + (lx.astype(xp.float64) + 0.5) * s.dx
-        xi = (x - s.pulse_center) / s.pulse_width
-        u = s.c0 * s.mach * xp.exp(-xi * xi)
-        drho = s.rho0 * u / s.c0
+        y = s.y_lo + (ly.astype(xp.float64) + 0.5) * s.dx
+        u, v, drho = s.kind.initial_fields(s, x, y, xp)  # the scene kind's fields at t = 0 (solvers/scenes/)
         # Lagrangian and fixed: m_j = rho_j(0) dx^2, so m/rho is the true volume at t = 0.
         rho_init = s.rho0 + (0.0 if s.model == "linear" else 1.0) * drho
         a = {
             "lx": lx, "ly": ly,
             "sx": xp.zeros(s.n_particles, dt), "sy": xp.zeros(s.n_particles, dt),
-            "u": u.astype(dt), "v": xp.zeros(s.n_particles, dt), "drho": drho.astype(dt),
+            "u": u.astype(dt), "v": v.astype(dt), "drho": drho.astype(dt),
             "mass": (rho_init * s.dx * s.dx).astype(dt),
         }
         for name in RATES + ("vol", "pr"):
@@ -221,7 +225,7 @@ class Solver(abc.ABC):
         """Copy the fields back to the host in particle-id order."""
         s = self.scene
         h = {name: self.to_host(self.arrays[name]) for name in STATE}
-        ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + np.rint(h["lx"]).astype(np.int64)
+        ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + np.rint(h["lx"]).astype(np.int64) % s.nx
         order = np.argsort(ids, kind="stable")
         x = s.x_lo + (h["lx"].astype(np.float64) + 0.5) * s.dx + h["sx"]
         y = s.y_lo + (h["ly"].astype(np.float64) + 0.5) * s.dx + h["sy"]
@@ -254,15 +258,24 @@ class Solver(abc.ABC):
 
 
 def cell_grid(scene: Scene) -> tuple:
-    """(cw, ch, ncx, ncy): cells one cutoff wide (one spare each side in x for particles
-    drifting past the edges) and at least one cutoff tall, filling the periodic height."""
-    ncy = max(int(math.floor(scene.height / scene.cutoff)), 1)
+    """(cw, ch, ncx, ncy, x_grid, width): cells at least one cutoff tall, filling the periodic height, and in
+    x either one cutoff wide with one spare each side for particles drifting past free edges (the grid's
+    left edge ``x_grid`` one cell left of the lattice, ``width`` 0), or at least one cutoff wide filling
+    the periodic width (``x_grid`` 0, ``width`` the period, m)."""
+    ncy = max(int(math.floor(scene.height / scene.cutoff + 1e-9)), 1)
+    if scene.periodic_x:
+        ncx = int(math.floor(scene.width / scene.cutoff + 1e-9))
+        if ncx < 3:
+            raise SceneError(f"x_max - x_min must hold 3 cells of one cutoff ({3 * scene.cutoff:.6g} m) for the "
+                             f"x-periodic {scene.name} scene (got {scene.width:.6g} m)")
+        return scene.width / ncx, scene.height / ncy, ncx, ncy, 0.0, scene.width
     ncx = int(math.ceil((scene.x_max - scene.x_min) / scene.cutoff)) + 2
-    return scene.cutoff, scene.height / ncy, ncx, ncy
+    return scene.cutoff, scene.height / ncy, ncx, ncy, -scene.cutoff, 0.0
 
 
 def tiny_scene(scene: Scene) -> Scene:
-    """A few hundred particles with the same model, integrator and precision (for JIT warm-up)."""
-    return scene.replace(dx=1.0, x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0,
+    """A few hundred particles with the same scene kind, model, integrator and precision (for JIT warm-up)."""
+    return scene.replace(dx=1.0, x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0, pulse_center=0.0,
+                         pulse_width=scene.default("pulse_width"), mach=scene.default("mach"),
                          strip_height=None, steps=2, t_end=None, h_factor=scene.default("h_factor"),
                          cutoff_factor=min(scene.cutoff_factor, 3.0))

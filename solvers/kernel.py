@@ -35,7 +35,8 @@ RHO0 = 5  # rho0, kg/m^3
 C0SQ = 6  # c0^2, m^2/s^2
 NONLIN = 7  # 1 where rho = rho0 + drho in the coefficients, 0 in the linear model
 ZERO = 8  # 0 in the solver's float type (accumulators start from it)
-SLOTS = 9
+NX = 9  # lattice columns in the periodic width, 0 where the x edges are free
+SLOTS = 10
 
 
 def constants(scene, dtype) -> tuple:
@@ -52,6 +53,7 @@ def constants(scene, dtype) -> tuple:
         C0SQ: scene.c0**2,
         NONLIN: nonlin,
         ZERO: 0.0,
+        NX: float(scene.nx) if scene.periodic_x else 0.0,
     }
     t = np.dtype(dtype).type
     return tuple(t(values[i]) for i in range(SLOTS))

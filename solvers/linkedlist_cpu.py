@@ -66,9 +66,10 @@ def sweeps(precision: str, kernel: str, parallel: bool) -> dict:
             total += P.neighbours_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k)
         return total
 
-    def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, height, cw, ch, ncx, ncy):
+    def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, width, height, cw, ch, ncx, ncy):
         for i in prange(lx.shape[0]):
-            cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, height, cw, ch, ncx, ncy)
+            P.wrap_at(i, lx, ly, sx, sy, dx, width, height)
+            cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, width, height, cw, ch, ncx, ncy)
 
     jit = numba.njit(nogil=True, parallel=parallel)
     return {"continuity": jit(continuity), "momentum": jit(momentum), "neighbours": jit(neighbours),
@@ -86,6 +87,7 @@ class LinkedListCPU(CellListSolver):
                "--pair-loop list (default where it fits) or gather (the paper's loop)")
     pair_loops = ("list", "gather")
     threaded = True
+    boundaries = ("free-x", "periodic-x", "periodic-y")
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         super().__init__(threads=threads or 1, pair_loop=pair_loop)
@@ -182,11 +184,11 @@ class LinkedListCPU(CellListSolver):
 
     def count_neighbours(self) -> int:
         """On a cell list of its own, over copies of the positions in its cell order (the state untouched)."""
-        s, a, n = self.scene, self.arrays, self.scene.n_particles
+        a, n = self.arrays, self.scene.n_particles
         cell, sorted_cell, order = np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.int64)
         begin = np.zeros(self.ncells + 1, np.uint32)
-        self.launch("cell_ids", a["lx"], a["ly"], a["sx"], a["sy"], cell, s.dx, -self.cw, s.height, self.cw,
-                    self.ch, self.ncx, self.ncy)
+        copies = [a[name].copy() for name in ("lx", "ly", "sx", "sy")]  # the kernel may wrap them
+        self.launch("cell_ids", *self.grid_arguments(*copies, cell))
         counting_sort(cell, self.ncells, begin, order, sorted_cell)
-        positions = [a[name][order] for name in ("lx", "ly", "sx", "sy")]
+        positions = [arr[order] for arr in copies]
         return int(self.launch("neighbours", sorted_cell, begin, self.ncx, self.ncy, *positions, self.k))

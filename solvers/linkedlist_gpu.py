@@ -42,6 +42,7 @@ class LinkedListGPU(CellListSolver):
     device = "gpu"
     serial_why = "one GPU thread per particle"
     resources = {"timing": 1, "GPU": 1}
+    boundaries = ("free-x", "periodic-x", "periodic-y")
 
     @classmethod
     def available(cls) -> None:
@@ -114,9 +115,9 @@ class LinkedListGPU(CellListSolver):
         """Counting sort by cell in three launches; the spare block becomes the current one."""
         from .gpu_kernels import scan_block
 
-        s, a = self.scene, self.arrays
-        self.launch("cell_count", a["lx"], a["ly"], a["sx"], a["sy"], self.cell, self.rank, self.counts, s.dx,
-                    -self.cw, s.height, self.cw, self.ch, self.ncx, self.ncy)
+        a = self.arrays
+        lx, ly, sx, sy, cell, *grid = self.grid_arguments(a["lx"], a["ly"], a["sx"], a["sy"], self.cell)
+        self.launch("cell_count", lx, ly, sx, sy, cell, self.rank, self.counts, *grid)
         self.launch("cell_begin", self.counts, self.begin, grid=(1, scan_block()))
         (src, _), (dst, cell_out) = self.blocks_of[self.current], self.blocks_of[1 - self.current]
         self.launch("scatter", self.cell, self.rank, self.begin, src, dst, cell_out, self.order)
@@ -157,13 +158,13 @@ class LinkedListGPU(CellListSolver):
         scattered into its cell order: the particle blocks and the solver's cell list untouched."""
         from .gpu_kernels import scan_block
 
-        s, a, xp, n = self.scene, self.arrays, self.xp, self.scene.n_particles
-        src = xp.stack([a["lx"], a["ly"], a["sx"], a["sy"]])
+        a, xp, n = self.arrays, self.xp, self.scene.n_particles
+        src = xp.stack([a["lx"], a["ly"], a["sx"], a["sy"]])  # a copy: the kernel may wrap it
         dst = xp.empty_like(src)
         cell, rank, cell_out, order = (xp.empty(n, xp.int32) for _ in range(4))
         counts, begin = xp.zeros(self.ncells, xp.int32), xp.empty(self.ncells + 1, xp.uint32)
-        self.launch("cell_count", a["lx"], a["ly"], a["sx"], a["sy"], cell, rank, counts, s.dx, -self.cw, s.height,
-                    self.cw, self.ch, self.ncx, self.ncy)
+        lx, ly, sx, sy, cell, *grid = self.grid_arguments(src[0], src[1], src[2], src[3], cell)
+        self.launch("cell_count", lx, ly, sx, sy, cell, rank, counts, *grid)
         self.launch("cell_begin", counts, begin, grid=(1, scan_block()))
         self.launch("scatter", cell, rank, begin, src, dst, cell_out, order)
         found = xp.zeros(n, xp.int32)

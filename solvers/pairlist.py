@@ -43,7 +43,7 @@ import numpy as np
 from .backend import cpu_pairs
 from .compress import PAD, compress_within
 from .denormals import flush_off, flush_on
-from .kernel import NONLIN, NY, RC2, RHO0, SPACING
+from .kernel import NONLIN, NX, NY, RC2, RHO0, SPACING
 
 INDEX_BYTES = 4  # uint32 neighbour index per pair
 ROW_BYTES = 4 + 8  # per particle: its pair count (uint32) and where its pairs start (uint64)
@@ -132,6 +132,7 @@ def kernels(precision: str, kernel: str, parallel: bool) -> dict:
         n, nt = U(lx.shape[0]), U(scratch.shape[0])
         budget = U(nbr.shape[0]) // n
         ncx, ncy = U(ncx), U(ncy)
+        periodic = k[NX] > 0  # x periodic: the stencil wraps across the x seam
         need = np.zeros(nt, np.uint64)
         for tt in prange(nt):
             t = U(tt)
@@ -153,6 +154,12 @@ def kernels(precision: str, kernel: str, parallel: bool) -> dict:
                 a0 = i + U(1)
                 a1 = first_beyond(a0, U(begin[cy * ncx + x1 + U(1)]), lxi, sxi, lx, sx, k)
                 nq = distances(a0, a1, lxi, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, U(0), k)
+                if periodic and cx == ncx - U(1):  # the cell to the right is the row's first, across the x seam
+                    lxs = lxi - k[NX]
+                    e1 = U(begin[cy * ncx + U(1)])
+                    b1 = first_beyond(U(begin[cy * ncx]), e1, lxs, sxi, lx, sx, k)
+                    nq = distances(U(begin[cy * ncx]), b1, lxs, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s,
+                                   nq, k)
                 # the three cells of the row above (across the periodic seam: i shifted down by ny rows)
                 up = cy + U(1)
                 if up >= ncy:
@@ -162,6 +169,13 @@ def kernels(precision: str, kernel: str, parallel: bool) -> dict:
                 b0 = first_within(U(begin[up * ncx + x0]), e1, lxi, sxi, lx, sx, k)
                 b1 = first_beyond(b0, e1, lxi, sxi, lx, sx, k)
                 nq = distances(b0, b1, lxi, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
+                if periodic and (cx == U(0) or cx == ncx - U(1)):  # the cell of the row above across the x seam
+                    other = ncx - U(1) if cx == U(0) else U(0)
+                    lxs = lxi + k[NX] if cx == U(0) else lxi - k[NX]
+                    e1 = U(begin[up * ncx + other + U(1)])
+                    b0 = first_within(U(begin[up * ncx + other]), e1, lxs, sxi, lx, sx, k)
+                    b1 = first_beyond(b0, e1, lxs, sxi, lx, sx, k)
+                    nq = distances(b0, b1, lxs, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
                 m = compress_within(js, rxs, rys, r2s, cj, crx, cry, cr2, nq, k[RC2])  # those within the cutoff
                 start[i] = at
                 count[i] = m
@@ -280,7 +294,7 @@ class PairList:
         """Per-thread scratch rows long enough for any particle's candidates (two stencil rows of 3 cells)."""
         per_cell = np.diff(begin.astype(np.int64))
         rows = np.convolve(per_cell, np.ones(3, np.int64), mode="same")  # 3 consecutive cells (upper bound)
-        need = 2 * int(rows.max(initial=0)) + 1 + PAD
+        need = 2 * int(rows.max(initial=0)) + 2 * int(per_cell.max(initial=0)) + 1 + PAD  # + cells across a seam
         if self.scratch is None or self.scratch[0].shape[2] < need:
             self.scratch = (np.empty((self.threads, 2, need), np.uint32),
                             np.empty((self.threads, 6, need), self.fx.dtype))

@@ -11,7 +11,11 @@ Positions are lattice coordinates (lx, ly: whole numbers held in the solver's
 float type) plus a displacement (sx, sy, m): r_ij = (lx_i - lx_j) dx +
 (sx_i - sx_j). The large part is exact, so float32 keeps its accuracy at
 small dx (absolute float32 coordinates lose up to 2 % of the momentum term at
-dx = 0.004 m). Periodicity in y is an exact shift by ny rows.
+dx = 0.004 m). Periodicity in y is an exact shift by ny rows, in x (scenes
+periodic in x: ``k[NX]`` columns, 0 for free edges) by nx columns. A moving
+particle that crosses a periodic seam has its lattice coordinate moved by a
+whole period at the next search (:func:`wrap_at`), so that its cell and its
+coordinates agree.
 
 Rates (design, section 1), with rho = rho0 + nonlin * drho (nonlin = 0 in the
 `linear` model) and the per-particle coefficients prepared by the solver,
@@ -24,7 +28,7 @@ of :func:`solvers.kernel.constants`, read by its named slots.
 import math
 from types import ModuleType
 
-from .kernel import C0SQ, NONLIN, NY, RC2, RHO0, SPACING, ZERO, make_gradient
+from .kernel import C0SQ, NONLIN, NX, NY, RC2, RHO0, SPACING, ZERO, make_gradient
 
 
 def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
@@ -77,27 +81,50 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
 
     # ---------------------------------------------------------------- cell list
     @jit
-    def cell_index(lx, ly, sx, sy, dx, x_grid, height, cw, ch, ncx, ncy):
+    def cell_index(lx, ly, sx, sy, dx, x_grid, width, height, cw, ch, ncx, ncy):
         """particleIndex of one particle: cy * ncx + cx from float64 positions.
 
         x_grid is the grid's left edge relative to the first lattice column's left
-        edge; x is clamped to the grid, y taken modulo the periodic height.
+        edge; x is clamped to the grid (free edges, ``width`` 0) or taken modulo the
+        periodic ``width``, y modulo the periodic height.
         """
         x = (float(lx) + 0.5) * dx + float(sx)
         y = (float(ly) + 0.5) * dx + float(sy)
+        if width > 0:
+            x = x - math.floor(x / width) * width
         y = y - math.floor(y / height) * height
         cx = min(max(int(math.floor((x - x_grid) / cw)), 0), ncx - 1)
         cy = min(max(int(y / ch), 0), ncy - 1)
         return cy * ncx + cx
 
     @jit
-    def stencil_row(i, dcy, cell, begin, ncx, ncy, ly, k):
-        """Row ``dcy`` (-1, 0, 1) of particle i's 3x3 cell stencil: (j0, j1, lyi shifted).
+    def wrap_at(i, lx, ly, sx, sy, dx, width, height):
+        """Particle i's lattice coordinates moved by whole periods into the box [0, width) x [0, height)
+        (measured from the first lattice site's cell corner) when it has crossed a periodic seam: the same
+        position, exactly (``width`` 0: x is not periodic)."""
+        if width > 0:
+            x = (float(lx[i]) + 0.5) * dx + float(sx[i])
+            if x >= width:
+                lx[i] -= math.floor(width / dx + 0.5)
+            elif x < 0:
+                lx[i] += math.floor(width / dx + 0.5)
+        y = (float(ly[i]) + 0.5) * dx + float(sy[i])
+        if y >= height:
+            ly[i] -= math.floor(height / dx + 0.5)
+        elif y < 0:
+            ly[i] += math.floor(height / dx + 0.5)
+
+    @jit
+    def stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k):
+        """Row ``dcy`` (-1, 0, 1) of particle i's 3x3 cell stencil as two ranges of particles:
+        (j0, j1, lyi, q0, q1, lxq), lyi being i's row shifted across the y seam and lxq i's column shifted
+        across the x seam for the second range (empty unless the row wraps in x).
 
         Cells are numbered cy * ncx + cx and particles are sorted by cell, so the
-        three cells of a stencil row are one contiguous range [j0, j1). Crossing
-        the periodic boundary shifts particle i by ny rows instead of wrapping
-        every pair.
+        three cells of a stencil row are one contiguous range [j0, j1), or, where a
+        periodic x seam cuts the row, two: [j0, j1) and the cell beyond the seam
+        [q0, q1). Crossing a periodic boundary shifts particle i by a whole period
+        instead of wrapping every pair.
         """
         c = cell[i]
         cx = c % ncx
@@ -109,17 +136,30 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         elif cy >= ncy:
             cy -= ncy
             lyi -= k[NY]
+        row = cy * ncx
         x0 = cx - 1 if cx > 0 else 0
         x1 = cx + 1 if cx < ncx - 1 else ncx - 1
-        return begin[cy * ncx + x0], begin[cy * ncx + x1 + 1], lyi
+        q0 = begin[row]
+        q1 = q0
+        lxq = lx[i]
+        if k[NX] > 0:
+            if cx == 0:  # the last cell of the row, across the seam on the left
+                q0, q1 = begin[row + ncx - 1], begin[row + ncx]
+                lxq = lx[i] + k[NX]
+            elif cx == ncx - 1:  # the first cell, across the seam on the right
+                q0, q1 = begin[row], begin[row + 1]
+                lxq = lx[i] - k[NX]
+        return begin[row + x0], begin[row + x1 + 1], lyi, q0, q1, lxq
 
     @jit
     def continuity_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, k):
         """d(drho_i)/dt from the 3x3 cells around particle i, kg/m^3/s."""
         acc = k[ZERO]
         for dcy in range(-1, 2):
-            j0, j1, lyi = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, k)
+            j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
             acc += continuity_range(j0, j1, lx[i], lyi, sx[i], sy[i], u[i], v[i],
+                                    lx, ly, sx, sy, u, v, vol, k)
+            acc += continuity_range(q0, q1, lxq, lyi, sx[i], sy[i], u[i], v[i],
                                     lx, ly, sx, sy, u, v, vol, k)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
@@ -129,11 +169,13 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         ax = k[ZERO]
         ay = k[ZERO]
         for dcy in range(-1, 2):
-            j0, j1, lyi = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, k)
+            j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
             bx, by = momentum_range(j0, j1, lx[i], lyi, sx[i], sy[i], pr[i],
                                     lx, ly, sx, sy, mass, pr, k)
-            ax += bx
-            ay += by
+            cx_, cy_ = momentum_range(q0, q1, lxq, lyi, sx[i], sy[i], pr[i],
+                                      lx, ly, sx, sy, mass, pr, k)
+            ax += bx + cx_
+            ay += by + cy_
         return -ax, -ay
 
     @jit
@@ -141,8 +183,9 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         """Neighbours of particle i within the cutoff, itself excluded."""
         count = 0
         for dcy in range(-1, 2):
-            j0, j1, lyi = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, k)
+            j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
             count += neighbours_range(j0, j1, lx[i], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
+            count += neighbours_range(q0, q1, lxq, lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
     # ---------------------------------------------------------------- all pairs
@@ -157,12 +200,24 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         return lyi
 
     @jit
+    def minimum_image_column(lxi, lxj, k):
+        """lxi shifted by a whole period so that |lxi - lxj| <= nx/2 where x is periodic (exact)."""
+        if k[NX] > 0:
+            d = lxi - lxj
+            if d > 0.5 * k[NX]:
+                return lxi - k[NX]
+            if d < -0.5 * k[NX]:
+                return lxi + k[NX]
+        return lxi
+
+    @jit
     def continuity_allpair(i, n, lx, ly, sx, sy, u, v, vol, drho, k):
         """d(drho_i)/dt summed over all n particles (the paper's all-pair search)."""
         acc = k[ZERO]
         for j in range(n):
             lyi = minimum_image_row(ly[i], ly[j], k)
-            acc += continuity_range(j, j + 1, lx[i], lyi, sx[i], sy[i], u[i], v[i],
+            lxi = minimum_image_column(lx[i], lx[j], k)
+            acc += continuity_range(j, j + 1, lxi, lyi, sx[i], sy[i], u[i], v[i],
                                     lx, ly, sx, sy, u, v, vol, k)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
@@ -173,7 +228,8 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         ay = k[ZERO]
         for j in range(n):
             lyi = minimum_image_row(ly[i], ly[j], k)
-            bx, by = momentum_range(j, j + 1, lx[i], lyi, sx[i], sy[i], pr[i],
+            lxi = minimum_image_column(lx[i], lx[j], k)
+            bx, by = momentum_range(j, j + 1, lxi, lyi, sx[i], sy[i], pr[i],
                                     lx, ly, sx, sy, mass, pr, k)
             ax += bx
             ay += by
@@ -184,7 +240,8 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         count = 0
         for j in range(n):
             lyi = minimum_image_row(ly[i], ly[j], k)
-            count += neighbours_range(j, j + 1, lx[i], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
+            lxi = minimum_image_column(lx[i], lx[j], k)
+            count += neighbours_range(j, j + 1, lxi, lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
     # ---- per particle: the sweeps' coefficients (PI) and the system update (SU), one particle each, so that a
@@ -218,6 +275,7 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         neighbours_range=neighbours_range,
         cell_index=cell_index, stencil_row=stencil_row, continuity_cells=continuity_cells,
         momentum_cells=momentum_cells, neighbours_cells=neighbours_cells, minimum_image_row=minimum_image_row,
+        minimum_image_column=minimum_image_column, wrap_at=wrap_at,
         continuity_allpair=continuity_allpair, momentum_allpair=momentum_allpair,
         neighbours_allpair=neighbours_allpair, coefficients_at=coefficients_at, kick_at=kick_at,
         advance_at=advance_at)

@@ -20,6 +20,7 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 
 from .kernel import KERNELS, SUPPORT
+from .scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
 INTEGRATORS = ("verlet", "kdk1", "euler", "rk2")
@@ -39,6 +40,9 @@ MAX_STEPS = 10_000_000  # the most steps a run may take (1e7)
 
 # Scene parameters that choose the numerical method rather than the physics.
 NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor", "kernel")
+# The domain: the scene kind's default (solvers/scenes/) where not given.
+DOMAIN = ("x_min", "x_max", "y_min", "y_max")
+PAPER_DOMAIN = {"x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
 
 
 class SceneError(ValueError):
@@ -56,10 +60,11 @@ class Scene:
     """One simulation, fully specified. Lengths in m, times in s, density in kg/m^3."""
 
     dx: float
-    x_min: float = -10.0
-    x_max: float = 40.0
-    y_min: float = -10.0
-    y_max: float = 10.0
+    name: str = DEFAULT_SCENE  # the scene kind (solvers/scenes/): the problem, its boundaries and reference
+    x_min: float | None = None  # the domain, m; None: the scene kind's default (the paper's: [-10, 40] x [-10, 10])
+    x_max: float | None = None
+    y_min: float | None = None
+    y_max: float | None = None
     strip_height: float | None = None  # replaces [y_min, y_max] by a centred strip
     rho0: float = 1.0
     c0: float = 1.0
@@ -81,6 +86,13 @@ class Scene:
     def __post_init__(self) -> None:
         if self.steps is None and self.t_end is None:
             object.__setattr__(self, "steps", 100)  # the paper's protocol
+        try:
+            kind = scene_kind(self.name)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
+        for key in DOMAIN:
+            if getattr(self, key) is None:
+                object.__setattr__(self, key, kind.domain.get(key, PAPER_DOMAIN[key]))
         self._validate()
 
     # ------------------------------------------------------------ validation
@@ -151,12 +163,23 @@ class Scene:
             need(self.t_end > 0, f"t_end must be > 0 s (got {self.t_end})")
             need(self.t_end / self.dt_max <= MAX_STEPS,
                  f"t_end = {self.t_end} s needs more than 1e7 steps at dt = {self.dt_max:g} s")
+        for problem in self.kind.check(self):  # the scene kind's own parameters first: they name its options
+            need(False, problem)
         least = STRIP_CUTOFFS * self.cutoff
         need(self.height >= least * (1 - 1e-9),
              f"{'strip_height' if self.strip_height is not None else 'y_max - y_min'} must be at least "
              f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
              f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)")
         need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
+        if self.periodic_x:
+            need(self.width >= least * (1 - 1e-9),
+                 f"x_max - x_min must be at least 3 cutoffs = {least:.6g} m at dx = {self.dx} for the x-periodic "
+                 f"{self.name} scene (got {self.width:.6g} m)")
+        breaking = self.kind.breaking_time(self)
+        need(self.model == "linear" or self.t_final < breaking,
+             f"--t-end: t = {self.t_final:g} s passes the pulse's nonlinear breaking time {breaking:.3g} s at "
+             f"--mach {self.mach:g}, --pulse-width {self.pulse_width:g} m (the isothermal solution has a shock "
+             f"there): end earlier, lower --mach, or use the linear model")
         limit = self.memory_limit()  # None: the scene states no limit (the harness gives it one)
         if limit is not None:
             need(self.memory_bytes() <= limit,
@@ -165,6 +188,26 @@ class Scene:
                  f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m")
 
     # ------------------------------------------------------------ geometry
+    @property
+    def kind(self):
+        """The scene kind (solvers/scenes/): initial fields, boundaries, reference and error measures."""
+        return scene_kind(self.name)
+
+    @property
+    def periodic_x(self) -> bool:
+        """Whether the domain is periodic in x (else its left and right edges are free)."""
+        return "x" in self.kind.periodic
+
+    @property
+    def boundaries(self) -> frozenset:
+        """The boundary kinds a solver needs for this scene (free-x, periodic-x, periodic-y)."""
+        return self.kind.boundaries(self)
+
+    @property
+    def width(self) -> float:
+        """Width of the lattice in x, m (the period where x is periodic)."""
+        return self.nx * self.dx
+
     @property
     def h(self) -> float:
         """Smoothing length, m."""
@@ -255,8 +298,15 @@ class Scene:
     # ------------------------------------------------------------ defaults and rules
     @classmethod
     def default(cls, name: str):
-        """The default value of the scene parameter ``name`` (the one place defaults live)."""
+        """The default value of the scene parameter ``name`` (the one place defaults live; the domain's
+        are the paper's here, a scene kind's own in :meth:`default_of`)."""
+        if name in PAPER_DOMAIN:
+            return PAPER_DOMAIN[name]
         return cls.__dataclass_fields__[name].default
+
+    def default_of(self, name: str):
+        """The default of parameter ``name`` for this scene's kind (its domain may differ from the paper's)."""
+        return self.kind.domain.get(name, self.default(name))
 
     @classmethod
     def cutoff_ratio(cls, kernel: str | None = None, cutoff_factor: float | None = None) -> float:
@@ -289,7 +339,8 @@ class Scene:
         return d
 
     def describe(self) -> str:
-        return (f"{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
+        scene = "" if self.name == DEFAULT_SCENE else f"{self.name}, "
+        return (f"{scene}{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
                 f"{self.kernel} kernel, h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
                 f"{self.n_steps} steps to t = {self.t_final:.4g} s, "
                 f"{self.model}/{self.integrator}/{self.precision}, "

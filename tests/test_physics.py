@@ -168,5 +168,8 @@ def test_lagrangian_records_carry_the_error_against_their_own_limit():
     coarse, fine = (r.mse_isothermal for r in recs)
     assert fine < coarse / 2.5  # second order: 6.5 % -> 2.0 %
     assert fine < recs[1].mse / 3  # the linear pulse is 8 % away from what lagrangian converges to
-    assert run(RunSpec("linkedlist-cpu", Scene(dx=0.5, t_end=2.0, model="linear",
-                                               strip_height=Scene.thinnest_strip(0.5)))).mse_isothermal is None
+    # every model is scored against the isothermal physics too (which model a scene needs): `linear` has a floor
+    # there, the two equations' distance (9.8 % at Mach 0.05, t = 10 s), whatever its dx
+    linear = run(RunSpec("linkedlist-cpu", Scene(dx=0.1, t_end=10.0, model="linear",
+                                                 strip_height=Scene.thinnest_strip(0.1))))
+    assert linear.mse < 0.03 and 0.08 < linear.mse_isothermal < 0.12

@@ -49,14 +49,33 @@ def test_the_stencil_row_across_the_periodic_seam_shifts_i_by_ny_rows():
     ncx, ncy = 5, 4
     begin = np.arange(ncx * ncy + 1, dtype=np.uint32) * 2  # two particles per cell
     cell = np.array([0 * ncx + 2], np.int32)  # a particle in the bottom row, middle column
-    ly = np.array([3.0])
-    j0, j1, lyi = P.stencil_row(0, -1, cell, begin, ncx, ncy, ly, k)  # the row below wraps to the top
-    assert (j0, j1) == (begin[3 * ncx + 1], begin[3 * ncx + 4]) and lyi == 3.0 + scene.ny
-    j0, j1, lyi = P.stencil_row(0, 1, cell, begin, ncx, ncy, ly, k)
-    assert (j0, j1) == (begin[1 * ncx + 1], begin[1 * ncx + 4]) and lyi == 3.0
+    ly, lx = np.array([3.0]), np.array([7.0])
+    j0, j1, lyi, q0, q1, _ = P.stencil_row(0, -1, cell, begin, ncx, ncy, ly, lx, k)  # the row below: the top
+    assert (j0, j1) == (begin[3 * ncx + 1], begin[3 * ncx + 4]) and lyi == 3.0 + scene.ny and q0 == q1
+    j0, j1, lyi, q0, q1, _ = P.stencil_row(0, 1, cell, begin, ncx, ncy, ly, lx, k)
+    assert (j0, j1) == (begin[1 * ncx + 1], begin[1 * ncx + 4]) and lyi == 3.0 and q0 == q1
     top = np.array([(ncy - 1) * ncx + 0], np.int32)  # top row, left edge: the row above is row 0, no column -1
-    j0, j1, lyi = P.stencil_row(0, 1, top, begin, ncx, ncy, ly, k)
-    assert (j0, j1) == (begin[0], begin[2]) and lyi == 3.0 - scene.ny
+    j0, j1, lyi, q0, q1, _ = P.stencil_row(0, 1, top, begin, ncx, ncy, ly, lx, k)
+    assert (j0, j1) == (begin[0], begin[2]) and lyi == 3.0 - scene.ny and q0 == q1  # free x edges: no wrap
+
+
+def test_the_stencil_row_across_the_x_seam_shifts_i_by_nx_columns():
+    """A scene periodic in x: the left column's stencil reaches the row's last cell, i shifted right by nx."""
+    scene = Scene(dx=1.0, name="acoustic-pulse")
+    k = kernel.constants(scene, np.float64)
+    assert k[kernel.NX] == scene.nx
+    P = cpu_pairs("float64")
+    ncx, ncy = 5, 4
+    begin = np.arange(ncx * ncy + 1, dtype=np.uint32) * 2
+    ly, lx = np.array([3.0]), np.array([0.0])
+    left = np.array([1 * ncx + 0], np.int32)
+    j0, j1, lyi, q0, q1, lxq = P.stencil_row(0, 0, left, begin, ncx, ncy, ly, lx, k)
+    assert (j0, j1) == (begin[ncx], begin[ncx + 2]) and (q0, q1) == (begin[2 * ncx - 1], begin[2 * ncx])
+    assert lxq == 0.0 + scene.nx and lyi == 3.0
+    right = np.array([1 * ncx + ncx - 1], np.int32)
+    j0, j1, lyi, q0, q1, lxq = P.stencil_row(0, 0, right, begin, ncx, ncy, ly, lx, k)
+    assert (j0, j1) == (begin[2 * ncx - 2], begin[2 * ncx]) and (q0, q1) == (begin[ncx], begin[ncx + 1])
+    assert lxq == 0.0 - scene.nx
 
 
 def test_counting_sort_is_a_stable_sort_with_cell_begin():

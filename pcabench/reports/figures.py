@@ -451,3 +451,66 @@ def cards_figure(rows, out: Path):
             ax.text(0.02, 0.95, "no GPU card measured yet: only the paper's", transform=ax.transAxes, fontsize=8,
                     color="0.3")
     return path
+
+
+def scene_fronts(points, out: Path, pid: str):
+    """Time to solution against error, one panel per scene at its default amplitude (t = 10 s): each model a
+    colour, runs past their predicted stable CFL drawn as crosses (never on a front)."""
+    scenes = sorted({p["scene"] for p in points}, key=lambda s: (s != "plane-pulse", s))
+    if len(scenes) < 2:
+        return None
+    path = out / "scene_fronts.png"
+    past = " x: past the predicted stable CFL," if any(p["past_stable"] for p in points) else ""
+    with figure(path, f"Time to solution against error on each scene, t = 10 s, Mach 0.05 ({pid});{past} "
+                      "colour: model", "time to solution, s", "relative RMS error",
+                ncols=len(scenes), logx=True, logy=True) as axes:
+        for ax, scene in zip(axes, scenes):
+            mine = [p for p in points if p["scene"] == scene and np.isclose(p["mach"], 0.05)]
+            for model in ("linear", "lagrangian"):
+                for past in (False, True):
+                    pts = [p for p in mine if p["model"] == model and p["past_stable"] == past]
+                    if not pts:
+                        continue
+                    ax.scatter([p["seconds"] for p in pts], [p["error"] for p in pts], s=14 if not past else 22,
+                               marker="x" if past else "o", color=MODEL_COLOUR[model],
+                               alpha=0.8 if not past else 0.6,
+                               label=f"{model}" + (" (past the stable CFL)" if past else ""))
+            errors = [p["error"] for p in mine]
+            if errors:
+                nice_log_ticks(ax, errors)
+            ax.set_title(f"{scene} (error of {'u' if scene == 'plane-pulse' else 'drho'})", fontsize=9)
+    return path
+
+
+def phase_direction(curves, fronts, out: Path, pid: str):
+    """Left: the predicted phase speed error (lattice and step) against the direction of travel, one line per
+    method; right: the 2D runs' wave front speed error along the axis and the diagonal, measured against
+    predicted (the same measure on the predicted fields)."""
+    if not curves:
+        return None
+    path = out / "phase_direction.png"
+    colours = palette(max(len(curves), 1))
+    with figure(path, f"Phase speed against the direction of travel ({pid})", "direction, degrees from the "
+                "lattice's x axis", "phase speed error at k = 1/b, %", ncols=2) as axes:
+        ax = axes[0]
+        for c, colour in zip(curves, colours):
+            ax.plot(c["angles"], 100 * np.asarray(c["error"]), color=colour, label=c["label"])
+        ax.set_xticks([0, 15, 30, 45])
+        ax.set_title("predicted, dx = 0.25 m", fontsize=9)
+        ax = axes[1]
+        ax.set_xlabel("predicted front speed error, %")
+        ax.set_ylabel("measured front speed error, %")
+        ax.set_title("2D runs: front along the axis (o) and the diagonal (^)", fontsize=9)
+        values = []
+        for f in fronts:
+            for k, marker in ((0, "o"), (1, "^")):
+                if f["predicted"][k] is None:
+                    continue
+                ax.scatter(100 * f["predicted"][k], 100 * f["measured"][k], marker=marker, facecolors="none",
+                           edgecolors="tab:blue", s=28)
+                values += [100 * f["predicted"][k], 100 * f["measured"][k]]
+        if values:
+            lo, hi = min(values), max(values)
+            pad = 0.05 * (hi - lo or 1.0)
+            ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="0.6", lw=0.8, ls=":")
+    return path

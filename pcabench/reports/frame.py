@@ -18,9 +18,10 @@ import pandas as pd
 from pcabench import store
 from pcabench.record import STEP_STAGES
 from pcabench.spec import stored_parameters
-from solvers import registry
+from solvers import DEFAULT_SCENE, registry
 
-SCENE_COLUMNS = ("strip_height", "cutoff_factor", "kernel", "h_factor", "cfl", "t_final", "height")
+SCENE_COLUMNS = ("strip_height", "cutoff_factor", "kernel", "h_factor", "cfl", "t_final", "height", "mach",
+                 "pulse_width")
 NUMERIC = ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal")
 
 
@@ -30,7 +31,9 @@ def load(paths) -> pd.DataFrame:
 
 
 def _flat(row: dict) -> dict:
-    r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions")}
+    r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions", "errors")}
+    for name, value in (row.get("errors") or {}).items():  # the scene's other error measures
+        r[f"err_{name}"] = value
     for stage, seconds in (row.get("stages") or {}).items():
         r[f"t_{stage}"] = seconds
     scene = row.get("scene") or {}
@@ -38,6 +41,7 @@ def _flat(row: dict) -> dict:
     for key in SCENE_COLUMNS:
         r[key] = scene.get(key)
     r["kernel"] = scene.get("kernel") or "gaussian"  # rows from before the kernel option: the Gaussian
+    r["scene"] = scene.get("name") or DEFAULT_SCENE  # rows from before the scene registry: the paper's
     # how the run ends: the paper's fixed step count, or a fixed physical time
     r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
     r["domain"] = "strip" if scene.get("strip_height") else "full"

@@ -38,10 +38,12 @@ class Context:
     out: Path
     shared: dict = field(default_factory=dict)
     cache: dict = field(default_factory=dict)
+    df_scenes: pd.DataFrame | None = None  # every scene's runs of this machine (``df`` holds the paper's scene's)
 
     @property
     def pid(self) -> str:
-        return str(self.df.profile_id.iloc[0])
+        df = self.df_scenes if self.df_scenes is not None else self.df
+        return str(df.profile_id.iloc[0])
 
     def once(self, key: str, compute: Callable[[], Any], across_machines: bool = False):
         """``compute()`` the first time ``key`` is asked for in this report (or in every report)."""
@@ -66,6 +68,7 @@ class Section:
     rows: Callable[[Context], Any]
     text: Callable[[Any, Context], list[str]]
     figures: tuple[Callable[[Any, Context], Path | None], ...] = ()
+    all_scenes: bool = False  # reads ``ctx.df_scenes``; the others read the paper's scene only
 
 
 def _paper_cell(r) -> str:
@@ -459,4 +462,92 @@ SECTIONS = (
     Section("stability", lambda ctx: T.stability(ctx.df, INACCURATE_ABOVE), _stability_text, (_stability_map,)),
     Section("float32", lambda ctx: T.float32_vs_float64(ctx.df), _float32_text),
     Section("failed", _failed_rows, _failed_text),
+)
+
+
+# ---------------------------------------------------------------- scenes (every scene of the machine's runs)
+def _scene_rows(ctx):
+    from . import scenes as S
+
+    df = ctx.df_scenes if ctx.df_scenes is not None else ctx.df
+    if df.empty or set(df.scene) == {Scene.default("name")} and not (df.mach != Scene.default("mach")).any():
+        return None  # the paper's scene only, at its amplitude: the sections above say it all
+    pts = S.points(df)
+    rows = S.time_to_accuracy(df)
+    methods = {}
+    for r in rows:
+        for p in (r["best"], r["paper"]):
+            if p is not None:
+                methods.setdefault((p["kernel"], p["h_factor"], p["cfl"]), {
+                    "kernel": p["kernel"], "h_factor": p["h_factor"], "cfl": p["cfl"], "dx": 0.25,
+                    "label": f"{p['method']}" + (" (paper's)" if p["paper_method"] else "")})
+    return {"points": pts, "fastest": rows, "needs": S.model_needs(df),
+            "phase": S.phase_directions(list(methods.values())), "fronts": S.front_shifts(pts)}
+
+
+def _scene_text(data, ctx) -> list[str]:
+    if not data:
+        return []
+    from . import scenes as S
+
+    rows = [[r["scene"], r["model"], pct(r["target"]), r["best"]["method"], fmt(r["best"]["dx"], "g"),
+             fmt(r["best"]["seconds"], ".3g"), pct(r["best"]["error"]), pct(r["predicted"]),
+             f"{r['best']['cfl'] / r['best']['stable_cfl']:.2f}" if r["best"]["stable_cfl"] else "-",
+             fmt(r["paper"]["dx"], "g") if r["paper"] else "-", fmt(r["paper"]["seconds"], ".3g") if r["paper"] else "-",
+             fmt(r["speedup"], ".3g") if r["speedup"] else "-"] for r in data["fastest"]]
+    lines = ["## Time to accuracy on each scene", "",
+             f"Every finished run at t = {S.T_FINAL:g} s of every scene (solvers/scenes/; `pcabench study --front "
+             "--scene NAME`), at the scene's default amplitude, Mach 0.05. The error is the scene's primary field "
+             "(u for the plane pulse, drho for the 2D acoustic pulse), relative RMS, against the exact linear "
+             "solution for `linear` and the isothermal solution for `lagrangian`. A run at or past its predicted "
+             "stable CFL is never picked, whatever its error (it was too short for round-off to grow). The "
+             "prediction (`pcabench accuracy --scene NAME`) is exact for `linear` on a periodic scene; for "
+             "`lagrangian` it is the linear part only. Times on this machine, serial unless labelled.", "",
+             md_table(["scene", "model", "target", "fastest method", "dx", "time (s)", "error", "predicted",
+                       "CFL / stable", "paper's method: dx", "time (s)", "paper / fastest"], rows)
+             if rows else "No run of a scene at t = 10 s reaches 10 %.", ""]
+    by_scene = {}
+    for r in data["fastest"]:
+        by_scene.setdefault((r["model"], r["target"]), {})[r["scene"]] = r["best"]["method"]
+    same = [(m, t, v) for (m, t), v in by_scene.items() if len(v) > 1]
+    if same:
+        lines += ["Does the method fastest on the plane pulse stay fastest in 2D? "
+                  + "; ".join(f"{m} to {pct(t)}: " + ("the same method" if len(set(v.values())) == 1 else
+                                                      ", ".join(f"{s}: {meth}" for s, meth in sorted(v.items())))
+                              for m, t, v in sorted(same)) + ".", ""]
+    needs = [[r["scene"], fmt(r["mach"], "g"), pct(r["target"]), pct(r["floor"]),
+              *(("-" if r.get(model) is None else
+                 f"{fmt(r[model]['seconds'], '.3g')} s (dx {fmt(r[model]['dx'], 'g')})" if r[model]["reaches"] else
+                 f"not reached (best {pct(r[model]['best'])})") for model in ("linear", "lagrangian")),
+              "linear suffices" if r["floor"] is not None and r["floor"] < r["target"] else
+              "lagrangian (linear's floor is above the target)"]
+             for r in data["needs"]]
+    if needs:
+        lines += ["### Which model this scene needs", "",
+                  "The paper's method (Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet) at several amplitudes, every "
+                  "model scored against the isothermal physics (the equations the paper's moving particles "
+                  "solve): the cheapest run within the target, or the smallest error its runs reached. `linear`'s "
+                  "floor is the distance between the exact linear and the isothermal solutions at t = 10 s (no "
+                  "dx removes it; it grows with the amplitude and the time): where it is below the target the "
+                  "linear model is all the scene needs.", "",
+                  md_table(["scene", "Mach", "target", "linear's floor", "linear", "lagrangian", "the scene needs"],
+                           needs), ""]
+    if data["phase"]:
+        spread = [abs(c["error"][0] - c["error"][-1]) for c in data["phase"]]
+        lines += ["The lattice's phase error depends on the direction of travel. `phase_direction.png` draws, for "
+                  "the methods of the table, the predicted phase speed error (lattice and step together) at the "
+                  "2D pulse's wavenumber 1/b from the lattice's axis (0 degrees) to its diagonal (45 degrees) at "
+                  f"dx = 0.25 m: axis and diagonal differ by at most {100 * max(spread):.3g} % of c0 there, far "
+                  "less than the lag itself. Beside it, the 2D runs' wave front speed error along the axis and "
+                  "along the diagonal (the outgoing peak of drho against the exact one's, over c0 t), measured "
+                  "against the same measure on the predicted fields; each run also stores its relative RMS error "
+                  "along the axes and the diagonals apart (`err_axis_rms`, `err_diagonal_rms`).", ""]
+    return lines
+
+
+SECTIONS = SECTIONS + (
+    Section("scenes", _scene_rows, _scene_text,
+            (lambda d, ctx: F.scene_fronts(d["points"], ctx.out, ctx.name) if d else None,
+             lambda d, ctx: F.phase_direction(d["phase"], d["fronts"], ctx.out, ctx.name) if d else None),
+            all_scenes=True),
 )

@@ -409,7 +409,7 @@ def predicted_by_model(df, dxs=(0.4, 0.2, 0.1)) -> list[dict]:
             p = {"kernel": "gaussian", "h_factor": r.h_factor, "cfl": r.cfl, "integrator": r.integrator,
                  "cutoff_factor": r.cutoff_factor, "dx": dx, "t_final": r.t_final, "strip_height": r.strip_height}
             rows.append({"model": model, "dx": dx, "measured": r.mse, "predicted": predicted_error(p),
-                         "isothermal": r.mse_isothermal})
+                         "isothermal": r.mse_isothermal if model == "lagrangian" else None})
     return rows
 
 

@@ -94,3 +94,38 @@ def test_list_build(benchmark, name, precision):
                                  "candidates_per_particle": cand / n, "pairs_per_particle": pairs / n,
                                  "ns_per_candidate": 1e9 * best / cand, "ns_per_pair": 1e9 * best / pairs})
     assert pairs / n == pytest.approx(np.pi * (solver.scene.cutoff / LIST_DX) ** 2 / 2, rel=0.1)  # each pair once
+
+
+# ---------------------------------------------------------------- one step of every scene (small sizes)
+SCENE_CASES = {"plane-pulse": {"dx": 1.0}, "acoustic-pulse": {"dx": 1.0, "x_min": -16.0, "x_max": 16.0,
+                                                             "y_min": -16.0, "y_max": 16.0}}
+
+
+@pytest.mark.parametrize("scene", SCENE_CASES)
+def test_scene_step(benchmark, scene):
+    """One Verlet step of each scene (linked list, float64, linear, about 1,000 particles), and its primary
+    error after the timed steps against the scene's exact solution: a change that breaks a scene shows."""
+    from pcabench.run import run
+    from pcabench.spec import RunSpec
+    from solvers.integrators import step_program
+
+    s = Scene(name=scene, steps=20, model="linear", cfl=0.5, **SCENE_CASES[scene])
+    solver = make_solver("linkedlist-cpu")
+    solver.input(s)
+    solver.warmup()
+    solver = make_solver("linkedlist-cpu")
+    solver.input(s)
+    solver.init()
+    first = [True]
+
+    def step():
+        for _stage, op in step_program(s.integrator, solver, first=first[0]):
+            op()
+        first[0] = False
+
+    benchmark.group = f"scene {scene} N={s.n_particles}"
+    benchmark.pedantic(step, rounds=ROUNDS, iterations=1, warmup_rounds=1)
+    record = run(RunSpec("linkedlist-cpu", s))  # the scene's error measures after 20 steps, by the harness
+    benchmark.extra_info.update({"scene": scene, "n_particles": s.n_particles, "mse": record.mse,
+                                 "errors": record.errors, "profile_id": machine_id()})
+    assert record.status == "ok" and record.mse < 0.3

@@ -1,0 +1,194 @@
+"""Scenes (solvers/scenes/): the registry, the 2D acoustic pulse on every solver, its exact prediction,
+its convergence to the exact reference, conservation on the periodic square, and one-line refusals."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from pcabench.reports.frame import frame
+from pcabench.run import run
+from pcabench.spec import RunSpec, identity, scene_from_row
+from solvers import DEFAULT_SCENE, Scene, SceneError, make_solver, scene_names
+from solvers.dispersion import predict, predicted_fields_2d, stable_cfl
+from solvers.integrators import step_program
+from solvers.linkedlist_cpu import LinkedListCPU
+
+from .conftest import cli_main
+
+
+def pulse(dx=1.0, **kw) -> Scene:
+    return Scene(dx=dx, name="acoustic-pulse", **{"steps": 12, "cfl": 0.5, **kw})
+
+
+def evolve(name, scene, **kw):
+    """The final fields of ``scene`` run on solver ``name`` (no harness: the primitives, step by step)."""
+    solver = make_solver(name, **kw)
+    solver.input(scene)
+    solver.init()
+    for step in range(1, scene.n_steps + 1):
+        for _stage, op in step_program(scene.integrator, solver, first=(step == 1)):
+            op()
+    return solver.output()
+
+
+def test_the_registry_offers_the_paper_scene_first_and_the_2d_pulse():
+    assert scene_names()[0] == DEFAULT_SCENE == "plane-pulse" == Scene(dx=1.0).name
+    assert "acoustic-pulse" in scene_names()
+    s = pulse()
+    assert s.periodic_x and (s.x_min, s.x_max, s.y_min, s.y_max) == (-20.0, 20.0, -20.0, 20.0)
+    assert not Scene(dx=1.0).periodic_x and (Scene(dx=1.0).x_min, Scene(dx=1.0).x_max) == (-10.0, 40.0)
+
+
+def test_rows_stored_before_the_registry_read_as_the_paper_scene():
+    old = {"dx": 0.5, "steps": 10, "x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
+    assert scene_from_row({"scene": old}).name == DEFAULT_SCENE
+    row = {"solver": "linkedlist-cpu", "scene": old, "stages": {s: 0.0 for s in
+           ("input", "init", "snp", "pi", "su", "output")}, "steps": 10, "status": "ok", "profile_id": "m",
+           "host": "h", "commit": "c", "mse": 0.1}
+    assert frame([row]).scene.iloc[0] == DEFAULT_SCENE
+    # the resume key tells the scenes apart
+    a, b = Scene(dx=0.5, t_end=5.0), pulse(dx=0.5, t_end=5.0, steps=None)
+    assert identity("linkedlist-cpu", 1, a, "", "m", "c", "h") != identity("linkedlist-cpu", 1, b, "", "m", "c", "h")
+    assert identity("linkedlist-cpu", 1, a, "", "m", "c", "h") == identity("linkedlist-cpu", 1, old | {"t_end": 5.0,
+                                                                            "steps": None}, "", "m", "c", "h")
+
+
+@pytest.mark.parametrize("model", ["linear", "lagrangian"])
+def test_every_cpu_solver_agrees_on_the_periodic_square(model):
+    scene = pulse(model=model, mach=0.2)
+    ref = evolve("allpair-cpu", scene)
+    for kw in (dict(pair_loop="gather"), dict(pair_loop="list"), dict(pair_loop="list", threads=2),
+               dict(pair_loop="gather", threads=2)):
+        got = evolve("linkedlist-cpu", scene, **kw)
+        for field in ("drho", "u", "v", "x", "y"):
+            assert np.abs(getattr(got, field) - getattr(ref, field)).max() < 1e-14, (kw, field)
+
+
+def test_moving_particles_cross_the_x_seam_and_keep_their_neighbours():
+    """The pulse sits on the square's left edge, so lagrangian particles cross the periodic seam: the cell list
+    (which moves a crossing particle's lattice coordinate by a period) agrees with the all-pair minimum image."""
+    scene = pulse(dx=0.5, model="lagrangian", mach=0.3, pulse_center=-20.0, steps=40, cfl=1.0)
+    ref = evolve("allpair-cpu", scene)
+    solver = make_solver("linkedlist-cpu")
+    solver.input(scene)
+    solver.init()
+    for step in range(1, scene.n_steps + 1):
+        for _stage, op in step_program(scene.integrator, solver, first=(step == 1)):
+            op()
+    got = solver.output()
+    assert np.abs(got.drho - ref.drho).max() < 1e-13 and np.abs(got.u - ref.u).max() < 1e-13
+    lx = solver.arrays["lx"]
+    assert (lx < 0).any() or (lx >= scene.nx).any()  # some particles did cross, and were wrapped
+
+
+SIM_SCRIPT = r"""
+import json, sys, numpy as np
+from solvers import Scene, make_solver
+from solvers.integrators import step_program
+out = {}
+for precision in ("float64", "float32"):
+    scene = Scene(dx=1.0, name="acoustic-pulse", x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0, steps=6,
+                  cfl=0.5, model="lagrangian", precision=precision, mach=0.2)
+    for name in ("linkedlist-cpu", "linkedlist-gpu"):
+        s = make_solver(name); s.input(scene); s.init()
+        for step in range(1, scene.n_steps + 1):
+            for _st, op in step_program(scene.integrator, s, first=(step == 1)):
+                op()
+        out[precision + name] = s.output().drho.tolist()
+print(json.dumps(out))
+"""
+
+
+def test_the_gpu_solver_runs_the_periodic_square_in_the_simulator():
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT], capture_output=True, text=True, env=env, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    for precision, tol in (("float64", 1e-12), ("float32", 2e-5)):
+        cpu, gpu = np.array(out[precision + "linkedlist-cpu"]), np.array(out[precision + "linkedlist-gpu"])
+        assert np.abs(gpu - cpu).max() <= tol * np.abs(cpu).max()
+
+
+@pytest.mark.parametrize("kw", [dict(), dict(kernel="wendland-c2", h_factor=1.3, cfl=1.5),
+                                dict(kernel="wendland-c4", h_factor=1.6, cfl=2.0), dict(integrator="kdk1")])
+def test_the_2d_prediction_is_the_linear_run(kw):
+    """The linear operator is diagonal in the periodic lattice's Fourier basis: the prediction (no simulation)
+    is the run to round-off, error measures included."""
+    scene = Scene(dx=0.5, name="acoustic-pulse", t_end=10.0, model="linear", **kw)
+    record = run(RunSpec("linkedlist-cpu", scene))
+    assert record.status == "ok"
+    p = predict(scene)
+    assert p.predicted_error == pytest.approx(record.mse, rel=1e-8)
+    for name, value in p.measures.items():
+        assert value == pytest.approx(record.errors[name], rel=1e-8), name
+    _x, _y, drho, _u, _v, _t = predicted_fields_2d(scene)
+    assert p.stable_cfl == pytest.approx(stable_cfl(scene.replace(name=DEFAULT_SCENE)), rel=1e-12)
+
+
+def test_the_2d_pulse_converges_to_the_exact_reference():
+    """At fixed h/dx the linear model converges to the exact 2D pulse (prediction = run, tested above): the
+    paper's method, 10.7 % at dx 0.25 and 3.1 % at dx 0.125, order 1.81 (measured)."""
+    errors = [predict(Scene(dx=dx, name="acoustic-pulse", t_end=10.0, model="linear")).predicted_error
+              for dx in (0.25, 0.125)]
+    order = np.log(errors[0] / errors[1]) / np.log(2.0)
+    assert errors[1] < 0.05 and order > 1.7, (errors, order)
+
+
+def test_mass_and_momentum_are_conserved_on_the_periodic_square():
+    """On the periodic square every pair across the x and y seams acts on both its particles: `linear` keeps
+    sum drho (the lattice's sums of r_ij G vanish for every particle), `lagrangian` keeps sum m u (pairwise
+    antisymmetric forces), to round-off; a pair missed across a seam breaks both."""
+    scene = pulse(model="linear", steps=20)
+    f = evolve("linkedlist-cpu", scene)
+    x = scene.x_lo + (np.arange(scene.n_particles) % scene.nx + 0.5) * scene.dx
+    y = scene.y_lo + (np.arange(scene.n_particles) // scene.nx + 0.5) * scene.dx
+    _u, _v, drho0 = scene.kind.initial_fields(scene, x, y, np)
+    assert abs(f.drho.sum() - drho0.sum()) < 1e-12 * np.abs(drho0).sum()
+    moving = pulse(model="lagrangian", mach=0.2, steps=20, pulse_center=-20.0)  # the pulse across the x seam
+    solver = make_solver("linkedlist-cpu")
+    solver.input(moving)
+    solver.init()
+    for step in range(1, moving.n_steps + 1):
+        for _stage, op in step_program(moving.integrator, solver, first=(step == 1)):
+            op()
+    a = solver.arrays
+    scale = np.abs(a["mass"] * np.hypot(a["u"], a["v"])).sum()
+    assert abs((a["mass"] * a["u"]).sum()) < 1e-12 * scale and abs((a["mass"] * a["v"]).sum()) < 1e-12 * scale
+
+
+def test_a_solver_without_periodic_x_is_refused_in_one_line():
+    class OldCellList(LinkedListCPU):
+        name = "old-cell-list"
+        boundaries = ("free-x", "periodic-y")
+
+    with pytest.raises(SceneError, match="periodic-x"):
+        OldCellList.supports(pulse())
+    OldCellList.supports(Scene(dx=1.0))
+
+
+@pytest.mark.parametrize("args,words", [
+    (("--scene", "no-such"), "--scene"),
+    (("--scene", "acoustic-pulse", "--mach", "0.5"), "--mach"),
+    (("--scene", "acoustic-pulse", "--pulse-width", "50"), "--pulse-width"),
+    (("--scene", "acoustic-pulse", "--strip-height", "20"), "--strip-height"),
+    (("--domain-size", "30"), "--domain-size"),
+    (("--t-end", "100", "--model", "lagrangian"), "breaking time"),
+    (("--scene", "acoustic-pulse", "--domain-size", "10"), "--domain-size"),
+])
+def test_bad_scene_input_is_one_line(args, words, capsys):
+    rc, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", *args, capsys=capsys)
+    assert rc == 2 and words in err and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_the_accuracy_command_predicts_a_scene(capsys):
+    rc, out, err = cli_main("accuracy", "--scene", "acoustic-pulse", "--dx", "0.5", "--json", capsys=capsys)
+    assert rc == 0, err
+    data = json.loads(out)
+    assert data["predicted_error"] == pytest.approx(
+        predict(Scene(dx=0.5, name="acoustic-pulse", t_end=10.0, model="linear")).predicted_error, rel=1e-12)
+    assert data["scene"]["name"] == "acoustic-pulse" and "axis_rms" in data["measures"]
