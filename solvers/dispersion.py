@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -174,8 +175,18 @@ def largest_stable_z(integrator: str) -> float:
 
 
 def stable_cfl(scene) -> float:
-    """The largest stable CFL (dt c0 / dx) for the scene's kernel, h/dx, cutoff and integrator."""
-    return largest_stable_z(scene.integrator) / (scene.dx * largest_symbol(scene))
+    """The largest stable CFL (dt c0 / dx) for the scene's kernel, h/dx, cutoff and integrator (it does not
+    depend on dx: D scales as 1/dx at fixed h/dx)."""
+    return _stable_cfl(scene.kernel, float(scene.h_factor), float(scene.cutoff_factor), scene.integrator)
+
+
+@lru_cache(maxsize=1024)
+def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> float:
+    from .scene import Scene
+
+    unit = Scene(dx=1.0, kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor, integrator=integrator,
+                 model="linear", memory_limit_bytes=2**62)
+    return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
 
 
 @dataclass(frozen=True)

@@ -192,3 +192,21 @@ def test_the_accuracy_command_predicts_a_scene(capsys):
     assert data["predicted_error"] == pytest.approx(
         predict(Scene(dx=0.5, name="acoustic-pulse", t_end=10.0, model="linear")).predicted_error, rel=1e-12)
     assert data["scene"]["name"] == "acoustic-pulse" and "axis_rms" in data["measures"]
+
+
+def test_the_fast_methods_come_from_the_prediction():
+    """The front's fast methods on the paper's scene are the cheapest the prediction says reach the paper's
+    configuration's error, one per kernel, within the model's margin of the predicted stable CFL."""
+    from pcabench.methods import MARGIN, fastest
+    from pcabench.presets import fast_methods
+
+    paper = predict(Scene(dx=0.05, t_end=10.0, model="linear", memory_limit_bytes=2**62)).predicted_error
+    found = fastest(paper, 10.0, "linear")
+    assert len({m["kernel"] for m in found}) == len(found) == 3
+    for m in found:
+        assert m["predicted_error"] <= paper and m["cfl"] <= MARGIN["linear"] * m["stable_cfl"] + 0.01
+        scene = Scene(dx=m["dx"], t_end=10.0, model="linear", kernel=m["kernel"], h_factor=m["h_factor"],
+                      cfl=m["cfl"], memory_limit_bytes=2**62)
+        assert predict(scene).predicted_error == pytest.approx(m["predicted_error"])
+    assert [dict(kernel=m["kernel"], h_factor=m["h_factor"], cfl=m["cfl"], dx=m["dx"]) for m in found] == \
+        list(fast_methods("linear"))
