@@ -57,6 +57,9 @@ def quick() -> list[RunSpec]:
     runs.append(_spec(dx=0.2, t_end=10.0, model="lagrangian"))
     # The stability map: Verlet on the stability scene at a few CFLs, up to past its limit
     runs += [_spec(dx=STABILITY_DX, t_end=10.0, model="linear", strip=True, cfl=cfl) for cfl in QUICK_CFL]
+    # Another scene: the 2D acoustic pulse, linear and lagrangian, at the default amplitude and a small one
+    runs += [_spec(name="acoustic-pulse", dx=0.5, t_end=10.0, model=model, mach=mach)
+             for mach in (Scene.default("mach"), 0.005) for model in ("linear", "lagrangian")]
     return runs
 
 

@@ -73,11 +73,11 @@ def test_a_quick_study_writes_every_figure_and_section_the_readme_promises(quick
     figures = {p.name for p in (out / PROFILE).glob("*.png")}
     assert figures == {"fig8_error_vs_dx.png", "fig9_allpair_vs_linkedlist.png", "fig10_runtime_vs_N.png",
                        "fig11_step_shares.png", "fig13_task_shares.png", "speed_vs_accuracy.png",
-                       "stability_map.png"}
+                       "stability_map.png", "scene_fronts.png", "phase_direction.png"}
     text = (out / PROFILE / "report.md").read_text()
     for heading in ("Table 4", "Table 5 and Fig. 11", "Fig. 10", "Speed per particle-step", "Fig. 9", "Fig. 8",
                     "Time to a given accuracy", "The cost of each simplification", "Stability: where methods fail",
-                    "float32 against float64", "Runs that did not finish"):
+                    "float32 against float64", "Runs that did not finish", "Time to accuracy on each scene"):
         assert f"## {heading}" in text, heading
     assert len(found) == len(figures) + 2  # and the cards page's two
 

@@ -483,33 +483,36 @@ def scene_fronts(points, out: Path, pid: str):
 
 
 def phase_direction(curves, fronts, out: Path, pid: str):
-    """Left: the predicted phase speed error (lattice and step) against the direction of travel, one line per
-    method; right: the 2D runs' wave front speed error along the axis and the diagonal, measured against
-    predicted (the same measure on the predicted fields)."""
+    """The lattice's anisotropy: the predicted phase speed error's change from its value along the axis, against
+    the direction of travel, one colour per method, at the pulse's wavenumber and at a short wave (a panel
+    each); where 2D runs stored it, their wave front speed error along the axis and the diagonal, measured
+    against predicted."""
     if not curves:
         return None
     path = out / "phase_direction.png"
-    colours = palette(max(len(curves), 1))
-    with figure(path, f"Phase speed against the direction of travel ({pid})", "direction, degrees from the "
-                "lattice's x axis", "phase speed error at k = 1/b, %", ncols=2) as axes:
-        ax = axes[0]
-        for c, colour in zip(curves, colours):
-            ax.plot(c["angles"], 100 * np.asarray(c["error"]), color=colour, label=c["label"])
-        ax.set_xticks([0, 15, 30, 45])
-        ax.set_title("predicted, dx = 0.25 m", fontsize=9)
-        ax = axes[1]
-        ax.set_xlabel("predicted front speed error, %")
-        ax.set_ylabel("measured front speed error, %")
-        ax.set_title("2D runs: front along the axis (o) and the diagonal (^)", fontsize=9)
-        values = []
-        for f in fronts:
-            for k, marker in ((0, "o"), (1, "^")):
-                if f["predicted"][k] is None:
-                    continue
-                ax.scatter(100 * f["predicted"][k], 100 * f["measured"][k], marker=marker, facecolors="none",
-                           edgecolors="tab:blue", s=28)
-                values += [100 * f["predicted"][k], 100 * f["measured"][k]]
-        if values:
+    colours = palette(len(curves))
+    fronts = [f for f in fronts if f["predicted"][0] is not None]
+    with figure(path, f"Phase speed against the direction of travel, predicted at dx = 0.25 m ({pid}); "
+                      "colour: method", "direction, degrees from the lattice's x axis",
+                "phase speed error minus its value along the axis, %", ncols=3 if fronts else 2) as axes:
+        for ax, key, title in ((axes[0], "error", "the pulse's wavenumber k = 1/b"),
+                               (axes[1], "short", "a short wave, 8 particles per wavelength")):
+            for c, colour in zip(curves, colours):
+                values = 100 * np.asarray(c[key])
+                ax.plot(c["angles"], values - values[0], color=colour, label=c["label"])
+            ax.set_xticks([0, 15, 30, 45])
+            ax.set_title(title, fontsize=9)
+        if fronts:
+            ax = axes[2]
+            ax.set_xlabel("predicted front speed error, %")
+            ax.set_ylabel("measured front speed error, %")
+            ax.set_title("2D runs: the front along the axis (o) and the diagonal (^)", fontsize=9)
+            values = []
+            for f in fronts:
+                for k, marker in ((0, "o"), (1, "^")):
+                    ax.scatter(100 * f["predicted"][k], 100 * f["measured"][k], marker=marker, facecolors="none",
+                               edgecolors="tab:blue", s=28)
+                    values += [100 * f["predicted"][k], 100 * f["measured"][k]]
             lo, hi = min(values), max(values)
             pad = 0.05 * (hi - lo or 1.0)
             ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="0.6", lw=0.8, ls=":")

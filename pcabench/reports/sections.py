@@ -534,11 +534,13 @@ def _scene_text(data, ctx) -> list[str]:
                            needs), ""]
     if data["phase"]:
         spread = [abs(c["error"][0] - c["error"][-1]) for c in data["phase"]]
+        short = [abs(c["short"][0] - c["short"][-1]) for c in data["phase"]]
         lines += ["The lattice's phase error depends on the direction of travel. `phase_direction.png` draws, for "
                   "the methods of the table, the predicted phase speed error (lattice and step together) at the "
                   "2D pulse's wavenumber 1/b from the lattice's axis (0 degrees) to its diagonal (45 degrees) at "
                   f"dx = 0.25 m: axis and diagonal differ by at most {100 * max(spread):.3g} % of c0 there, far "
-                  "less than the lag itself. Beside it, the 2D runs' wave front speed error along the axis and "
+                  "less than the lag itself; for a short wave of 8 particles per wavelength by up to "
+                  f"{100 * max(short):.3g} %. Beside it, the 2D runs' wave front speed error along the axis and "
                   "along the diagonal (the outgoing peak of drho against the exact one's, over c0 t), measured "
                   "against the same measure on the predicted fields; each run also stores its relative RMS error "
                   "along the axes and the diagonals apart (`err_axis_rms`, `err_diagonal_rms`).", ""]
