@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import os
 import re
@@ -35,7 +34,7 @@ from solvers import (
     registry,
 )
 
-from . import __version__, memory, paths
+from . import __version__, jsonout, memory, paths
 from .errors import NoResults
 from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
@@ -232,7 +231,7 @@ def cmd_run(args) -> int:
         out["kernel"] = scene.kernel
         out["mse_isothermal"] = record.mse_isothermal
         out["message"] = record.message
-        print(json.dumps(to_row(out), allow_nan=False))  # standard JSON: null, never NaN
+        print(jsonout.dumps(to_row(out)))  # strict JSON: null, never NaN
     else:
         print(record.stage_table())
         print(f"particles        {record.n_particles:,}")
@@ -368,6 +367,8 @@ def cmd_runs(args) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("default")
         df = load(results)
+    if df.empty:
+        raise NoResults(f"no stored runs in {results}: run `pcabench study` first, or use --reference")
     with pd.option_context("display.max_columns", None, "display.width", 200):
         if args.compare:
             try:
@@ -377,8 +378,11 @@ def cmd_runs(args) -> int:
             print(runs.render(out) if not out.empty else "no configuration was run by both")
         else:
             out = runs.table(df, solver=args.solver, status=args.status, machine=args.machine, commit=args.commit,
-                             model=args.model).tail(args.limit)
-            print(runs.render(out) if not out.empty else f"no stored runs match in {results}")
+                             model=args.model)
+            print(runs.render(out.tail(args.limit)) if not out.empty else f"no stored runs match in {results}")
+            if len(out) > args.limit:
+                print(f"(the last {args.limit} of {len(out)} matching runs, by machine and time; --limit {len(out)} "
+                      "shows them all)")
     return 0
 
 
@@ -388,9 +392,14 @@ def cmd_accuracy(args) -> int:
     given = {key: getattr(args, opt) for opt, key in ACCURACY_OPTIONS.items() if getattr(args, opt) is not None}
     scene = Scene(dx=args.dx, t_end=args.t_end, model="linear", memory_limit_bytes=2**62, **given)
     p = predict(scene)
+    past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/stability.py)
     if args.json:
-        print(json.dumps({"scene": scene.as_dict(), **p.as_dict()}, sort_keys=True))
+        print(jsonout.dumps({"scene": scene.as_dict(), **p.as_dict(), "past_stable_cfl": past}, sort_keys=True))
         return 0
+    if past:
+        print(f"CFL {scene.cfl:g} is past the largest stable CFL {p.stable_cfl:.3g} of {scene.integrator}: a run "
+              "grows without bound (the predicted error is that growth)" if p.stable_cfl > 0 else
+              f"{scene.integrator} grows at every CFL: a long enough run grows without bound")
     print(f"{scene.describe()}\n"
           f"predicted relative RMS error of u at t = {p.t_end:.4g} s: {p.predicted_error:.4g} (max error "
           f"{p.predicted_me:.3g} m/s)\n"
@@ -425,14 +434,15 @@ def cmd_advise(args) -> int:
         machine = machine_id() if machine_id() in machines else machines.index[0]
     out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain)}
     if args.json:
-        print(json.dumps(out, sort_keys=True, default=str))
-        return 0
+        print(jsonout.dumps(out, sort_keys=True))
+        return EXIT_OK if out["found"] else EXIT_RUN_FAILED
     head = (f"{args.model} to a relative RMS error of u <= {args.error:g} (against {out['error_against']}) at "
             f"t = {args.t_end:g} s on {machine}"
             + (f", {args.domain} domain" if args.domain else ""))
     if not out["found"]:
         s = out["suggestion"]
-        print(f"{head}: none of the {out['runs_considered']} stored runs reaches it.")
+        print(f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL.")
+        _print_unstable(out["unstable_by_prediction"], "runs that reach it")
         if "study" not in s:
             print("no method of the searched grid is predicted to reach it")
         else:
@@ -442,17 +452,34 @@ def cmd_advise(args) -> int:
               f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)")
         return EXIT_RUN_FAILED
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
-          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} of a predicted stable {out['stable_cfl']:.3g}, "
-          f"dx {out['dx']:g}, {out['precision']}, {out['threads']} thread(s), {out['domain']} domain, "
-          f"{out['n_particles']:,} particles, {out['steps']} steps, commit {out['commit'][:7]})"
-          + (" -- close to the stability limit" if out["cfl_margin"] < 1.2 else "") + f"\n  {out['command']}")
-    if out["paper_seconds"]:
+          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the predicted stable "
+          f"{out['stable_cfl']:.3g}, dx {out['dx']:g}, {out['precision']}, {out['threads']} thread(s), "
+          f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
+          f"commit {out['commit'][:7]})\n  {out['command']}")
+    if out["is_paper_configuration"]:
+        print("  this is the paper's configuration: none faster reaches the error")
+    elif out["paper_seconds"]:
         print(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
-              f"{out['speedup_over_paper']:.3g}x slower\n  {out['paper_command']}")
+              f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}")
     else:
-        print("  no stored run of the paper's configuration that compares with it (same kind of domain, threads "
-              "and commit) reaches it; `pcabench advise --domain full` or `strip` looks at another")
-    return 0
+        other = {"strip": "full", "full": "strip"}[out["domain"]]
+        print(f"  no stored run of the paper's configuration on the {out['domain']} domain with the same threads "
+              f"and commit reaches it; `pcabench advise --domain {other}` looks at the {other} domain's runs")
+    _print_unstable(out["unstable_by_prediction"], "faster runs")
+    return EXIT_OK
+
+
+def _print_unstable(rows, what: str) -> None:
+    """advise's runs past their predicted stable CFL that reached the error: named, never advised."""
+    if rows:
+        print(f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a longer run "
+              "or a finer dx grows them without bound)")
+    for r in rows:
+        limit = (f"CFL {r['cfl']:g} is past the predicted stable {r['stable_cfl']:.3g}" if r["stable_cfl"] > 0
+                 else "its integrator grows at every CFL")
+        print(f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
+              f"bounded only because its {r['steps']} steps gave the most unstable mode "
+              f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)")
 
 
 def cmd_profile(args) -> int:
@@ -467,7 +494,7 @@ def cmd_profile(args) -> int:
     if args.save:
         out = check_folder(args.out, "--out") if args.out else check_folder(paths.user_profiles(), home_option())
         print(f"wrote {profiles.save(profile, out)}", file=sys.stderr)
-    print(json.dumps(profile, indent=2))
+    print(jsonout.dumps(profile, indent=2))
     return 0
 
 
@@ -546,7 +573,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--compare", nargs=2, metavar=("A", "B"),
                    help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, "
                         "ratio, errors")
-    p.add_argument("--limit", type=positive_int("--limit"), default=200, help="the newest rows to print at most")
+    p.add_argument("--limit", type=positive_int("--limit"), default=200,
+                   help="print at most the last this many matching runs, by machine and time (default 200; a line "
+                        "says when rows were left out)")
     p.set_defaults(func=cmd_runs)
 
     p = sub.add_parser("accuracy", help="predict a run's error and largest stable CFL from the dispersion relation",

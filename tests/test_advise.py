@@ -50,7 +50,7 @@ def test_the_fastest_run_reaching_the_error_against_the_paper_method_on_the_same
     assert out["domain"] == "strip" and out["paper_seconds"] == pytest.approx(50.0)  # not the full domain's 900
     assert out["speedup_over_paper"] == pytest.approx(25.0)
     assert "--kernel wendland-c2" in out["command"] and "--strip-height 4" in out["command"]
-    assert 0 < out["stable_cfl"] and out["cfl_margin"] == pytest.approx(out["stable_cfl"] / 2.5)
+    assert 0 < out["stable_cfl"] and out["cfl_fraction"] == pytest.approx(2.5 / out["stable_cfl"])
     full = advise(df, 0.01, 10.0, domain="full")
     assert full["seconds"] == pytest.approx(30.0) and full["paper_seconds"] == pytest.approx(900.0)
 

@@ -18,12 +18,14 @@ from pathlib import Path
 import numpy as np
 from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
+from pcabench.stability import UNSTABLE_BY_PREDICTION
+
 from . import paper as P
 from . import tables as T
 
 CLASS_STYLE = {"stable": ("tab:green", "o"), "inaccurate": ("tab:orange", "s"), "unstable": ("tab:red", "X"),
                "timeout": ("tab:gray", "v"), "error": ("black", "x"), "out-of-memory": ("tab:purple", "P"),
-               "skipped": ("tab:gray", ".")}
+               "skipped": ("tab:gray", "."), UNSTABLE_BY_PREDICTION: ("tab:red", "X")}
 STAGE_COLOURS = {"input": "tab:gray", "init": "tab:brown", "snp": "tab:blue", "pi": "tab:orange",
                  "su": "tab:green", "output": "tab:purple"}
 PRECISION_MARKER = {"float64": "o", "float32": "s"}
@@ -387,11 +389,17 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
                 ncols=len(panels), logx=True, logy=True, size=(5.2 * len(panels) + 3.8, 4.6)) as axes:
         for ax, (t_final, model) in zip(axes, panels):
             here = [p for p in points if (p["t_final"], p["model"]) == (t_final, model)]
-            for (kern, precision), pts in _groups(here, ("kernel", "precision")):
+            for (kern, precision), pts in _groups([p for p in here if not p.get("past_limit")],
+                                                  ("kernel", "precision")):
                 colour = KERNEL_COLOURS.get(kern, "grey")
                 ax.plot([p["seconds"] for p in pts], [p["error"] for p in pts], ls="none", marker="o", ms=4.5,
                         color=colour, mfc="none" if precision == "float32" else colour, alpha=0.75,
                         label=f"{kern}, {precision}")
+            past = [p for p in here if p.get("past_limit")]
+            if past:
+                ax.plot([p["seconds"] for p in past], [p["error"] for p in past], ls="none", marker="X", ms=6,
+                        mfc="none", mec="tab:purple", mew=1.0,
+                        label="unstable by prediction (CFL at or past its stable CFL), any kernel: never on the front")
             paper = [p for p in here if p["paper_method"]]
             ax.plot([p["seconds"] for p in paper], [p["error"] for p in paper], ls="none", marker="*", ms=11,
                     mfc="none", mec="black", mew=1.1, label="the paper's method (Gaussian, h 2.13dx, 3h, CFL 0.2)")
@@ -408,24 +416,42 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
 
 
 def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
+    """Each method's runs by CFL, in the classes of the section's table (``tables.stability``), and the
+    predicted stable CFL of each row as a black bar; a tick at every CFL swept."""
     if not points:
         return None
     configs = [lim["config"] for lim in limits]
     path = out / "stability_map.png"
-    with figure(path, f"Stability map ({pid}): inaccurate = bounded but relative RMS > "
-                f"{100 * inaccurate_above:g} %; numbers: the step where an unstable run stopped",
-                "CFL = dt c0 / dx", "", logx=True, size=(11, 1.8 + 0.32 * len(configs))) as (ax,):
+    with figure(path, f"Stability map ({pid}): black bar: the predicted stable CFL; past it a run is unstable "
+                "(hollow: it ended bounded, too few steps for round-off to grow); inaccurate = bounded but relative "
+                f"RMS > {100 * inaccurate_above:g} %; numbers: the step where a run blew up",
+                "CFL = dt c0 / dx", "", logx=True, size=(11, 2.1 + 0.32 * len(configs))) as (ax,):
         for cls, (colour, marker) in CLASS_STYLE.items():
             pts = [p for p in points if p["class"] == cls]
             if pts:
-                ax.scatter([p["cfl"] for p in pts], [configs.index(p["config"]) for p in pts], c=colour,
-                           marker=marker, s=40, label=cls)
+                hollow = cls == UNSTABLE_BY_PREDICTION
+                ax.scatter([p["cfl"] for p in pts], [configs.index(p["config"]) for p in pts],
+                           c="none" if hollow else colour, edgecolors=colour if hollow else None, marker=marker,
+                           s=40, linewidths=1.2 if hollow else None, label=cls)
         for p in points:
             if p["class"] == "unstable" and p["failed_step"]:
                 ax.annotate(f"{int(p['failed_step'])}", (p["cfl"], configs.index(p["config"])), fontsize=6,
                             xytext=(3, 3), textcoords="offset points")
-        plain_log_ticks(ax, [p["cfl"] for p in points])
-        ax.tick_params(axis="x", labelsize=7)
+        cfls = [p["cfl"] for p in points]
+        drawn = False
+        for i, lim in enumerate(limits):
+            if lim["stable_cfl"] > 0:
+                ax.plot([lim["stable_cfl"]] * 2, [i - 0.38, i + 0.38], color="black", lw=2, solid_capstyle="butt",
+                        label=None if drawn else "predicted stable CFL")
+                drawn = True
+            else:
+                ax.annotate("predicted: grows at every CFL", (min(cfls), i), xytext=(-4, 6),
+                            textcoords="offset points", fontsize=6, color="0.3", ha="left")
+        ax.set_xlim(min(cfls) / 1.25, max(cfls + [lim["stable_cfl"] for lim in limits]) * 1.1)
+        ax.xaxis.set_major_locator(FixedLocator(sorted(set(cfls))))
+        ax.xaxis.set_major_formatter(lambda v, _: f"{v:g}")
+        ax.xaxis.set_minor_locator(NullLocator())
+        ax.tick_params(axis="x", labelsize=7, labelrotation=90)
         ax.set_yticks(range(len(configs)))
         ax.set_yticklabels(configs, fontsize=7)
         ax.set_ylim(-0.6, len(configs) - 0.4)

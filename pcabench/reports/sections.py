@@ -318,8 +318,29 @@ def _front_text(data, ctx) -> list[str]:
             "is the linear part only: the moving particles and the nonlinear terms add to it.", "",
             md_table(["model", "t (s)", "method", "dx", "domain", "precision", "time (s)", "error", "predicted"],
                      fronts), "",
+            *_unstable_front_text(T.unstable_on_front(points)),
             *_predicted_by_model(data["predicted"]),
             *_why_the_paper_method()]
+
+
+def _limit_words(stable_cfl: float) -> str:
+    return f"{stable_cfl:.3g}" if stable_cfl > 0 else "none (grows at every CFL)"
+
+
+def _unstable_front_text(rows) -> list[str]:
+    if not rows:
+        return []
+    return ["Unstable by prediction, never on the front nor in the first table, whatever their error: the runs "
+            "at or past their method's predicted stable CFL that a front ignoring the prediction would hold. "
+            "Each ended bounded only because its run was too short: its most unstable mode grew by the "
+            "e-foldings shown, while round-off (1e-16) needs about 37 to reach the pulse's size; a finer dx "
+            "or a longer time makes it blow up.", "",
+            md_table(["model", "t (s)", "method", "dx", "domain", "precision", "time (s)", "error",
+                      "predicted stable CFL", "steps", "e-foldings"],
+                     [[p["model"], fmt(p["t_final"], "g"), p["method"], fmt(p["dx"], "g"), p["domain"],
+                       p["precision"], fmt(p["seconds"], ".3g"), fmt(p["error"], ".3g"),
+                       _limit_words(p["stable_cfl"]), str(p["steps"]), fmt(p["e_foldings"], ".3g")]
+                      for p in rows]), ""]
 
 
 def _predicted_by_model(predicted) -> list[str]:
@@ -376,33 +397,64 @@ def _simplifications_text(rows, ctx) -> list[str]:
 
 
 # ---------------------------------------------------------------- stability
+def _e_fold_words(bounded) -> str:
+    """"CFL 5-7 ended bounded after 6-8 steps, their most unstable mode 1.9-12 e-foldings" from
+    ``bounded_past_limit`` entries (cfl, steps, e-foldings)."""
+    steps = sorted({b[1] for b in bounded})
+    folds = [b[2] for b in bounded]
+    span = (lambda lo, hi, f: f"{lo:{f}}" if f"{lo:{f}}" == f"{hi:{f}}" else f"{lo:{f}}-{hi:{f}}")
+    return (f"ended bounded after {span(steps[0], steps[-1], 'd')} steps, in which the most unstable mode grew by "
+            f"{span(min(folds), max(folds), '.2g')} e-foldings")
+
+
+def _stability_row(lim) -> list[str]:
+    swept = lim["cfls"]
+    bounded = lim["bounded_past_limit"]
+    blew = lim["blew_up_at"]
+    return [lim["config"], f"{lim['dx']:g}", ", ".join(f"{c:g}" for c in swept), _limit_words(lim["stable_cfl"]),
+            T.cfl_ranges(lim["accurate_at"], swept) or "none",
+            "; ".join(f"{c:g} ({pct(e)})" for c, e in lim["inaccurate_at"]) or "-",
+            "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in blew) or "-",
+            (f"{T.cfl_ranges([b[0] for b in bounded], swept)}: " + _e_fold_words(bounded)) if bounded else "-"]
+
+
 def _stability_text(rows, ctx) -> list[str]:
     _points, limits = rows
     if not limits:
         return []
     lines = ["## Stability: where methods fail", "",
-             f"`pcabench study --stability` (and a quick study's few CFLs): the linear model on a strip, each run "
-             f"classed stable, inaccurate (bounded, relative RMS above {100 * INACCURATE_ABOVE:g} %) or unstable "
-             "(stopped at the step where max|u| left its bound or went non-finite).", "",
-             md_table(["method", "dx", "CFLs run", "bounded up to CFL", "stable and accurate up to CFL",
-                       "first failure"],
-                      [[lim["config"], f"{lim['dx']:g}", ", ".join(f"{c:g}" for c in lim["cfls"]),
-                        fmt(lim["bounded_up_to"], "g") if lim["bounded_up_to"] else "none",
-                        fmt(lim["stable_up_to"], "g") if lim["stable_up_to"] else "none",
-                        "-" if not lim["first_failure"] else
-                        f"CFL {lim['first_failure'][0]:g}: {lim['first_failure'][1]}"
-                        + (f" at step {lim['first_failure'][2]}" if lim["first_failure"][2] else "")
-                        + (f" ({pct(lim['first_failure'][3])})" if lim["first_failure"][1] == "inaccurate"
-                           else "")] for lim in limits]), ""]
+             "`pcabench study --stability` (and a quick study's few CFLs): the linear model on a strip. The story "
+             "comes from the prediction (`pcabench accuracy`: the largest CFL at which one step of the integrator "
+             "never grows any lattice mode, exact for this model): a run at or past its method's predicted stable "
+             "CFL is unstable. It either blew up (stopped at the step where max|u| left its bound or went "
+             "non-finite) or, where it ended bounded, it is *unstable by prediction*: its run was too short for "
+             "round-off to grow, as its e-foldings say (round-off, 1e-16 of the pulse, needs about 37 to reach the "
+             "pulse's size; a finer dx or a longer time makes such a run blow up). Below the limit a run is stable "
+             f"(relative RMS error within {100 * INACCURATE_ABOVE:g} %) or inaccurate (bounded, error above it). "
+             "The map draws the same classes, and the predicted limit on each row.", "",
+             md_table(["method", "dx", "CFLs run", "predicted stable CFL",
+                       f"stable, within {100 * INACCURATE_ABOVE:g} %, at CFL",
+                       "inaccurate (below the limit) at CFL", "blew up at CFL",
+                       "past the limit, ended bounded (unstable by prediction)"],
+                      [_stability_row(lim) for lim in limits]), ""]
     for lim in limits:
         if lim["h_factor"] == Scene.default("h_factor") and lim["precision"] == "float64" and len(lim["cfls"]) > 3:
-            unb = lim["first_unbounded"]
-            lines.append(f"- **{lim['integrator']}** ({lim['protocol']}): stays bounded up to CFL "
-                         f"{fmt(lim['bounded_up_to'], 'g') if lim['bounded_up_to'] else 'none of those run'}"
-                         + (f", blows up from CFL {unb[0]:g}" + (f" (step {unb[2]})" if unb[2] else "")
-                            if unb else ", and never blew up")
-                         + f"; within {100 * INACCURATE_ABOVE:g} % error up to CFL "
-                         f"{fmt(lim['stable_up_to'], 'g') if lim['stable_up_to'] else 'none'}.")
+            swept = lim["cfls"]
+            parts = [f"predicted stable up to CFL {lim['stable_cfl']:.3g}" if lim["stable_cfl"] > 0
+                     else "predicted to grow at every CFL"]
+            if lim["blew_up_at"]:
+                parts.append(f"blew up at CFL {T.cfl_ranges([c for c, _ in lim['blew_up_at']], swept)}")
+            if lim["bounded_past_limit"]:
+                b = lim["bounded_past_limit"]
+                parts.append(f"CFL {T.cfl_ranges([x[0] for x in b], swept)} {_e_fold_words(b)}: too few for "
+                             "round-off to grow, unstable by prediction, not stable")
+            if lim["blew_up_below_limit"]:
+                parts.append(f"blew up below the predicted limit at CFL "
+                             f"{T.cfl_ranges(lim['blew_up_below_limit'], swept)} (against the prediction)")
+            accurate = T.cfl_ranges(lim["accurate_at"], swept)
+            parts.append(f"stable and within {100 * INACCURATE_ABOVE:g} % error at CFL {accurate}" if accurate
+                         else f"stable and within {100 * INACCURATE_ABOVE:g} % error at none of the CFLs run")
+            lines.append(f"- **{lim['integrator']}** ({lim['protocol']}): " + "; ".join(parts) + ".")
     return lines + [""]
 
 

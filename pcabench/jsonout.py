@@ -1,0 +1,29 @@
+"""Strict JSON for every ``--json``: what json.loads with a strict parser reads (NaN and infinities as null)."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+
+def plain(value):
+    """``value`` with numpy scalars and arrays as Python ones, and every non-finite float as None."""
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [plain(v) for v in value]
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, int)):
+        return int(value)
+    if isinstance(value, (np.floating, float)):
+        return float(value) if math.isfinite(value) else None
+    if value is None or isinstance(value, str):
+        return value
+    return str(value)
+
+
+def dumps(value, **kw) -> str:
+    """``value`` as strict JSON (``allow_nan=False`` holds: NaN and +-inf are null)."""
+    return json.dumps(plain(value), allow_nan=False, **kw)
