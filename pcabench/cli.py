@@ -40,6 +40,11 @@ from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
 
+DESCRIPTION = """Benchmark SPH solvers of computational acoustics (a Gaussian sound pulse in 2D, the paper's
+scene) on CPUs and GPUs: run one scene, sweep studies into a results store, write reports with
+tables and figures, and ask which stored run reaches an error fastest (advise) or what error and
+largest stable step the dispersion relation predicts (accuracy)."""
+
 # exit codes: each one means one thing
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 2, 3, 4, 130
 EXIT_HELP = f"""exit codes:
@@ -507,7 +512,7 @@ def cmd_gpu_check(args) -> int:
 
 # ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="pcabench", description=__doc__.split("\n")[0], epilog=EXIT_HELP,
+    parser = Parser(prog="pcabench", description=DESCRIPTION, epilog=EXIT_HELP,
                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"pcabench {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
@@ -626,24 +631,39 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# Scene's parameter names as the options a user types (a SceneError names the parameter)
+OPTION_NAMES = {"cutoff_factor": "--cutoff", "t_end": "--t-end", "strip_height": "--strip-height",
+                "h_factor": "--h-factor", "pair_loop": "--pair-loop"}
+LEADING_OPTIONS = ("dx", "cfl", "steps", "threads", "kernel", "integrator", "precision", "model", "solver")
+
+
+def option_words(message: str) -> str:
+    """``message`` with Scene's parameter names written as the options that set them (``--cutoff``)."""
+    for name, option in OPTION_NAMES.items():
+        message = re.sub(rf"(?<![\w-]){name}\b", option, message)
+    return re.sub(rf"^({'|'.join(LEADING_OPTIONS)})\b", r"--\1", message)
+
+
 def main(argv=None) -> int:
     shown = warnings.formatwarning
     warnings.formatwarning = lambda message, *_, **__: f"pcabench: warning: {message}\n"  # one line each
+    prog = "pcabench"
     try:
         parser = build_parser()  # finds the solvers: a plug-in left out is one warning line
         args = parser.parse_args(argv)
+        prog = f"pcabench {args.command}"
         return args.func(args)
     except (SceneError, OptionError, StoreError) as exc:
-        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {option_words(str(exc))} (see {prog} --help)\n")
     except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
         where = f"{exc.filename}: " if exc.filename else ""
-        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {where}{exc.strerror or exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {where}{exc.strerror or exc}\n")
     except SolverUnavailable as exc:
-        parser.exit(EXIT_UNAVAILABLE, f"pcabench: {exc}\n")
+        parser.exit(EXIT_UNAVAILABLE, f"{prog}: {exc}\n")
     except NoResults as exc:
-        parser.exit(EXIT_NO_RESULTS, f"pcabench: {exc}\n")
+        parser.exit(EXIT_NO_RESULTS, f"{prog}: {exc}\n")
     except KeyboardInterrupt:
-        parser.exit(EXIT_INTERRUPTED, "pcabench: interrupted\n")
+        parser.exit(EXIT_INTERRUPTED, f"{prog}: interrupted\n")
     finally:
         warnings.formatwarning = shown
 
