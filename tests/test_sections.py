@@ -115,3 +115,22 @@ def test_the_stability_summary_agrees_with_the_prediction_and_the_map(tmp_path, 
     assert drawn == {cls: sorted(v) for cls, v in by_class.items()}  # one colour per class, the table's classes
     assert limit_bars == [lim["stable_cfl"] for lim in limits]  # the predicted limit on every row
     assert {p["cfl"] for p in points} <= set(ticks)  # a tick at every CFL swept
+
+
+def test_fig9_keeps_the_loop_measured_beside_the_most_all_pair_runs(tmp_path):
+    from pcabench.reports import frame
+
+    from .test_study import row
+
+    path = tmp_path / "f9" / "m.jsonl"
+    for dx in (1.0, 0.5):  # all-pair and the pair list at two N; a plug-in study adds gather at one N only
+        store.append(row(solver="allpair-cpu", dx=dx, steps=10), path)
+        rec = row(dx=dx, steps=10)
+        rec.pair_loop = "list"
+        store.append(rec, path)
+    rec = row(dx=1.0, steps=10, stamp=5)
+    rec.pair_loop = "gather"
+    store.append(rec, path)
+    rows = T.fig9(frame.load(path.parent))
+    assert {r["linkedlist_loop"] for r in rows} == {"list"}
+    assert all(r["linkedlist_ms"] for r in rows)  # both N keep their linked-list time

@@ -203,9 +203,10 @@ def _fig9_text(rows, ctx) -> list[str]:
     steps = T.fig9_steps(rows)
     pub = [p for p in P.step_times() if p["source"] == "Fig. 9 text"]
     return ["## Fig. 9: all-pair against linked list (serial, float64, paper's scene)", "",
-            f"Linked list: {T.FIG9_LOOP_NAMES[rows[0]['linkedlist_loop']]}"
+            f"Linked list: {T.FIG9_LOOP_NAMES.get(rows[0]['linkedlist_loop'], rows[0]['linkedlist_loop'])}, "
+            "the loop measured beside the most all-pair runs, one loop throughout"
             + ("." if rows[0]["linkedlist_loop"] == "gather"
-               else " (no gather-loop runs stored; `--pair-loop gather` measures the paper's).")
+               else " (`--pair-loop gather` at the same N measures the paper's).")
             + " Both sides of a row made the same number of steps"
             + (f"; the figure draws the {steps}-step runs." if steps else "."), "",
             md_table(["steps", "N", "all-pair ms/step", "linked list ms/step", "eta = t_AP / t_LL",
@@ -502,7 +503,8 @@ SECTIONS = (
             (lambda rows, ctx: F.fig10(rows, ctx.out, ctx.name),)),
     Section("speed", lambda ctx: T.speed(ctx.df), _speed_text),
     Section("table6", lambda ctx: [r for r in ctx.table6() if r["gpu_profile"] == ctx.pid], _table6_text,
-            (lambda rows, ctx: F.fig14(rows, ctx.out, ctx.pid) if rows else None,)),
+            # drawn where this GPU was measured with its own host's CPU: the paper's lines alone are the cards page's
+            (lambda rows, ctx: F.fig14(rows, ctx.out, ctx.pid) if any(r["same_machine"] for r in rows) else None,)),
     Section("fig9", lambda ctx: T.fig9(ctx.df), _fig9_text, (lambda rows, ctx: F.fig9(rows, ctx.out, ctx.name),)),
     Section("fig8", _fig8_rows, _fig8_text, (lambda rows, ctx: F.fig8(rows["series"], ctx.out, ctx.name),)),
     Section("front", _front_rows, _front_text,

@@ -83,6 +83,10 @@ def table4(df) -> list[dict]:
     step. ``paper``: the paper's published numbers of the same kind at the same N (:func:`paper.same_kind`;
     a GPU row also gets Table 4's stage times), [] where it has none."""
     keys = ["solver", "precision", "n_particles", *PROTOCOL]
+    every = default_numerics(df[(df.status == "ok") & (df.model == "lagrangian") & (df.domain == "full")])
+    # init is timed once per run: how far the stored reruns of one configuration (any commit) differ in it
+    spread = every.groupby(keys).t_init.agg(lambda x: x.max() / x.min() if len(x) > 1 and x.min() > 0 else 1.0) \
+        if not every.empty else {}
     rows = []
     for _, r in _newest_per(paper_scene(df), keys).sort_values(["solver", "precision", "threads", "loop",
                                                                  "steps", "n_particles"]).iterrows():
@@ -90,6 +94,7 @@ def table4(df) -> list[dict]:
                "N": int(r.n_particles),
                "device": r.device, "search": r.search, "threads": int(r.threads), "commit": str(r.commit)[:7]}
         row.update({s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")})
+        row["init_spread"] = float(spread.get(tuple(r[k] for k in keys), 1.0))
         row.update(per_step_ms(r))
         row["paper"] = P.same_kind(r.device, r.search, r.n_particles) if _paper_kind(r) else []
         row["paper_stages"] = (P.table4().get(int(r.n_particles)) if r.device == "gpu" and _paper_kind(r)
@@ -127,7 +132,7 @@ def one_step_shares(rows4) -> list[dict]:
     for row in rows4:
         total = sum(row[s] for s in STAGES)
         rows.append({"config": row["config"], "protocol": row["protocol"], "run": row["run"], "steps": row["steps"],
-                     "N": row["N"], "device": row["device"],
+                     "N": row["N"], "device": row["device"], "init_spread": row.get("init_spread", 1.0),
                      **{s: 100 * row[s] / total for s in STAGES}})
     return rows
 
@@ -194,22 +199,24 @@ def fig9(df) -> list[dict]:
     """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL, by run
     length (``steps``) and N: the two sides of a row always made the same number of steps.
 
-    One pair loop throughout: the paper's gather loop where it was measured, so
-    that eta means what the paper's does; else the pair list. Each row names it
-    (``linkedlist_loop``).
+    One pair loop throughout: the one measured beside the most all-pair runs
+    (same run length and N), the paper's gather loop on a tie, so that a few
+    gather rows added by another study never switch the figure to a loop with
+    fewer points. Each row names it (``linkedlist_loop``).
     """
     runs = paper_scene(df)
     serial = runs[(runs.device == "cpu") & (runs.search == "linked list") & (runs.threads == 1)
                   & (runs.precision == "float64")]
-    gather = serial.loop == "gather"
-    loop = "gather" if gather.any() else "list"
-    ll = _newest_per(serial[serial.loop == loop], ["steps", "n_particles"]).set_index(["steps", "n_particles"])
     everything = latest(default_numerics(df[(df.model == "lagrangian") & (df.domain == "full")]))
     ap_all = everything[everything.search == "all-pair"]
-    rows = []
     # a run's length: the steps it made, or for a run that made none (skipped, timed out) the steps it asked for
     asked = ap_all.steps_requested.fillna(ap_all.steps) if "steps_requested" in ap_all else ap_all.steps
     length = ap_all.steps.where(ap_all.status == "ok", asked)
+    ap_keys = set(zip(length.astype(int), ap_all.n_particles))
+    beside = {lp: len(ap_keys & set(zip(g.steps.astype(int), g.n_particles))) for lp, g in serial.groupby("loop")}
+    loop = max(beside, key=lambda lp: (beside[lp], lp == "gather")) if beside else "list"
+    ll = _newest_per(serial[serial.loop == loop], ["steps", "n_particles"]).set_index(["steps", "n_particles"])
+    rows = []
     for (steps, n), g in ap_all.groupby([length.astype(int), "n_particles"]):
         ok = g[g.status == "ok"]
         r = (ok if not ok.empty else g).sort_values("timestamp").iloc[-1]
