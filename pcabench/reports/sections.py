@@ -168,13 +168,18 @@ def _speed_text(rows, ctx) -> list[str]:
 
 
 # ---------------------------------------------------------------- Table 6 and Fig. 14
-def table6_md(rows) -> str:
-    return md_table(["N", "protocol", "GPU precision", "GPU ms/step", "CPU (profile)", "CPU ms/step", "speedup",
-                     "speedup vs all cores"],
-                    [[f"{r['N']:,}", r["protocol"], r["precision"], fmt(r["gpu_ms"], ".3f"),
-                      f"{r['cpu_profile']}, {r['cpu_loop']}", fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
-                      "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f} "
-                                                                 f"(x{r['cpu_threads']})"] for r in rows])
+def table6_md(rows, across: bool = False, gpu_column: bool = False) -> str:
+    """Table 6's rows, named and rounded alike in every report and the cards page: a "speedup" for a GPU against
+    its own host's CPU, a "ratio" ``across`` machines (two computers, not what a GPU buys one of them)."""
+    word = "ratio" if across else "speedup"
+    return md_table((["GPU profile"] if gpu_column else [])
+                    + ["N", "protocol", "GPU precision", "GPU ms/step", "CPU profile, loop", "CPU ms/step (1 thread)",
+                       word, f"{word} vs all cores (threads)"],
+                    [([r["gpu_profile"]] if gpu_column else [])
+                     + [f"{r['N']:,}", r["protocol"], r["precision"], fmt(r["gpu_ms"], ".3f"),
+                        f"{r['cpu_profile']}, {r['cpu_loop']}", fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
+                        "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f} "
+                                                                   f"(x{r['cpu_threads']})"] for r in rows])
 
 
 def _table6_text(rows, ctx) -> list[str]:
@@ -192,7 +197,7 @@ def _table6_text(rows, ctx) -> list[str]:
     if other:
         lines += ["### Across machines (not a speedup of one machine)", "",
                   "This GPU's times against a CPU measured on another machine, named per row: a comparison of "
-                  "two computers, not what a GPU buys one of them.", "", table6_md(other), ""]
+                  "two computers, not what a GPU buys one of them.", "", table6_md(other, across=True), ""]
     return lines
 
 
