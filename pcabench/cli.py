@@ -415,6 +415,11 @@ def cmd_accuracy(args) -> int:
     return 0
 
 
+# advise's numbers printed to 3 significant digits (the scene's own parameters stay exact)
+ROUNDED_AS_PRINTED = ("error", "seconds", "stable_cfl", "paper_seconds", "paper_error", "speedup_over_paper",
+                      "unstable_by_prediction")
+
+
 def cmd_advise(args) -> int:
     from . import runs
     from .advise import advise
@@ -438,8 +443,11 @@ def cmd_advise(args) -> int:
     else:
         machine = machine_id() if machine_id() in machines else machines.index[0]
     out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain)}
-    if args.json:
-        print(jsonout.dumps(out, sort_keys=True))
+    if args.json:  # the numbers the text prints, rounded as it prints them
+        shown = {key: jsonout.significant(out[key]) for key in ROUNDED_AS_PRINTED if out.get(key) is not None}
+        if out.get("cfl_fraction") is not None:
+            shown["cfl_fraction"] = round(out["cfl_fraction"], 2)  # printed as "0.66 of the predicted stable"
+        print(jsonout.dumps({**out, **shown}, sort_keys=True))
         return EXIT_OK if out["found"] else EXIT_RUN_FAILED
     head = (f"{args.model} to a relative RMS error of u <= {args.error:g} (against {out['error_against']}) at "
             f"t = {args.t_end:g} s on {machine}"

@@ -24,6 +24,18 @@ def plain(value):
     return str(value)
 
 
+def significant(value, digits: int = 3):
+    """``value`` (a float, or a dict or list of them) to ``digits`` significant digits, as the text prints it
+    (``f"{x:.3g}"``); other values as they are."""
+    if isinstance(value, dict):
+        return {k: significant(v, digits) for k, v in value.items()}
+    if isinstance(value, list):
+        return [significant(v, digits) for v in value]
+    if isinstance(value, (float, np.floating)) and math.isfinite(value):
+        return float(f"{value:.{digits}g}")
+    return value
+
+
 def dumps(value, **kw) -> str:
     """``value`` as strict JSON (``allow_nan=False`` holds: NaN and +-inf are null)."""
     return json.dumps(plain(value), allow_nan=False, **kw)

@@ -128,3 +128,5 @@ def test_advise_json_is_strict_and_the_paper_configuration_is_not_compared_with_
                            "m", "--json", capsys=capsys)
     data = json.loads(text, parse_constant=_refuse)  # a full-domain run: its strip height is null, never NaN
     assert rc == 0 and data["strip_height"] is None
+    assert data["stable_cfl"] == float(f"{data['stable_cfl']:.3g}") and data["cfl_fraction"] == round(
+        data["cfl_fraction"], 2)  # rounded as the text prints them
