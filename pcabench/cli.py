@@ -466,7 +466,8 @@ def cmd_advise(args) -> int:
         return EXIT_RUN_FAILED
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
           f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the predicted stable "
-          f"{out['stable_cfl']:.3g}, dx {out['dx']:g}, {out['precision']}, {out['threads']} thread(s), "
+          f"{out['stable_cfl']:.3g}{'' if args.model == 'linear' else ' (its linear part)'}, dx {out['dx']:g}, "
+          f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
           f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
           f"commit {out['commit'][:7]})\n  {out['command']}")
     if out["is_paper_configuration"]:
