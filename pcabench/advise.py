@@ -79,6 +79,7 @@ def _unstable_row(r, column: str) -> dict:
     """A run that reached the error past its predicted stable CFL: what it was, never advised."""
     a = assess(r)
     return {"method": numerics_label(r), "dx": float(r.dx), "cfl": float(r.cfl), "stable_cfl": a["stable_cfl"],
+            "limit_from": a["limit_from"],
             "error": float(r[column]), "seconds": float(r.t_solution), "steps": int(r.steps),
             "e_foldings": e_foldings(r, int(r.steps))}
 
@@ -118,14 +119,15 @@ def advise(df, error: float, t_end: float, model: str = "linear", domain: str | 
         return out
     best = hits.iloc[0]
     faster = unstable[unstable.t_solution < best.t_solution]
-    stable = assess(best)["stable_cfl"]
+    limit = assess(best)
+    stable = limit["stable_cfl"]
     paper = paper_configuration(hits[[comparable(r, best) for _, r in hits.iterrows()]])
     paper_best = paper.iloc[0] if not paper.empty else None
     out.update(found=True, command=command(best, t_end), error=float(best[column]), seconds=float(best.t_solution),
                machine=str(best.machine), solver=str(best.solver), domain=str(best.domain),
                precision=str(best.precision), commit=str(best.commit)[:12], threads=int(best.threads),
                n_particles=int(best.n_particles), steps=int(best.steps), **scene_of(best),
-               stable_cfl=stable, cfl_fraction=float(best.cfl) / stable,
+               stable_cfl=stable, cfl_fraction=float(best.cfl) / stable, limit_from=limit["limit_from"],
                paper_seconds=None if paper_best is None else float(paper_best.t_solution),
                paper_error=None if paper_best is None else float(paper_best[column]),
                paper_command=None if paper_best is None else command(paper_best, t_end),

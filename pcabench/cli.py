@@ -465,8 +465,10 @@ def cmd_advise(args) -> int:
               f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)")
         return EXIT_RUN_FAILED
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
-          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the predicted stable "
-          f"{out['stable_cfl']:.3g}{'' if args.model == 'linear' else ' (its linear part)'}, dx {out['dx']:g}, "
+          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
+          + (f"stable {out['stable_cfl']:.3g} measured over long runs" if out["limit_from"] == "long runs" else
+             f"predicted stable {out['stable_cfl']:.3g}{'' if args.model == 'linear' else ' (its linear part)'}")
+          + f", dx {out['dx']:g}, "
           f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
           f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
           f"commit {out['commit'][:7]})\n  {out['command']}")
@@ -489,8 +491,9 @@ def _print_unstable(rows, what: str) -> None:
         print(f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a longer run "
               "or a finer dx grows them without bound)")
     for r in rows:
-        limit = (f"CFL {r['cfl']:g} is past the predicted stable {r['stable_cfl']:.3g}" if r["stable_cfl"] > 0
-                 else "its integrator grows at every CFL")
+        which = (f"predicted stable {r['stable_cfl']:.3g}" if r["limit_from"] == "prediction"
+                 else f"stable {r['stable_cfl']:.3g} measured over long runs")
+        limit = f"CFL {r['cfl']:g} is past the {which}" if r["stable_cfl"] > 0 else "its integrator grows at every CFL"
         print(f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
               f"bounded only because its {r['steps']} steps gave the most unstable mode "
               f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)")

@@ -130,3 +130,21 @@ def test_advise_json_is_strict_and_the_paper_configuration_is_not_compared_with_
     assert rc == 0 and data["strip_height"] is None
     assert data["stable_cfl"] == float(f"{data['stable_cfl']:.3g}") and data["cfl_fraction"] == round(
         data["cfl_fraction"], 2)  # rounded as the text prints them
+
+
+def test_a_moving_model_past_its_long_run_limit_is_never_advised(tmp_path, capsys):
+    from pcabench import stability
+
+    path = tmp_path / "results" / store.store_name("m", "h")
+    path.parent.mkdir()
+    # the paper's method at CFL 4.8: under the linear prediction 4.97, past the 4.75 long lagrangian runs blew up at
+    _row(path, 0.5, 0.05, model="lagrangian", mse_isothermal=0.009, cfl=4.8)
+    _row(path, 80.0, 0.09, model="lagrangian", mse_isothermal=0.0095)
+    a = stability.assess({"model": "lagrangian", "cfl": 4.8, "dx": 0.2})
+    assert a["past_limit"] and a["limit_from"] == "long runs" and a["stable_cfl"] == 4.75
+    assert not stability.assess({"model": "linear", "cfl": 4.8, "dx": 0.2})["past_limit"]
+    out = advise(load_frame(path.parent), 0.01, 10.0, model="lagrangian")
+    assert out["seconds"] == pytest.approx(80.0) and out["unstable_by_prediction"][0]["cfl"] == 4.8
+    rc, text, _ = cli_main("advise", "--error", "0.01", "--model", "lagrangian", "--results", str(path.parent),
+                           capsys=capsys)
+    assert rc == 0 and "CFL 4.8 is past the stable 4.75 measured over long runs" in text, text
