@@ -6,8 +6,11 @@ the fastest by time to solution (init + steps, JIT apart) whose relative RMS
 error of u is at most the target; beside it, the fastest run of the paper's
 configuration (Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet) that reaches the
 same error, and the ratio. The margin to instability comes from the
-dispersion relation (solvers/dispersion.py). Where no stored run reaches the
-target, the prediction names the sweep that would.
+dispersion relation (solvers/dispersion.py, pcabench/stability.py): a run at or
+past its method's predicted stable CFL is never advised, however small its
+error (it ended bounded only because its run was too short for round-off to
+grow). Where no stored run reaches the target, the prediction names the sweep
+that would.
 """
 from __future__ import annotations
 
@@ -19,7 +22,8 @@ import numpy as np
 from solvers import DEFAULT_SOLVER, Scene
 from solvers.dispersion import predict, stable_cfl
 
-from .reports.tables import comparable, default_numerics, latest
+from .reports.tables import comparable, default_numerics, latest, numerics_label
+from .stability import assess, e_foldings
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid).
 SEARCH_KERNELS = ("gaussian", "wendland-c2", "wendland-c4")
@@ -75,40 +79,67 @@ def paper_configuration(df):
     return d[d["kernel"].fillna("gaussian") == "gaussian"] if "kernel" in d else d
 
 
+def _unstable_row(r, column: str) -> dict:
+    """A run that reached the error past its predicted stable CFL: what it was, never advised."""
+    a = assess(r)
+    return {"method": numerics_label(r), "dx": float(r.dx), "cfl": float(r.cfl), "stable_cfl": a["stable_cfl"],
+            "limit_from": a["limit_from"],
+            "error": float(r[column]), "seconds": float(r.t_solution), "steps": int(r.steps),
+            "e_foldings": e_foldings(r, int(r.steps))}
+
+
+def _unstable_rows(runs, column: str, most: int = 3) -> list[dict]:
+    """The fastest ``most`` methods (kernel, h/dx, cutoff, CFL, dx) of ``runs`` (fastest first), once each."""
+    rows, seen = [], set()
+    for _, r in runs.iterrows():
+        row = _unstable_row(r, column)
+        if (row["method"], row["dx"]) not in seen and len(rows) < most:
+            seen.add((row["method"], row["dx"]))
+            rows.append(row)
+    return rows
+
+
 def advise(df, error: float, t_end: float, model: str = "linear", domain: str | None = None,
            scene: str = Scene.default("name")) -> dict:
-    """The fastest stored run reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``, if given),
-    the fastest run of the paper's configuration reaching it that compares with it, and the ratio. Like is
-    compared with like (``tables.comparable``): the same kind of domain (a strip holds fewer particles than
-    the full domain; on a strip each method runs on the thinnest strip its support allows), the same
-    threads and the same commit."""
+    """The fastest stored run of ``scene`` reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``,
+    if given) below its predicted stable CFL, the fastest run of the paper's configuration reaching it that compares
+    with it, and the ratio. Like is compared with like (``tables.comparable``): the same kind of domain (a
+    strip holds fewer particles than the full domain; on a strip each method runs on the thinnest strip its
+    support allows), the same threads and the same commit. A run at or past its method's predicted stable
+    CFL (pcabench/stability.py) is never advised, whatever its error: ``unstable_by_prediction`` lists those
+    faster than the advice (or all of them, fastest first, where none below the limit reaches the error)."""
     runs = reaching(df, t_end, model)
     if domain is not None and not runs.empty:
         runs = runs[runs.domain == domain]
     column = error_column(model)
     hits = runs[runs[column] <= error] if not runs.empty else runs
+    past = np.array([assess(r)["past_limit"] for _, r in hits.iterrows()], bool)
+    unstable, hits = hits[past], hits[~past]
     out = {"error_target": error, "t_end": t_end, "model": model, "runs_considered": int(len(runs)),
            "error_against": "the isothermal solution" if column == "mse_isothermal" else "the linear pulse"}
     if hits.empty:
         out["found"] = False
+        out["unstable_by_prediction"] = _unstable_rows(unstable, column)
         out["suggestion"] = suggest(error, t_end, model) if scene == Scene.default("name") else {
             "note": f"no prediction search for the {scene} scene yet: run its front",
             "paper_dx": None, "smallest_dx_searched": None, "front": f"pcabench study --front --scene {scene}"}
         return out
     best = hits.iloc[0]
-    scene = Scene(t_end=t_end, model=model, memory_limit_bytes=2**62,
-                  **{k: v for k, v in scene_of(best).items() if not (isinstance(v, float) and math.isnan(v))})
-    stable = stable_cfl(scene)
+    faster = unstable[unstable.t_solution < best.t_solution]
+    limit = assess(best)
+    stable = limit["stable_cfl"]
     paper = paper_configuration(hits[[comparable(r, best) for _, r in hits.iterrows()]])
     paper_best = paper.iloc[0] if not paper.empty else None
     out.update(found=True, command=command(best, t_end), error=float(best[column]), seconds=float(best.t_solution),
                machine=str(best.machine), solver=str(best.solver), domain=str(best.domain),
                precision=str(best.precision), commit=str(best.commit)[:12], threads=int(best.threads),
                n_particles=int(best.n_particles), steps=int(best.steps), **scene_of(best),
-               stable_cfl=stable, cfl_margin=stable / float(best.cfl) if stable else 0.0,
+               stable_cfl=stable, cfl_fraction=float(best.cfl) / stable, limit_from=limit["limit_from"],
                paper_seconds=None if paper_best is None else float(paper_best.t_solution),
                paper_error=None if paper_best is None else float(paper_best[column]),
-               paper_command=None if paper_best is None else command(paper_best, t_end))
+               paper_command=None if paper_best is None else command(paper_best, t_end),
+               unstable_by_prediction=_unstable_rows(faster, column))
+    out["is_paper_configuration"] = paper_best is not None and out["paper_command"] == out["command"]
     out["speedup_over_paper"] = out["paper_seconds"] / out["seconds"] if out["paper_seconds"] else None
     return out
 
@@ -136,7 +167,7 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
         if predict(scene).predicted_error <= error:
             paper = scene
     out = {"paper_dx": None if paper is None else paper.dx, "smallest_dx_searched": min(SEARCH_DX),
-           "note": "predicted from the linear part (solvers/dispersion.py)"}
+           "note": "predicted from the dispersion relation of the linear part"}
     if best is not None:
         _, s, p = best
         out.update(kernel=getattr(s, "kernel", "gaussian"), h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import os
 import re
@@ -39,11 +38,16 @@ from solvers import (
     scenes,
 )
 
-from . import __version__, memory, paths
+from . import __version__, jsonout, memory, paths
 from .errors import NoResults
 from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
+
+DESCRIPTION = """Benchmark SPH solvers of computational acoustics (a Gaussian sound pulse in 2D, the paper's
+scene) on CPUs and GPUs: run one scene, sweep studies into a results store, write reports with
+tables and figures, and ask which stored run reaches an error fastest (advise) or what error and
+largest stable step the dispersion relation predicts (accuracy)."""
 
 # exit codes: each one means one thing
 EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 2, 3, 4, 130
@@ -267,7 +271,7 @@ def cmd_run(args) -> int:
         out["errors"] = record.errors
         out["mse_isothermal"] = record.mse_isothermal
         out["message"] = record.message
-        print(json.dumps(to_row(out), allow_nan=False))  # standard JSON: null, never NaN
+        print(jsonout.dumps(to_row(out)))  # strict JSON: null, never NaN
     else:
         print(record.stage_table())
         print(f"particles        {record.n_particles:,}")
@@ -409,7 +413,9 @@ def cmd_runs(args) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("default")
         df = load(results)
-    if args.scene and not df.empty:
+    if df.empty:
+        raise NoResults(f"no stored runs in {results}: run `pcabench study` first, or use --reference")
+    if args.scene:
         df = df[df.scene == args.scene]
     with pd.option_context("display.max_columns", None, "display.width", 200):
         if args.compare:
@@ -420,8 +426,11 @@ def cmd_runs(args) -> int:
             print(runs.render(out) if not out.empty else "no configuration was run by both")
         else:
             out = runs.table(df, solver=args.solver, status=args.status, machine=args.machine, commit=args.commit,
-                             model=args.model).tail(args.limit)
-            print(runs.render(out) if not out.empty else f"no stored runs match in {results}")
+                             model=args.model)
+            print(runs.render(out.tail(args.limit)) if not out.empty else f"no stored runs match in {results}")
+            if len(out) > args.limit:
+                print(f"(the last {args.limit} of {len(out)} matching runs, by machine and time; --limit {len(out)} "
+                      "shows them all)")
     return 0
 
 
@@ -431,9 +440,14 @@ def cmd_accuracy(args) -> int:
     given = {key: getattr(args, opt) for opt, key in ACCURACY_OPTIONS.items() if getattr(args, opt) is not None}
     scene = Scene(dx=args.dx, t_end=args.t_end, model="linear", memory_limit_bytes=2**62, **given, **domain_of(args))
     p = predict(scene)
+    past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/stability.py)
     if args.json:
-        print(json.dumps({"scene": scene.as_dict(), **p.as_dict()}, sort_keys=True))
+        print(jsonout.dumps({"scene": scene.as_dict(), **p.as_dict(), "past_stable_cfl": past}, sort_keys=True))
         return 0
+    if past:
+        print(f"CFL {scene.cfl:g} is past the largest stable CFL {p.stable_cfl:.3g} of {scene.integrator}: a run "
+              "grows without bound (the predicted error is that growth)" if p.stable_cfl > 0 else
+              f"{scene.integrator} grows at every CFL: a long enough run grows without bound")
     print(f"{scene.describe()}\n"
           f"predicted relative RMS error of {scene.kind.primary} at t = {p.t_end:.4g} s: {p.predicted_error:.4g} "
           f"(max error {p.predicted_me:.3g} {'m/s' if scene.kind.primary == 'u' else 'kg/m^3'})\n"
@@ -447,6 +461,11 @@ def cmd_accuracy(args) -> int:
     for name, value in (p.measures or {}).items():
         print(f"predicted {name.replace('_', ' ')}: {value:.4g}")
     return 0
+
+
+# advise's numbers printed to 3 significant digits (the scene's own parameters stay exact)
+ROUNDED_AS_PRINTED = ("error", "seconds", "stable_cfl", "paper_seconds", "paper_error", "speedup_over_paper",
+                      "unstable_by_prediction")
 
 
 def cmd_advise(args) -> int:
@@ -478,19 +497,24 @@ def cmd_advise(args) -> int:
         machine = named[0]
     else:
         machine = machine_id() if machine_id() in machines else machines.index[0]
-    out = {"machine": machine, **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain,
-                                        args.scene)}
-    if args.json:
-        print(json.dumps(out, sort_keys=True, default=str))
-        return 0
+    out = {"machine": machine, "scene": args.scene,
+           **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain, args.scene)}
+    if args.json:  # the numbers the text prints, rounded as it prints them
+        shown = {key: jsonout.significant(out[key]) for key in ROUNDED_AS_PRINTED if out.get(key) is not None}
+        if out.get("cfl_fraction") is not None:
+            shown["cfl_fraction"] = round(out["cfl_fraction"], 2)  # printed as "0.66 of the predicted stable"
+        print(jsonout.dumps({**out, **shown}, sort_keys=True))
+        return EXIT_OK if out["found"] else EXIT_RUN_FAILED
     primary = scene_kind(args.scene).primary
-    head = (f"{args.scene}, {args.model} to a relative RMS error of {primary} <= {args.error:g} "
+    scene_words = "" if args.scene == DEFAULT_SCENE else f"{args.scene}, "
+    head = (f"{scene_words}{args.model} to a relative RMS error of {primary} <= {args.error:g} "
             f"(against {out['error_against']}) at "
             f"t = {args.t_end:g} s on {machine}"
             + (f", {args.domain} domain" if args.domain else ""))
     if not out["found"]:
         s = out["suggestion"]
-        print(f"{head}: none of the {out['runs_considered']} stored runs reaches it.")
+        print(f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL.")
+        _print_unstable(out["unstable_by_prediction"], "runs that reach it")
         if "front" in s:
             print(f"{s['note']}:\n  {s['front']}")
             return EXIT_RUN_FAILED
@@ -503,17 +527,38 @@ def cmd_advise(args) -> int:
               f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)")
         return EXIT_RUN_FAILED
     print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
-          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} of a predicted stable {out['stable_cfl']:.3g}, "
-          f"dx {out['dx']:g}, {out['precision']}, {out['threads']} thread(s), {out['domain']} domain, "
-          f"{out['n_particles']:,} particles, {out['steps']} steps, commit {out['commit'][:7]})"
-          + (" -- close to the stability limit" if out["cfl_margin"] < 1.2 else "") + f"\n  {out['command']}")
-    if out["paper_seconds"]:
+          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
+          + (f"stable {out['stable_cfl']:.3g} measured over long runs" if out["limit_from"] == "long runs" else
+             f"predicted stable {out['stable_cfl']:.3g}{'' if args.model == 'linear' else ' (its linear part)'}")
+          + f", dx {out['dx']:g}, "
+          f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
+          f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
+          f"commit {out['commit'][:7]})\n  {out['command']}")
+    if out["is_paper_configuration"]:
+        print("  this is the paper's configuration: none faster reaches the error")
+    elif out["paper_seconds"]:
         print(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
-              f"{out['speedup_over_paper']:.3g}x slower\n  {out['paper_command']}")
+              f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}")
     else:
-        print("  no stored run of the paper's configuration that compares with it (same kind of domain, threads "
-              "and commit) reaches it; `pcabench advise --domain full` or `strip` looks at another")
-    return 0
+        other = {"strip": "full", "full": "strip"}[out["domain"]]
+        print(f"  no stored run of the paper's configuration on the {out['domain']} domain with the same threads "
+              f"and commit reaches it; `pcabench advise --domain {other}` looks at the {other} domain's runs")
+    _print_unstable(out["unstable_by_prediction"], "faster runs")
+    return EXIT_OK
+
+
+def _print_unstable(rows, what: str) -> None:
+    """advise's runs past their predicted stable CFL that reached the error: named, never advised."""
+    if rows:
+        print(f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a longer run "
+              "or a finer dx grows them without bound)")
+    for r in rows:
+        which = (f"predicted stable {r['stable_cfl']:.3g}" if r["limit_from"] == "prediction"
+                 else f"stable {r['stable_cfl']:.3g} measured over long runs")
+        limit = f"CFL {r['cfl']:g} is past the {which}" if r["stable_cfl"] > 0 else "its integrator grows at every CFL"
+        print(f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
+              f"bounded only because its {r['steps']} steps gave the most unstable mode "
+              f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)")
 
 
 def cmd_profile(args) -> int:
@@ -528,7 +573,7 @@ def cmd_profile(args) -> int:
     if args.save:
         out = check_folder(args.out, "--out") if args.out else check_folder(paths.user_profiles(), home_option())
         print(f"wrote {profiles.save(profile, out)}", file=sys.stderr)
-    print(json.dumps(profile, indent=2))
+    print(jsonout.dumps(profile, indent=2))
     return 0
 
 
@@ -541,7 +586,7 @@ def cmd_gpu_check(args) -> int:
 
 # ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="pcabench", description=__doc__.split("\n")[0], epilog=EXIT_HELP,
+    parser = Parser(prog="pcabench", description=DESCRIPTION, epilog=EXIT_HELP,
                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"pcabench {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
@@ -609,7 +654,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--compare", nargs=2, metavar=("A", "B"),
                    help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, "
                         "ratio, errors")
-    p.add_argument("--limit", type=positive_int("--limit"), default=200, help="the newest rows to print at most")
+    p.add_argument("--limit", type=positive_int("--limit"), default=200,
+                   help="print at most the last this many matching runs, by machine and time (default 200; a line "
+                        "says when rows were left out)")
     p.set_defaults(func=cmd_runs)
 
     p = sub.add_parser("accuracy", help="predict a run's error and largest stable CFL from the dispersion relation",
@@ -664,24 +711,39 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+# Scene's parameter names as the options a user types (a SceneError names the parameter)
+OPTION_NAMES = {"cutoff_factor": "--cutoff", "t_end": "--t-end", "strip_height": "--strip-height",
+                "h_factor": "--h-factor", "pair_loop": "--pair-loop"}
+LEADING_OPTIONS = ("dx", "cfl", "steps", "threads", "kernel", "integrator", "precision", "model", "solver")
+
+
+def option_words(message: str) -> str:
+    """``message`` with Scene's parameter names written as the options that set them (``--cutoff``)."""
+    for name, option in OPTION_NAMES.items():
+        message = re.sub(rf"(?<![\w-]){name}\b", option, message)
+    return re.sub(rf"^({'|'.join(LEADING_OPTIONS)})\b", r"--\1", message)
+
+
 def main(argv=None) -> int:
     shown = warnings.formatwarning
     warnings.formatwarning = lambda message, *_, **__: f"pcabench: warning: {message}\n"  # one line each
+    prog = "pcabench"
     try:
         parser = build_parser()  # finds the solvers: a plug-in left out is one warning line
         args = parser.parse_args(argv)
+        prog = f"pcabench {args.command}"
         return args.func(args)
     except (SceneError, OptionError, StoreError) as exc:
-        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {option_words(str(exc))} (see {prog} --help)\n")
     except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
         where = f"{exc.filename}: " if exc.filename else ""
-        parser.exit(EXIT_BAD_INPUT, f"pcabench: error: {where}{exc.strerror or exc}\n")
+        parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {where}{exc.strerror or exc}\n")
     except SolverUnavailable as exc:
-        parser.exit(EXIT_UNAVAILABLE, f"pcabench: {exc}\n")
+        parser.exit(EXIT_UNAVAILABLE, f"{prog}: {exc}\n")
     except NoResults as exc:
-        parser.exit(EXIT_NO_RESULTS, f"pcabench: {exc}\n")
+        parser.exit(EXIT_NO_RESULTS, f"{prog}: {exc}\n")
     except KeyboardInterrupt:
-        parser.exit(EXIT_INTERRUPTED, "pcabench: interrupted\n")
+        parser.exit(EXIT_INTERRUPTED, f"{prog}: interrupted\n")
     finally:
         warnings.formatwarning = shown
 

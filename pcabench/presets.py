@@ -25,7 +25,7 @@ STABILITY_H = (1.0, 1.3)  # h/dx beside Scene's default
 # Above this relative RMS error a run that stayed bounded is classed inaccurate: twice the
 # error of Verlet at CFL 0.2 on the stability scene (10 % at dx = 0.25, t = 10 s).
 INACCURATE_ABOVE = 0.20
-QUICK_CFL = (0.2, 2.0, 5.0, 7.0)  # the quick study's stability map: stable, stable, near the limit, past it
+QUICK_CFL = (0.2, 2.0, 5.0, 7.0)  # the quick map: stable, stable, just past the predicted 4.97, far past it
 
 
 def _spec(solver=DEFAULT_SOLVER, threads=SERIAL, strip=False, pair_loop="auto", **scene) -> RunSpec:

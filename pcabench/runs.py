@@ -75,6 +75,8 @@ def compare(df: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
         if not kind:
             raise KeyError(f"--compare: {key!r} is neither a machine nor a commit of a finished run in the store "
                            f"(machines: {', '.join(machines(df.machine, ''))})")
+    if kind_a != kind_b:  # a machine's runs span commits, a commit's span machines: no like with like
+        raise KeyError(f"--compare: {a!r} is a {kind_a} and {b!r} a {kind_b}: compare two machines or two commits")
     # a machine's columns are named by the machine, a prefix's included
     a, b = (r.machine.iloc[0] if kind == "machine" else key for key, kind, r in ((a, kind_a, ra), (b, kind_b, rb)))
     newest = [c for c in CONFIG if c in ok]

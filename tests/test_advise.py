@@ -36,6 +36,8 @@ def results(tmp_path):
     _row(path, 2.0, 0.006, kernel="wendland-c2", h_factor=2.0, cfl=2.5)
     _row(path, 1.0, 0.02, kernel="wendland-c4", h_factor=1.3, cfl=1.0)  # faster, not accurate enough
     _row(path, 0.1, 0.001, strip=False, kernel="wendland-c4", cfl=1.0, status="unstable")  # failed: never advised
+    # the fastest and most accurate, but at CFL 3 past its predicted stable 2.35: bounded only for being short
+    _row(path, 0.5, 0.0012, kernel="wendland-c2", h_factor=1.3, cfl=3.0)
     _row(path, 900.0, 0.007, strip=False)  # the paper's method on the full domain
     _row(path, 30.0, 0.007, strip=False, kernel="wendland-c2", h_factor=2.0, cfl=2.5)
     _row(path, 80.0, 0.09, model="lagrangian", mse_isothermal=0.011)
@@ -50,7 +52,7 @@ def test_the_fastest_run_reaching_the_error_against_the_paper_method_on_the_same
     assert out["domain"] == "strip" and out["paper_seconds"] == pytest.approx(50.0)  # not the full domain's 900
     assert out["speedup_over_paper"] == pytest.approx(25.0)
     assert "--kernel wendland-c2" in out["command"] and "--strip-height 4" in out["command"]
-    assert 0 < out["stable_cfl"] and out["cfl_margin"] == pytest.approx(out["stable_cfl"] / 2.5)
+    assert 0 < out["stable_cfl"] and out["cfl_fraction"] == pytest.approx(2.5 / out["stable_cfl"])
     full = advise(df, 0.01, 10.0, domain="full")
     assert full["seconds"] == pytest.approx(30.0) and full["paper_seconds"] == pytest.approx(900.0)
 
@@ -86,3 +88,63 @@ def test_advise_takes_a_machine_prefix_as_runs_does(results, capsys):
     rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", "zz",
                             capsys=capsys)
     assert rc == 2 and "--machine 'zz'" in err and len(err.strip().splitlines()) == 1
+
+
+def _refuse(name):
+    raise ValueError(f"not strict JSON: {name}")
+
+
+def test_a_run_past_its_predicted_stable_cfl_is_never_advised(results, capsys):
+    df = load_frame(results)
+    out = advise(df, 0.01, 10.0)
+    assert out["found"] and out["cfl"] == 2.5 and out["cfl"] < out["stable_cfl"]  # not the 0.5 s run at CFL 3
+    assert out["cfl_fraction"] == pytest.approx(2.5 / out["stable_cfl"]) and out["cfl_fraction"] < 1
+    (past,) = out["unstable_by_prediction"]  # named beside the advice, as unstable by prediction
+    assert past["cfl"] == 3.0 and past["stable_cfl"] == pytest.approx(2.354, abs=1e-3) and past["e_foldings"] > 0
+    rc, text, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", "m", capsys=capsys)
+    assert rc == 0, err
+    assert f"CFL 2.5 = {2.5 / out['stable_cfl']:.2f} of the predicted stable {out['stable_cfl']:.3g}" in text
+    assert "unstable by prediction" in text and "CFL 3 is past the predicted stable 2.35" in text
+    assert ".py" not in text  # no file paths in the explanation
+    # only the run past its limit reaches 0.0015: nothing is advised, in text and in JSON (exit 1 both)
+    rc, text, _ = cli_main("advise", "--error", "0.0015", "--results", str(results), "--machine", "m", capsys=capsys)
+    assert rc == 1 and "below its predicted stable CFL" in text and "CFL 3 is past" in text and ".py" not in text
+    rc, text, _ = cli_main("advise", "--error", "0.0015", "--results", str(results), "--machine", "m", "--json",
+                           capsys=capsys)
+    data = json.loads(text, parse_constant=_refuse)
+    assert rc == 1 and data["found"] is False and data["unstable_by_prediction"][0]["cfl"] == 3.0
+
+
+def test_advise_json_is_strict_and_the_paper_configuration_is_not_compared_with_itself(results, capsys):
+    rc, text, _ = cli_main("advise", "--error", "0.0115", "--model", "lagrangian", "--results", str(results),
+                           "--machine", "m", capsys=capsys)
+    assert rc == 0 and "this is the paper's configuration" in text and "slower" not in text, text
+    assert text.count("pcabench run ") == 1, text  # the command once, not twice with "1x"
+    rc, text, _ = cli_main("advise", "--error", "0.0115", "--model", "lagrangian", "--results", str(results),
+                           "--machine", "m", "--json", capsys=capsys)
+    data = json.loads(text, parse_constant=_refuse)
+    assert rc == 0 and data["is_paper_configuration"] is True and data["strip_height"] == 4.0
+    rc, text, _ = cli_main("advise", "--error", "0.01", "--domain", "full", "--results", str(results), "--machine",
+                           "m", "--json", capsys=capsys)
+    data = json.loads(text, parse_constant=_refuse)  # a full-domain run: its strip height is null, never NaN
+    assert rc == 0 and data["strip_height"] is None
+    assert data["stable_cfl"] == float(f"{data['stable_cfl']:.3g}") and data["cfl_fraction"] == round(
+        data["cfl_fraction"], 2)  # rounded as the text prints them
+
+
+def test_a_moving_model_past_its_long_run_limit_is_never_advised(tmp_path, capsys):
+    from pcabench import stability
+
+    path = tmp_path / "results" / store.store_name("m", "h")
+    path.parent.mkdir()
+    # the paper's method at CFL 4.8: under the linear prediction 4.97, past the 4.75 long lagrangian runs blew up at
+    _row(path, 0.5, 0.05, model="lagrangian", mse_isothermal=0.009, cfl=4.8)
+    _row(path, 80.0, 0.09, model="lagrangian", mse_isothermal=0.0095)
+    a = stability.assess({"model": "lagrangian", "cfl": 4.8, "dx": 0.2})
+    assert a["past_limit"] and a["limit_from"] == "long runs" and a["stable_cfl"] == 4.75
+    assert not stability.assess({"model": "linear", "cfl": 4.8, "dx": 0.2})["past_limit"]
+    out = advise(load_frame(path.parent), 0.01, 10.0, model="lagrangian")
+    assert out["seconds"] == pytest.approx(80.0) and out["unstable_by_prediction"][0]["cfl"] == 4.8
+    rc, text, _ = cli_main("advise", "--error", "0.01", "--model", "lagrangian", "--results", str(path.parent),
+                           capsys=capsys)
+    assert rc == 0 and "CFL 4.8 is past the stable 4.75 measured over long runs" in text, text

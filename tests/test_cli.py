@@ -56,13 +56,13 @@ def test_unstable_run_reports_status_and_step_with_exit_1():
     (["--dx", "-1"], ["dx", "> 0"]),
     (["--dx", "nan"], ["--dx", "finite"]),
     (["--dx", "0.00001"], ["dx", "smallest dx that fits"]),
-    (["--dx", "1", "--cutoff", "0.5"], ["cutoff", ">= 1"]),
-    (["--dx", "1", "--cfl", "0"], ["cfl", "> 0"]),
+    (["--dx", "1", "--cutoff", "0.5"], ["--cutoff", ">= 1"]),
+    (["--dx", "1", "--cfl", "0"], ["--cfl", "> 0"]),
     (["--dx", "1", "--steps", "0"], ["--steps", ">= 1"]),
-    (["--dx", "1", "--t-end", "-5"], ["t_end", "> 0"]),
-    (["--dx", "0.1", "--strip-height", "0.5"], ["strip_height", "3 cutoffs"]),
+    (["--dx", "1", "--t-end", "-5"], ["--t-end", "> 0"]),
+    (["--dx", "0.1", "--strip-height", "0.5"], ["--strip-height", "3 cutoffs"]),
     (["--dx", "1", "--threads", "0"], ["--threads", ">= 1"]),
-    (["--dx", "1", "--threads", "100000"], ["threads", "between 1 and"]),
+    (["--dx", "1", "--threads", "100000"], ["--threads", "between 1 and"]),
     (["--dx", "1", "--precision", "float16"], ["precision", "float64"]),
     (["--dx", "1", "--integrator", "leapfrog"], ["integrator", "verlet"]),
     (["--dx", "1", "--model", "eulerian"], ["model", "lagrangian"]),
@@ -71,6 +71,9 @@ def test_bad_input_exits_2_with_a_clear_message(args, words, capsys):
     code, out, err = cli_main("run", "--solver", "linkedlist-cpu", *args, capsys=capsys)
     assert code == 2, (out, err)
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    # one prefix, the option as typed (never Scene's parameter name), and the subcommand's help
+    assert err.startswith("pcabench run: error: ") and err.rstrip().endswith("(see pcabench run --help)"), err
+    assert not any(name in err for name in ("cutoff_factor", "t_end", "strip_height", "h_factor")), err
     for word in words:
         assert word in err, err
 
@@ -128,3 +131,36 @@ def test_library_code_never_raises_system_exit():
                 continue
             text = path.read_text()
             assert not re.search(r"raise SystemExit|except[^\n]*SystemExit", text), path
+
+
+def test_help_describes_the_tool(capsys):
+    code, out, _ = cli_main("--help", capsys=capsys)
+    assert code == 0 and "Benchmark SPH" in out and "argparse" not in out
+
+
+def test_accuracy_says_when_the_cfl_is_past_the_stable_one(capsys):
+    code, out, _ = cli_main("accuracy", "--dx", "0.1", "--cfl", "10", capsys=capsys)
+    assert code == 0 and out.splitlines()[0].startswith("CFL 10 is past the largest stable CFL 4.97"), out
+    code, out, _ = cli_main("accuracy", "--dx", "0.1", "--cfl", "10", "--json", capsys=capsys)
+    data = json.loads(out, parse_constant=_refuse)
+    assert data["past_stable_cfl"] is True and data["stable_cfl"] < 10
+    code, out, _ = cli_main("accuracy", "--dx", "0.1", "--cfl", "2", "--json", capsys=capsys)
+    assert json.loads(out, parse_constant=_refuse)["past_stable_cfl"] is False
+    code, out, _ = cli_main("accuracy", "--dx", "0.1", "--cfl", "2", capsys=capsys)
+    assert "past" not in out
+
+
+def _refuse(name):
+    raise ValueError(f"not strict JSON: {name}")
+
+
+def test_json_is_strict_everywhere(capsys):
+    from pcabench import jsonout
+
+    text = jsonout.dumps({"a": float("nan"), "b": [float("inf"), -float("inf")], "c": np.float32(1.5),
+                          "d": np.int64(3), "e": np.bool_(True)})
+    assert json.loads(text, parse_constant=_refuse) == {"a": None, "b": [None, None], "c": 1.5, "d": 3, "e": True}
+    code, out, _ = cli_main("accuracy", "--dx", "0.25", "--integrator", "euler", "--json", capsys=capsys)
+    assert json.loads(out, parse_constant=_refuse)["stable_cfl"] == 0
+    code, out, _ = cli_main("profile", "--no-gpu", capsys=capsys)
+    assert code == 0 and json.loads(out, parse_constant=_refuse)

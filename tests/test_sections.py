@@ -50,3 +50,87 @@ def test_a_new_section_is_one_entry_with_its_rows_text_and_figure(tmp_path, monk
     write_reports(_results(tmp_path), tmp_path / "out")
     report = (tmp_path / "out" / "machine-a" / "report.md").read_text()
     assert "## My table" in report and "runs on machine-a" in report and "![my_figure](my_figure.png)" in report
+
+
+def _stability_frame(tmp_path):
+    from pcabench.reports import frame
+
+    from .test_study import row
+
+    path = tmp_path / "stab" / "m.jsonl"
+    for cfl, status, mse in ((0.2, "ok", 0.1), (1.0, "ok", 0.1), (2.0, "ok", 0.1), (3.0, "ok", 0.1), (4.0, "ok", 0.1),
+                             (4.5, "ok", 0.3), (5.0, "ok", 0.1), (6.0, "ok", 0.5), (7.0, "ok", 0.4),
+                             (8.0, "unstable", 1.0)):
+        store.append(row(model="linear", preset="stability", dx=0.25, t_end=10.0, strip_height=5.0, cfl=cfl,
+                         status=status, failed_step=4 if status == "unstable" else None, mse=mse), path)
+    for cfl, mse in ((0.2, 0.3), (4.0, 0.13)):  # a longer run: inaccurate at 0.2, accurate at 4
+        store.append(row(model="linear", preset="stability", dx=0.25, t_end=30.0, strip_height=5.0, cfl=cfl,
+                         mse=mse), path)
+    return frame.load(path.parent)
+
+
+def test_the_stability_summary_agrees_with_the_prediction_and_the_map(tmp_path, monkeypatch):
+    import matplotlib.axes
+    import matplotlib.figure
+
+    from pcabench.reports import figures as F
+
+    points, limits = T.stability(_stability_frame(tmp_path), 0.2)
+    for p in points:  # at or past the predicted 4.97 a run is unstable, blown up or by prediction
+        assert (p["class"] in ("unstable", "unstable by prediction")) == (p["cfl"] >= 4.97), p
+    lines = sections._stability_text((points, limits), None)
+    text = "\n".join(lines)
+    summary = next(line for line in lines if line.startswith("- **verlet** (t = 10 s)"))
+    assert "predicted stable up to CFL 4.97" in summary and "blew up at CFL 8" in summary, summary
+    assert "CFL 5-7 ended bounded after 10 steps" in summary and "unstable by prediction" in summary, summary
+    assert "within 20 % error at CFL 0.2-4." in summary, summary  # 4.5 inaccurate, 5-7 past the limit
+    assert "never blew up" not in text and "bounded up to" not in text
+    long = next(lim for lim in limits if lim["protocol"] == "t = 30 s")
+    assert long["accurate_at"] == [4.0] and [c for c, _ in long["inaccurate_at"]] == [0.2]  # not "none"
+
+    drawn, limit_bars, ticks = {}, [], []
+    scatter, plot, savefig = matplotlib.axes.Axes.scatter, matplotlib.axes.Axes.plot, matplotlib.figure.Figure.savefig
+
+    def record_scatter(self, x, y, *args, label=None, **kw):
+        drawn[label] = sorted(zip(x, y))
+        return scatter(self, x, y, *args, label=label, **kw)
+
+    def record_plot(self, *args, **kw):
+        if kw.get("color") == "black":
+            limit_bars.append(args[0][0])
+        return plot(self, *args, **kw)
+
+    def record_ticks(self, *args, **kw):
+        ticks.extend(self.axes[0].get_xticks())
+        return savefig(self, *args, **kw)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "scatter", record_scatter)
+    monkeypatch.setattr(matplotlib.axes.Axes, "plot", record_plot)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", record_ticks)
+    assert F.stability_map(points, limits, tmp_path, "m", 0.2)
+    configs = [lim["config"] for lim in limits]
+    by_class = {}
+    for p in points:
+        by_class.setdefault(p["class"], []).append((p["cfl"], configs.index(p["config"])))
+    assert drawn == {cls: sorted(v) for cls, v in by_class.items()}  # one colour per class, the table's classes
+    assert limit_bars == [lim["stable_cfl"] for lim in limits]  # the predicted limit on every row
+    assert {p["cfl"] for p in points} <= set(ticks)  # a tick at every CFL swept
+
+
+def test_fig9_keeps_the_loop_measured_beside_the_most_all_pair_runs(tmp_path):
+    from pcabench.reports import frame
+
+    from .test_study import row
+
+    path = tmp_path / "f9" / "m.jsonl"
+    for dx in (1.0, 0.5):  # all-pair and the pair list at two N; a plug-in study adds gather at one N only
+        store.append(row(solver="allpair-cpu", dx=dx, steps=10), path)
+        rec = row(dx=dx, steps=10)
+        rec.pair_loop = "list"
+        store.append(rec, path)
+    rec = row(dx=1.0, steps=10, stamp=5)
+    rec.pair_loop = "gather"
+    store.append(rec, path)
+    rows = T.fig9(frame.load(path.parent))
+    assert {r["linkedlist_loop"] for r in rows} == {"list"}
+    assert all(r["linkedlist_ms"] for r in rows)  # both N keep their linked-list time

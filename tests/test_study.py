@@ -149,9 +149,13 @@ def test_tables_from_a_fixed_results_file(results):
 
     points, limits = T.stability(a, inaccurate_above=0.15)
     lim = {x["config"].split(",")[0]: x for x in limits}
-    assert lim["verlet"]["stable_up_to"] == 4.0 and lim["verlet"]["first_failure"][:2] == (5.0, "inaccurate")
-    assert lim["verlet"]["bounded_up_to"] == 5.0 and lim["verlet"]["first_unbounded"] == (6.0, "unstable", 7)
-    assert lim["euler"]["stable_up_to"] is None and lim["euler"]["first_failure"][1:3] == ("unstable", 30)
+    # CFL 5 ended bounded but is past verlet's predicted 4.97: unstable by prediction, with its e-foldings
+    assert lim["verlet"]["stable_cfl"] == pytest.approx(4.967, abs=1e-3)
+    assert lim["verlet"]["accurate_at"] == [0.2, 1.0, 4.0] and lim["verlet"]["blew_up_at"] == [(6.0, 7)]
+    assert [b[0] for b in lim["verlet"]["bounded_past_limit"]] == [5.0]
+    assert 0 < lim["verlet"]["bounded_past_limit"][0][2] < 37
+    assert lim["euler"]["stable_cfl"] == 0 and lim["euler"]["accurate_at"] == []
+    assert lim["euler"]["blew_up_at"] == [(0.2, 30)]
 
     f32 = {r["model"]: r for r in T.float32_vs_float64(a)}
     assert f32["linear"]["stops_at"] == pytest.approx(0.05)
@@ -179,8 +183,8 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
         assert image.shape[0] > 100 and image.shape[1] > 100 and image.std() > 0, name
     a = (out / "machine-a" / "report.md").read_text()
     for words in ("Table 4", "Table 5", "Table 6", "Fig. 9", "Fig. 8", "fitted order 2.00", "stops falling at dx = 0.2",
-                  "Time to a given accuracy", "paper / fastest", "cost of each simplification", "accurate up to CFL",
-                  "bounded up to CFL", "skipped"):
+                  "Time to a given accuracy", "paper / fastest", "cost of each simplification", "predicted stable CFL",
+                  "unstable by prediction", "skipped"):
         assert words in a, words
     cards = (out / "cards.md").read_text()
     assert "machine-b" in cards and "Tesla K20c" in cards and "Quadro M4000" in cards

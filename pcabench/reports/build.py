@@ -17,7 +17,7 @@ from . import frame
 from . import paper as P
 from . import tables as T
 from .md import fmt, md_table
-from .sections import SECTIONS, Context
+from .sections import SECTIONS, Context, table6_md
 
 
 def _machine(pid: str) -> str:
@@ -71,19 +71,11 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
              "Measured, each GPU against its own host's CPU (one thread), at the same N and run length:", ""]
     same = [r for r in ours if r["same_machine"]]
     other = [r for r in ours if not r["same_machine"]]
-    lines += [md_table(["GPU profile", "N", "protocol", "precision", "GPU ms/step", "CPU ms/step (1 thread)",
-                        "speedup", "speedup vs all cores"],
-                       [[r["gpu_profile"], f"{r['N']:,}", r["protocol"], r["precision"], fmt(r["gpu_ms"], ".3f"),
-                         fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
-                         "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f}"] for r in same])
-              if same else "No GPU has been measured with its own host's CPU at the same N yet."]
+    lines += [table6_md(same, gpu_column=True) if same else
+              "No GPU has been measured with its own host's CPU at the same N yet."]
     if other:
-        lines += ["", "Across machines (a GPU against another machine's CPU core; not a speedup of one machine):",
-                  "", md_table(["GPU profile", "N", "protocol", "precision", "GPU ms/step", "CPU profile",
-                                "CPU ms/step (1 thread)", "ratio"],
-                               [[r["gpu_profile"], f"{r['N']:,}", r["protocol"], r["precision"],
-                                 fmt(r["gpu_ms"], ".3f"), r["cpu_profile"], fmt(r["cpu_ms"], ".1f"),
-                                 fmt(r["speedup"], ".1f")] for r in other])]
+        lines += ["", "Across machines (a GPU against another machine's CPU; not a speedup of one machine):",
+                  "", table6_md(other, across=True, gpu_column=True)]
     lines += ["", f"Published (the paper's Table 6: whole runs of {P.TABLE6_STEPS} steps, serial CPU; its runtime "
                   "unit is printed as min, but Table 4 makes seconds the consistent reading, so the runtimes are "
                   "given here as printed and read as s):", "",

@@ -18,12 +18,14 @@ from pathlib import Path
 import numpy as np
 from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
+from pcabench.stability import UNSTABLE_BY_PREDICTION
+
 from . import paper as P
 from . import tables as T
 
 CLASS_STYLE = {"stable": ("tab:green", "o"), "inaccurate": ("tab:orange", "s"), "unstable": ("tab:red", "X"),
                "timeout": ("tab:gray", "v"), "error": ("black", "x"), "out-of-memory": ("tab:purple", "P"),
-               "skipped": ("tab:gray", ".")}
+               "skipped": ("tab:gray", "."), UNSTABLE_BY_PREDICTION: ("tab:red", "X")}
 STAGE_COLOURS = {"input": "tab:gray", "init": "tab:brown", "snp": "tab:blue", "pi": "tab:orange",
                  "su": "tab:green", "output": "tab:purple"}
 PRECISION_MARKER = {"float64": "o", "float32": "s"}
@@ -144,30 +146,44 @@ def fig8(series, out: Path, pid: str):
                 size=(5.6 * len(protocols) + 0.6, 4.6 + 0.16 * max(sum(s["protocol"] == p for s in series)
                                                                  for p in protocols)), legend="below") as axes:
         for ax, protocol in zip(axes, protocols):
-            dxs = []
+            dxs, note = [], ""
             for s in (s for s in series if s["protocol"] == protocol):
                 f32 = s["precision"] == "float32"
+                hidden = s["domain"] == "full" and _under_the_strip(s, series)
                 ax.plot(s["dx"], s["mse"], color=MODEL_COLOUR.get(s["model"], "k"),
                         marker=PRECISION_MARKER[s["precision"]], ms=9 if f32 else 5, mfc="none" if f32 else None,
                         mew=1.4 if f32 else 1.0, ls="-" if s["domain"] == "strip" else ":", lw=1.2,
                         zorder=3 if f32 else 2,  # float32 on top: where it tracks float64 it would hide under it
-                        label=f"{s['model']} {s['precision']}{'' if domain else ' ' + s['domain']}: {T.trend(s)}")
+                        label=f"{s['model']} {s['precision']}{'' if domain else ' ' + s['domain']}: {T.trend(s)}"
+                        + (" (under the strip's line)" if hidden else ""))
                 dxs += list(s["dx"])
             dx_paper, mse_paper = P.fig8_point()
             if protocol == "100 steps":
                 if min(dxs) / dx_paper <= 4:  # drawn only near our runs; else named, not stretched to
-                    ax.plot([dx_paper], [mse_paper], marker="^", ms=9, mew=1.4, zorder=4, **PUBLISHED,
+                    ax.plot([dx_paper], [mse_paper], marker="^", ms=15, mew=1.4, zorder=4, **PUBLISHED,
                             label=f"paper, dx = {dx_paper:g}, 100 steps (published)")
                     dxs.append(dx_paper)
-                else:
-                    ax.text(0.02, 0.02, f"paper (published): {mse_paper:g} at dx = {dx_paper:g}, off this axis",
-                            transform=ax.transAxes, fontsize=7, color="0.35")
+                else:  # named in the panel's title: a note inside the axes would sit on the data
+                    note = f"\npaper (published): {mse_paper:g} at dx = {dx_paper:g}, off this axis"
             plain_log_ticks(ax, dxs)
             nice_log_ticks(ax, [e for s in series if s["protocol"] == protocol for e in s["mse"]]
                            + ([mse_paper] if dx_paper in dxs else []))
             ax.set_title(protocol + (" (fixed physical time)" if protocol.startswith("t =")
-                                     else " (the paper's protocol)"), fontsize=9)
+                                     else " (the paper's protocol)") + note, fontsize=9)
     return path
+
+
+def _under_the_strip(s, series, tolerance: float = 0.03) -> bool:
+    """Whether full-domain series ``s`` has a strip twin (model, precision, protocol) within ``tolerance`` at
+    every dx of ``s``: drawn under it, so the legend says so."""
+    for t in series:
+        if (t["domain"], t["model"], t["precision"], t["protocol"]) == ("strip", s["model"], s["precision"],
+                                                                        s["protocol"]):
+            strip = dict(zip(t["dx"], t["mse"]))
+            shared = [(e, strip[d]) for d, e in zip(s["dx"], s["mse"]) if d in strip]
+            if len(shared) == len(s["dx"]) and all(b and abs(a / b - 1) <= tolerance for a, b in shared):
+                return True
+    return False
 
 
 def fig9(rows, out: Path, pid: str):
@@ -176,7 +192,7 @@ def fig9(rows, out: Path, pid: str):
         return None
     rows = [r for r in rows if r["steps"] == steps and (r["allpair_ms"] or r["linkedlist_ms"])]
     path = out / "fig9_allpair_vs_linkedlist.png"
-    loop = T.FIG9_LOOP_NAMES[rows[0]["linkedlist_loop"]]
+    loop = T.FIG9_LOOP_NAMES.get(rows[0]["linkedlist_loop"], rows[0]["linkedlist_loop"])
     pub = [r for r in P.step_times() if r["source"] == "Fig. 9 text"]
     with figure(path, f"Fig. 9: all-pair against linked list, serial CPU, float64, {steps}-step runs ({pid})",
                 "particles N", "", ncols=2, logx=True, logy=True, size=(13, 4.4)) as (a, b):
@@ -186,8 +202,8 @@ def fig9(rows, out: Path, pid: str):
             if pts:
                 a.plot(*zip(*pts), marker="o", color=SEARCH_COLOUR[search], label=label)
         for search, marker in (("all-pair", "^"), ("linked list", "v")):
-            _published(a, [r for r in pub if r["search"] == search], marker,
-                       f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published)")
+            _published(a, [r for r in pub if r["search"] == search], marker,  # large and on top: never hidden
+                       f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published)", ms=10, zorder=4)
         skipped = [r["N"] for r in rows if r["allpair_status"] == "skipped"]
         for n in skipped:
             a.axvline(n, color="tab:gray", ls=":", lw=1)
@@ -319,9 +335,12 @@ def fig13(rows, out: Path, pid: str):
     if any(r["device"] == "gpu" for r in rows):
         paper = [(f"paper GPU Tesla K20c, N={n:,} (Table 4, one-step run)",
                   {s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)}) for n, v in P.table4().items()]
+    spread = max(r.get("init_spread", 1.0) for r in rows)
+    noisy = (f"; init is timed once per run, and stored reruns of one configuration differ in it by up to "
+             f"{spread:.1f}x: one slow init can dominate a row" if spread >= 1.5 else "")
     return _shares(out / "fig13_task_shares.png",
                    f"Fig. 13: share of a one-step run by task ({pid}): input + init + one step + output, the step "
-                   f"being the mean step of runs of {run}", "% of a run of one step", rows, paper, T.STAGES)
+                   f"being the mean step of runs of {run}{noisy}", "% of a run of one step", rows, paper, T.STAGES)
 
 
 def fig14(rows, out: Path, title: str):
@@ -387,11 +406,17 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
                 ncols=len(panels), logx=True, logy=True, size=(5.2 * len(panels) + 3.8, 4.6)) as axes:
         for ax, (t_final, model) in zip(axes, panels):
             here = [p for p in points if (p["t_final"], p["model"]) == (t_final, model)]
-            for (kern, precision), pts in _groups(here, ("kernel", "precision")):
+            for (kern, precision), pts in _groups([p for p in here if not p.get("past_limit")],
+                                                  ("kernel", "precision")):
                 colour = KERNEL_COLOURS.get(kern, "grey")
                 ax.plot([p["seconds"] for p in pts], [p["error"] for p in pts], ls="none", marker="o", ms=4.5,
                         color=colour, mfc="none" if precision == "float32" else colour, alpha=0.75,
                         label=f"{kern}, {precision}")
+            past = [p for p in here if p.get("past_limit")]
+            if past:
+                ax.plot([p["seconds"] for p in past], [p["error"] for p in past], ls="none", marker="X", ms=6,
+                        mfc="none", mec="tab:purple", mew=1.0,
+                        label="unstable by prediction (CFL at or past its stable CFL), any kernel: never on the front")
             paper = [p for p in here if p["paper_method"]]
             ax.plot([p["seconds"] for p in paper], [p["error"] for p in paper], ls="none", marker="*", ms=11,
                     mfc="none", mec="black", mew=1.1, label="the paper's method (Gaussian, h 2.13dx, 3h, CFL 0.2)")
@@ -408,24 +433,42 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
 
 
 def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
+    """Each method's runs by CFL, in the classes of the section's table (``tables.stability``), and the
+    predicted stable CFL of each row as a black bar; a tick at every CFL swept."""
     if not points:
         return None
     configs = [lim["config"] for lim in limits]
     path = out / "stability_map.png"
-    with figure(path, f"Stability map ({pid}): inaccurate = bounded but relative RMS > "
-                f"{100 * inaccurate_above:g} %; numbers: the step where an unstable run stopped",
-                "CFL = dt c0 / dx", "", logx=True, size=(11, 1.8 + 0.32 * len(configs))) as (ax,):
+    with figure(path, f"Stability map ({pid}): black bar: the predicted stable CFL; past it a run is unstable "
+                "(a hollow X where it ended bounded: too few steps for round-off to grow); inaccurate = bounded but relative "
+                f"RMS > {100 * inaccurate_above:g} %; numbers: the step where a run blew up",
+                "CFL = dt c0 / dx", "", logx=True, size=(11, 2.1 + 0.32 * len(configs))) as (ax,):
         for cls, (colour, marker) in CLASS_STYLE.items():
             pts = [p for p in points if p["class"] == cls]
             if pts:
-                ax.scatter([p["cfl"] for p in pts], [configs.index(p["config"]) for p in pts], c=colour,
-                           marker=marker, s=40, label=cls)
+                hollow = cls == UNSTABLE_BY_PREDICTION
+                ax.scatter([p["cfl"] for p in pts], [configs.index(p["config"]) for p in pts],
+                           c="white" if hollow else colour, edgecolors=colour if hollow else None, marker=marker,
+                           s=40, linewidths=1.2 if hollow else None, label=cls, zorder=3)  # above the limit bar
         for p in points:
             if p["class"] == "unstable" and p["failed_step"]:
                 ax.annotate(f"{int(p['failed_step'])}", (p["cfl"], configs.index(p["config"])), fontsize=6,
                             xytext=(3, 3), textcoords="offset points")
-        plain_log_ticks(ax, [p["cfl"] for p in points])
-        ax.tick_params(axis="x", labelsize=7)
+        cfls = [p["cfl"] for p in points]
+        drawn = False
+        for i, lim in enumerate(limits):
+            if lim["stable_cfl"] > 0:
+                ax.plot([lim["stable_cfl"]] * 2, [i - 0.38, i + 0.38], color="black", lw=1.5, solid_capstyle="butt",
+                        label=None if drawn else "predicted stable CFL")
+                drawn = True
+            else:
+                ax.annotate("predicted: grows at every CFL", (min(cfls), i), xytext=(-4, 6),
+                            textcoords="offset points", fontsize=6, color="0.3", ha="left")
+        ax.set_xlim(min(cfls) / 1.25, max(cfls + [lim["stable_cfl"] for lim in limits]) * 1.1)
+        ax.xaxis.set_major_locator(FixedLocator(sorted(set(cfls))))
+        ax.xaxis.set_major_formatter(lambda v, _: f"{v:g}")
+        ax.xaxis.set_minor_locator(NullLocator())
+        ax.tick_params(axis="x", labelsize=7, labelrotation=90)
         ax.set_yticks(range(len(configs)))
         ax.set_yticklabels(configs, fontsize=7)
         ax.set_ylim(-0.6, len(configs) - 0.4)

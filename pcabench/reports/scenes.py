@@ -16,6 +16,7 @@ from functools import lru_cache
 import numpy as np
 
 from pcabench.spec import stored_parameters
+from pcabench.stability import past_limit, stable_limit
 from solvers import DEFAULT_SCENE, Scene
 
 from .tables import is_paper_method, latest, numerics_label
@@ -30,18 +31,10 @@ def scene_of(r) -> Scene:
     return Scene(**stored_parameters(json.loads(r.scene_key)), memory_limit_bytes=2**62)
 
 
-@lru_cache(maxsize=4096)
-def _stable(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, dx: float, name: str) -> float:
-    from solvers.dispersion import stable_cfl
-
-    return stable_cfl(Scene(dx=dx, name=name, kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor,
-                            integrator=integrator, model="linear", memory_limit_bytes=2**62))
-
-
 def stable_cfl_of(r) -> float:
-    """The largest stable CFL the prediction gives for row ``r``'s method (the linear operator's)."""
-    return _stable(str(r.kernel), float(r.h_factor), float(r.cutoff_factor), str(r.integrator), float(r.dx),
-                   str(r.scene))
+    """The largest stable CFL of row ``r``'s method (pcabench/stability.py: the prediction, or the lower limit
+    long runs measured for a moving model)."""
+    return stable_limit(r)
 
 
 def points(df) -> list[dict]:
@@ -61,7 +54,7 @@ def points(df) -> list[dict]:
                     "seconds": float(r.t_solution), "error": float(error), "linear_error": float(r.mse),
                     "isothermal_error": None if r.mse_isothermal is None or not np.isfinite(r.mse_isothermal)
                     else float(r.mse_isothermal),
-                    "paper_method": is_paper_method(r), "stable_cfl": stable, "past_stable": float(r.cfl) >= stable,
+                    "paper_method": is_paper_method(r), "stable_cfl": stable, "past_stable": past_limit(r.cfl, stable),
                     "front_axis": r.get("err_front_axis"), "front_diagonal": r.get("err_front_diagonal"),
                     "commit": str(r.commit),
                     "N": int(r.n_particles), "row": r})

@@ -171,13 +171,18 @@ def _speed_text(rows, ctx) -> list[str]:
 
 
 # ---------------------------------------------------------------- Table 6 and Fig. 14
-def table6_md(rows) -> str:
-    return md_table(["N", "protocol", "GPU precision", "GPU ms/step", "CPU (profile)", "CPU ms/step", "speedup",
-                     "speedup vs all cores"],
-                    [[f"{r['N']:,}", r["protocol"], r["precision"], fmt(r["gpu_ms"], ".3f"),
-                      f"{r['cpu_profile']}, {r['cpu_loop']}", fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
-                      "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f} "
-                                                                 f"(x{r['cpu_threads']})"] for r in rows])
+def table6_md(rows, across: bool = False, gpu_column: bool = False) -> str:
+    """Table 6's rows, named and rounded alike in every report and the cards page: a "speedup" for a GPU against
+    its own host's CPU, a "ratio" ``across`` machines (two computers, not what a GPU buys one of them)."""
+    word = "ratio" if across else "speedup"
+    return md_table((["GPU profile"] if gpu_column else [])
+                    + ["N", "protocol", "GPU precision", "GPU ms/step", "CPU profile, loop", "CPU ms/step (1 thread)",
+                       word, f"{word} vs all cores (threads)"],
+                    [([r["gpu_profile"]] if gpu_column else [])
+                     + [f"{r['N']:,}", r["protocol"], r["precision"], fmt(r["gpu_ms"], ".3f"),
+                        f"{r['cpu_profile']}, {r['cpu_loop']}", fmt(r["cpu_ms"], ".1f"), fmt(r["speedup"], ".1f"),
+                        "-" if r["speedup_all_cores"] is None else f"{r['speedup_all_cores']:.1f} "
+                                                                   f"(x{r['cpu_threads']})"] for r in rows])
 
 
 def _table6_text(rows, ctx) -> list[str]:
@@ -195,7 +200,7 @@ def _table6_text(rows, ctx) -> list[str]:
     if other:
         lines += ["### Across machines (not a speedup of one machine)", "",
                   "This GPU's times against a CPU measured on another machine, named per row: a comparison of "
-                  "two computers, not what a GPU buys one of them.", "", table6_md(other), ""]
+                  "two computers, not what a GPU buys one of them.", "", table6_md(other, across=True), ""]
     return lines
 
 
@@ -206,9 +211,10 @@ def _fig9_text(rows, ctx) -> list[str]:
     steps = T.fig9_steps(rows)
     pub = [p for p in P.step_times() if p["source"] == "Fig. 9 text"]
     return ["## Fig. 9: all-pair against linked list (serial, float64, paper's scene)", "",
-            f"Linked list: {T.FIG9_LOOP_NAMES[rows[0]['linkedlist_loop']]}"
+            f"Linked list: {T.FIG9_LOOP_NAMES.get(rows[0]['linkedlist_loop'], rows[0]['linkedlist_loop'])}, "
+            "the loop measured beside the most all-pair runs, one loop throughout"
             + ("." if rows[0]["linkedlist_loop"] == "gather"
-               else " (no gather-loop runs stored; `--pair-loop gather` measures the paper's).")
+               else " (`--pair-loop gather` at the same N measures the paper's).")
             + " Both sides of a row made the same number of steps"
             + (f"; the figure draws the {steps}-step runs." if steps else "."), "",
             md_table(["steps", "N", "all-pair ms/step", "linked list ms/step", "eta = t_AP / t_LL",
@@ -321,8 +327,32 @@ def _front_text(data, ctx) -> list[str]:
             "is the linear part only: the moving particles and the nonlinear terms add to it.", "",
             md_table(["model", "t (s)", "method", "dx", "domain", "precision", "time (s)", "error", "predicted"],
                      fronts), "",
+            *_unstable_front_text(T.unstable_on_front(points)),
             *_predicted_by_model(data["predicted"]),
             *_why_the_paper_method()]
+
+
+def _limit_words(stable_cfl: float) -> str:
+    return f"{stable_cfl:.3g}" if stable_cfl > 0 else "none (grows at every CFL)"
+
+
+def _unstable_front_text(rows) -> list[str]:
+    if not rows:
+        return []
+    return ["Unstable by prediction, never on the front nor in the first table, whatever their error: the runs "
+            "at or past their method's predicted stable CFL that a front ignoring the prediction would hold. "
+            "Each ended bounded only because its run was too short: its most unstable mode grew by the "
+            "e-foldings shown, while round-off (1e-16) needs about 37 to reach the pulse's size; a finer dx "
+            "or a longer time makes it blow up. For `fixed` and `lagrangian` the limit is their linear part's, "
+            "or where lower the one long runs measured (pcabench/stability.py: the paper's method blows up from "
+            "CFL 4.75 and 4.7 within 300 s, below the linear 4.97).", "",
+            md_table(["model", "t (s)", "method", "dx", "domain", "precision", "time (s)", "error",
+                      "stable CFL", "steps", "e-foldings"],
+                     [[p["model"], fmt(p["t_final"], "g"), p["method"], fmt(p["dx"], "g"), p["domain"],
+                       p["precision"], fmt(p["seconds"], ".3g"), fmt(p["error"], ".3g"),
+                       _limit_words(p["stable_cfl"]) + (" (long runs)" if p.get("limit_from") == "long runs" else ""),
+                       str(p["steps"]), fmt(p["e_foldings"], ".3g")]
+                      for p in rows]), ""]
 
 
 def _predicted_by_model(predicted) -> list[str]:
@@ -379,33 +409,64 @@ def _simplifications_text(rows, ctx) -> list[str]:
 
 
 # ---------------------------------------------------------------- stability
+def _e_fold_words(bounded) -> str:
+    """"CFL 5-7 ended bounded after 6-8 steps, their most unstable mode 1.9-12 e-foldings" from
+    ``bounded_past_limit`` entries (cfl, steps, e-foldings)."""
+    steps = sorted({b[1] for b in bounded})
+    folds = [b[2] for b in bounded]
+    span = (lambda lo, hi, f: f"{lo:{f}}" if f"{lo:{f}}" == f"{hi:{f}}" else f"{lo:{f}}-{hi:{f}}")
+    return (f"ended bounded after {span(steps[0], steps[-1], 'd')} steps, in which the most unstable mode grew by "
+            f"{span(min(folds), max(folds), '.2g')} e-foldings")
+
+
+def _stability_row(lim) -> list[str]:
+    swept = lim["cfls"]
+    bounded = lim["bounded_past_limit"]
+    blew = lim["blew_up_at"]
+    return [lim["config"], f"{lim['dx']:g}", ", ".join(f"{c:g}" for c in swept), _limit_words(lim["stable_cfl"]),
+            T.cfl_ranges(lim["accurate_at"], swept) or "none",
+            "; ".join(f"{c:g} ({pct(e)})" for c, e in lim["inaccurate_at"]) or "-",
+            "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in blew) or "-",
+            (f"{T.cfl_ranges([b[0] for b in bounded], swept)}: " + _e_fold_words(bounded)) if bounded else "-"]
+
+
 def _stability_text(rows, ctx) -> list[str]:
     _points, limits = rows
     if not limits:
         return []
     lines = ["## Stability: where methods fail", "",
-             f"`pcabench study --stability` (and a quick study's few CFLs): the linear model on a strip, each run "
-             f"classed stable, inaccurate (bounded, relative RMS above {100 * INACCURATE_ABOVE:g} %) or unstable "
-             "(stopped at the step where max|u| left its bound or went non-finite).", "",
-             md_table(["method", "dx", "CFLs run", "bounded up to CFL", "stable and accurate up to CFL",
-                       "first failure"],
-                      [[lim["config"], f"{lim['dx']:g}", ", ".join(f"{c:g}" for c in lim["cfls"]),
-                        fmt(lim["bounded_up_to"], "g") if lim["bounded_up_to"] else "none",
-                        fmt(lim["stable_up_to"], "g") if lim["stable_up_to"] else "none",
-                        "-" if not lim["first_failure"] else
-                        f"CFL {lim['first_failure'][0]:g}: {lim['first_failure'][1]}"
-                        + (f" at step {lim['first_failure'][2]}" if lim["first_failure"][2] else "")
-                        + (f" ({pct(lim['first_failure'][3])})" if lim["first_failure"][1] == "inaccurate"
-                           else "")] for lim in limits]), ""]
+             "`pcabench study --stability` (and a quick study's few CFLs): the linear model on a strip. The story "
+             "comes from the prediction (`pcabench accuracy`: the largest CFL at which one step of the integrator "
+             "never grows any lattice mode, exact for this model): a run at or past its method's predicted stable "
+             "CFL is unstable. It either blew up (stopped at the step where max|u| left its bound or went "
+             "non-finite) or, where it ended bounded, it is *unstable by prediction*: its run was too short for "
+             "round-off to grow, as its e-foldings say (round-off, 1e-16 of the pulse, needs about 37 to reach the "
+             "pulse's size; a finer dx or a longer time makes such a run blow up). Below the limit a run is stable "
+             f"(relative RMS error within {100 * INACCURATE_ABOVE:g} %) or inaccurate (bounded, error above it). "
+             "The map draws the same classes, and the predicted limit on each row.", "",
+             md_table(["method", "dx", "CFLs run", "predicted stable CFL",
+                       f"stable, within {100 * INACCURATE_ABOVE:g} %, at CFL",
+                       "inaccurate (below the limit) at CFL", "blew up at CFL",
+                       "past the limit, ended bounded (unstable by prediction)"],
+                      [_stability_row(lim) for lim in limits]), ""]
     for lim in limits:
         if lim["h_factor"] == Scene.default("h_factor") and lim["precision"] == "float64" and len(lim["cfls"]) > 3:
-            unb = lim["first_unbounded"]
-            lines.append(f"- **{lim['integrator']}** ({lim['protocol']}): stays bounded up to CFL "
-                         f"{fmt(lim['bounded_up_to'], 'g') if lim['bounded_up_to'] else 'none of those run'}"
-                         + (f", blows up from CFL {unb[0]:g}" + (f" (step {unb[2]})" if unb[2] else "")
-                            if unb else ", and never blew up")
-                         + f"; within {100 * INACCURATE_ABOVE:g} % error up to CFL "
-                         f"{fmt(lim['stable_up_to'], 'g') if lim['stable_up_to'] else 'none'}.")
+            swept = lim["cfls"]
+            parts = [f"predicted stable up to CFL {lim['stable_cfl']:.3g}" if lim["stable_cfl"] > 0
+                     else "predicted to grow at every CFL"]
+            if lim["blew_up_at"]:
+                parts.append(f"blew up at CFL {T.cfl_ranges([c for c, _ in lim['blew_up_at']], swept)}")
+            if lim["bounded_past_limit"]:
+                b = lim["bounded_past_limit"]
+                parts.append(f"CFL {T.cfl_ranges([x[0] for x in b], swept)} {_e_fold_words(b)}: too few for "
+                             "round-off to grow, unstable by prediction, not stable")
+            if lim["blew_up_below_limit"]:
+                parts.append(f"blew up below the predicted limit at CFL "
+                             f"{T.cfl_ranges(lim['blew_up_below_limit'], swept)} (against the prediction)")
+            accurate = T.cfl_ranges(lim["accurate_at"], swept)
+            parts.append(f"stable and within {100 * INACCURATE_ABOVE:g} % error at CFL {accurate}" if accurate
+                         else f"stable and within {100 * INACCURATE_ABOVE:g} % error at none of the CFLs run")
+            lines.append(f"- **{lim['integrator']}** ({lim['protocol']}): " + "; ".join(parts) + ".")
     return lines + [""]
 
 
@@ -453,7 +514,8 @@ SECTIONS = (
             (lambda rows, ctx: F.fig10(rows, ctx.out, ctx.name),)),
     Section("speed", lambda ctx: T.speed(ctx.df), _speed_text),
     Section("table6", lambda ctx: [r for r in ctx.table6() if r["gpu_profile"] == ctx.pid], _table6_text,
-            (lambda rows, ctx: F.fig14(rows, ctx.out, ctx.pid) if rows else None,)),
+            # drawn where this GPU was measured with its own host's CPU: the paper's lines alone are the cards page's
+            (lambda rows, ctx: F.fig14(rows, ctx.out, ctx.pid) if any(r["same_machine"] for r in rows) else None,)),
     Section("fig9", lambda ctx: T.fig9(ctx.df), _fig9_text, (lambda rows, ctx: F.fig9(rows, ctx.out, ctx.name),)),
     Section("fig8", _fig8_rows, _fig8_text, (lambda rows, ctx: F.fig8(rows["series"], ctx.out, ctx.name),)),
     Section("front", _front_rows, _front_text,

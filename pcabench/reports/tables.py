@@ -83,6 +83,10 @@ def table4(df) -> list[dict]:
     step. ``paper``: the paper's published numbers of the same kind at the same N (:func:`paper.same_kind`;
     a GPU row also gets Table 4's stage times), [] where it has none."""
     keys = ["solver", "precision", "n_particles", *PROTOCOL]
+    every = default_numerics(df[(df.status == "ok") & (df.model == "lagrangian") & (df.domain == "full")])
+    # init is timed once per run: how far the stored reruns of one configuration (any commit) differ in it
+    spread = every.groupby(keys).t_init.agg(lambda x: x.max() / x.min() if len(x) > 1 and x.min() > 0 else 1.0) \
+        if not every.empty else {}
     rows = []
     for _, r in _newest_per(paper_scene(df), keys).sort_values(["solver", "precision", "threads", "loop",
                                                                  "steps", "n_particles"]).iterrows():
@@ -90,6 +94,7 @@ def table4(df) -> list[dict]:
                "N": int(r.n_particles),
                "device": r.device, "search": r.search, "threads": int(r.threads), "commit": str(r.commit)[:7]}
         row.update({s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")})
+        row["init_spread"] = float(spread.get(tuple(r[k] for k in keys), 1.0))
         row.update(per_step_ms(r))
         row["paper"] = P.same_kind(r.device, r.search, r.n_particles) if _paper_kind(r) else []
         row["paper_stages"] = (P.table4().get(int(r.n_particles)) if r.device == "gpu" and _paper_kind(r)
@@ -127,7 +132,7 @@ def one_step_shares(rows4) -> list[dict]:
     for row in rows4:
         total = sum(row[s] for s in STAGES)
         rows.append({"config": row["config"], "protocol": row["protocol"], "run": row["run"], "steps": row["steps"],
-                     "N": row["N"], "device": row["device"],
+                     "N": row["N"], "device": row["device"], "init_spread": row.get("init_spread", 1.0),
                      **{s: 100 * row[s] / total for s in STAGES}})
     return rows
 
@@ -194,22 +199,24 @@ def fig9(df) -> list[dict]:
     """All-pair against linked list (serial, float64, paper scene): ms per step and eta = t_AP / t_LL, by run
     length (``steps``) and N: the two sides of a row always made the same number of steps.
 
-    One pair loop throughout: the paper's gather loop where it was measured, so
-    that eta means what the paper's does; else the pair list. Each row names it
-    (``linkedlist_loop``).
+    One pair loop throughout: the one measured beside the most all-pair runs
+    (same run length and N), the paper's gather loop on a tie, so that a few
+    gather rows added by another study never switch the figure to a loop with
+    fewer points. Each row names it (``linkedlist_loop``).
     """
     runs = paper_scene(df)
     serial = runs[(runs.device == "cpu") & (runs.search == "linked list") & (runs.threads == 1)
                   & (runs.precision == "float64")]
-    gather = serial.loop == "gather"
-    loop = "gather" if gather.any() else "list"
-    ll = _newest_per(serial[serial.loop == loop], ["steps", "n_particles"]).set_index(["steps", "n_particles"])
     everything = latest(default_numerics(df[(df.model == "lagrangian") & (df.domain == "full")]))
     ap_all = everything[everything.search == "all-pair"]
-    rows = []
     # a run's length: the steps it made, or for a run that made none (skipped, timed out) the steps it asked for
     asked = ap_all.steps_requested.fillna(ap_all.steps) if "steps_requested" in ap_all else ap_all.steps
     length = ap_all.steps.where(ap_all.status == "ok", asked)
+    ap_keys = set(zip(length.astype(int), ap_all.n_particles))
+    beside = {lp: len(ap_keys & set(zip(g.steps.astype(int), g.n_particles))) for lp, g in serial.groupby("loop")}
+    loop = max(beside, key=lambda lp: (beside[lp], lp == "gather")) if beside else "list"
+    ll = _newest_per(serial[serial.loop == loop], ["steps", "n_particles"]).set_index(["steps", "n_particles"])
+    rows = []
     for (steps, n), g in ap_all.groupby([length.astype(int), "n_particles"]):
         ok = g[g.status == "ok"]
         r = (ok if not ok.empty else g).sort_values("timestamp").iloc[-1]
@@ -349,9 +356,12 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
     `linear`, the isothermal solution for `lagrangian` (its error against the
     linear pulse never falls below the two equations' 9.8 % difference; rows
     from before that was measured are left out). The front of a model at a
-    time holds the runs no faster run of that model beats in error.
+    time holds the runs no faster run of that model beats in error, among the runs below their method's
+    predicted stable CFL (``past_limit``: at or past it, a run is unstable by prediction whatever its error,
+    pcabench/stability.py; it is drawn and listed as such, never on the front).
     """
     from pcabench.advise import error_column
+    from pcabench.stability import assess
 
     pts = latest(df[(df.status == "ok") & df.protocol.str.startswith("t =") & df.model.isin(FRONT_MODELS)])
     points = []
@@ -365,7 +375,12 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
                        "model": r.model, "domain": r.domain, "dx": r.dx, "N": int(r.n_particles),
                        "t_final": r.t_final, "seconds": r.t_solution, "error": float(error), "mse": r.mse,
                        "strip_height": r.strip_height, "solver": r.solver, "threads": int(r.threads),
-                       "commit": str(r.commit)})
+                       "commit": str(r.commit), "steps": int(r.steps), **assess(r)})
+    return points, fronts([p for p in points if not p["past_limit"]])
+
+
+def fronts(points) -> list[dict]:
+    """Each (time, model)'s front of ``points``: the runs no faster run beats in error."""
     front = []
     for t_final, model in sorted({(p["t_final"], p["model"]) for p in points}):
         best = np.inf
@@ -374,7 +389,15 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
             if p["error"] < best:
                 best = p["error"]
                 front.append(p)
-    return points, front
+    return front
+
+
+def unstable_on_front(points) -> list[dict]:
+    """The runs past their predicted stable CFL that a front of every run, stable or not, would hold: what
+    ignoring the prediction would have picked. Each with ``e_foldings``: its most unstable mode's growth."""
+    from pcabench.stability import e_foldings
+
+    return [{**p, "e_foldings": e_foldings(p, p["steps"])} for p in fronts(points) if p["past_limit"]]
 
 
 def comparable(a, b) -> bool:
@@ -420,10 +443,12 @@ def paper_method_rows(df):
 
 def fastest_to(points, targets=(0.10, 0.05, 0.02, 0.01, 0.005)) -> list[dict]:
     """For each time, model and error target: the fastest run reaching it, the fastest run of the paper's
-    method reaching it, and how many times faster the first is."""
+    method reaching it, and how many times faster the first is. Runs past their predicted stable CFL
+    (``past_limit``) are never picked."""
     rows = []
     for t_final, model in sorted({(p["t_final"], p["model"]) for p in points}):
-        pts = sorted((p for p in points if p["t_final"] == t_final and p["model"] == model), key=lambda p: p["seconds"])
+        pts = sorted((p for p in points if p["t_final"] == t_final and p["model"] == model
+                      and not p.get("past_limit")), key=lambda p: p["seconds"])
         for target in targets:
             hit = next((p for p in pts if p["error"] <= target), None)
             paper = hit and next((p for p in pts if p["error"] <= target and p["paper_method"] and comparable(p, hit)),
@@ -470,47 +495,83 @@ def _step_or_none(x):
     return None if x is None or not np.isfinite(x) else int(x)
 
 
-def classify(r, inaccurate_above: float) -> str:
-    """stable / inaccurate (bounded, error above the bar) / unstable, or the failed run's status."""
+def classify(r, inaccurate_above: float, past_limit: bool = False) -> str:
+    """stable (below its predicted stable CFL, bounded, accurate) / inaccurate (the same, error above the bar) /
+    unstable (it blew up) / unstable by prediction (at or past the predicted limit, ended bounded: too few
+    steps for round-off to grow), or the failed run's status."""
+    from pcabench.stability import UNSTABLE_BY_PREDICTION
+
     if r["status"] == "ok":
+        if past_limit:
+            return UNSTABLE_BY_PREDICTION
         return "stable" if r["mse"] <= inaccurate_above else "inaccurate"
     return r["status"]
 
 
-def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
-    """The stability map's points and, per configuration, the largest CFL up to which every run is stable.
+def cfl_ranges(cfls, swept) -> str:
+    """``cfls`` (a subset of the sorted ``swept``) as runs of neighbours in ``swept``: "0.1-4.5, 6"."""
+    swept = sorted(swept)
+    chosen = sorted(set(cfls))
+    parts, start, prev = [], None, None
+    for c in chosen:
+        if start is not None and swept.index(c) == swept.index(prev) + 1:
+            prev = c
+            continue
+        if start is not None:
+            parts.append(f"{start:g}" if start == prev else f"{start:g}-{prev:g}")
+        start = prev = c
+    if start is not None:
+        parts.append(f"{start:g}" if start == prev else f"{start:g}-{prev:g}")
+    return ", ".join(parts)
 
-    The runs of the stability preset, and a quick study's CFL sweep (three CFLs or more of one method).
+
+def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
+    """The stability map's points and one summary per configuration, both from the same classes.
+
+    Built from the prediction (pcabench/stability.py): a run at or past its
+    method's predicted stable CFL is unstable, by its blow-up or, where it
+    ended bounded, by prediction (``e_foldings``: how far its most unstable
+    mode grew in its steps, too little for round-off to show). The runs of the
+    stability preset, and a quick study's CFL sweep (three CFLs or more of one
+    method).
     """
+    from pcabench.stability import UNSTABLE_BY_PREDICTION, assess, e_foldings
+
     runs = latest(df[df.preset.isin(["stability", "quick"]) & df.protocol.str.startswith("t =")
                      & (df.model == "linear") & (df.domain == "strip")])
-    keys = ["integrator", "h_factor", "precision", "protocol", "dx"]
+    keys = ["integrator", "kernel", "h_factor", "cutoff_factor", "precision", "protocol", "dx"]
     if not runs.empty:
         sweeps = runs.groupby(keys + ["preset"]).cfl.transform("nunique")
         runs = runs[(runs.preset == "stability") | (sweeps >= 3)]
     points, limits = [], []
-    for (integ, h, precision, protocol, dx), g in runs.groupby(keys):
+    for (integ, kern, h, cut, precision, protocol, dx), g in runs.groupby(keys):
         g = g.sort_values("cfl")
-        name = f"{integ}, h = {h:g} dx, {precision}, {protocol}"
-        limit, bounded, first_bad, first_unbounded = None, None, None, None
+        method = f"{integ}, h = {h:g} dx" + (f", {kern}" if kern != "gaussian" else "")
+        if kern == "gaussian" and not np.isclose(cut, Scene.default("cutoff_factor")):
+            method += f", {cut:g}h"
+        name = f"{method}, {precision}, {protocol}"
+        mine = []
         for _, r in g.iterrows():
-            cls = classify(r, inaccurate_above)
-            step = _step_or_none(r.failed_step)
-            points.append({"config": name, "cfl": r.cfl, "class": cls, "mse": r.mse,
-                           "failed_step": step, "steps": r.steps_requested})
-            if first_bad is None:
-                if cls == "stable":
-                    limit = r.cfl
-                else:
-                    first_bad = (r.cfl, cls, step, r.mse)
-            if first_unbounded is None:
-                if cls in ("stable", "inaccurate"):
-                    bounded = r.cfl
-                else:
-                    first_unbounded = (r.cfl, cls, step)
-        limits.append({"config": name, "integrator": integ, "h_factor": h, "precision": precision,
-                       "protocol": protocol, "dx": dx, "cfls": g.cfl.tolist(), "stable_up_to": limit,
-                       "first_failure": first_bad, "bounded_up_to": bounded, "first_unbounded": first_unbounded})
+            a = assess(r)
+            cls = classify(r, inaccurate_above, a["past_limit"])
+            steps = r.steps if r.status == "ok" else r.steps_requested
+            mine.append({"config": name, "cfl": float(r.cfl), "class": cls, "mse": r.mse,
+                         "failed_step": _step_or_none(r.failed_step), "steps": _step_or_none(steps),
+                         "stable_cfl": a["stable_cfl"], "past_limit": a["past_limit"],
+                         "e_foldings": e_foldings(r, int(r.steps)) if cls == UNSTABLE_BY_PREDICTION else None})
+        points += mine
+        limits.append({"config": name, "integrator": integ, "kernel": kern, "h_factor": h, "precision": precision,
+                       "protocol": protocol, "dx": dx, "cfls": [p["cfl"] for p in mine],
+                       "stable_cfl": mine[0]["stable_cfl"],
+                       "accurate_at": [p["cfl"] for p in mine if p["class"] == "stable"],
+                       "inaccurate_at": [(p["cfl"], p["mse"]) for p in mine if p["class"] == "inaccurate"],
+                       "blew_up_at": [(p["cfl"], p["failed_step"]) for p in mine if p["class"] == "unstable"],
+                       "bounded_past_limit": [(p["cfl"], p["steps"], p["e_foldings"]) for p in mine
+                                              if p["class"] == UNSTABLE_BY_PREDICTION],
+                       "blew_up_below_limit": [p["cfl"] for p in mine
+                                               if p["class"] == "unstable" and not p["past_limit"]],
+                       "other": [(p["cfl"], p["class"]) for p in mine if p["class"] not in
+                                 ("stable", "inaccurate", "unstable", UNSTABLE_BY_PREDICTION)]})
     return points, limits
 
 
