@@ -19,6 +19,7 @@ import ctypes
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -78,6 +79,7 @@ def exit_status(returncode: int, oom_before: int | None, oom_after: int | None) 
 
 RECORD_LIMIT = 1 << 20  # the most bytes a child's record may take on its channel
 OUTPUT_KEPT = 2000  # characters of a solver's stdout and stderr kept in its record's message
+PROGRESS = re.compile(r"\r[^\r\n]*: step \d+/\d+ [^\r\n]*\n?")  # pcabench.progress's lines
 
 
 def _drain(stream, keep: list, relay=None) -> None:
@@ -149,8 +151,9 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
             reader.join(timeout=5)
         if stream is not None and err and not err[-1].endswith("\n"):
             stream.write("\n")  # end the child's last progress line
-    printed = "".join(f"\nthe solver's {name} (cut): {_cut(chunks)}" for name, chunks in
-                      (("stdout", out), ("stderr", err)) if name == "stdout" and _cut(chunks))
+    said = PROGRESS.sub("", "".join(err)).strip()  # stderr less the child's own progress lines
+    printed = "".join(f"\nthe solver's {name} (cut): {_cut([text])}" for name, text in
+                      (("stdout", "".join(out).strip()), ("stderr", said)) if text)
     data = record[0] if record else b""
     if proc.returncode == 0 and data:
         try:
@@ -169,9 +172,8 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
         status, what = exit_status(proc.returncode, oom_before, oom_kills())
         if proc.returncode == 0:
             what = "it sent no record"
-    stderr = _cut(err)[-400:]
     status = "error" if proc.returncode == 0 else status
-    return store.to_row(failed_record(spec, status, what + (f": {stderr}" if stderr else "") + printed, machine))
+    return store.to_row(failed_record(spec, status, what + printed, machine))
 
 
 def run_here(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:

@@ -178,13 +178,15 @@ def test_the_schema_tolerates_a_named_scene_and_extra_plain_keys():
 
 def test_environment_values_that_become_paths_are_checked_like_store_rows(monkeypatch, tmp_path, capsys):
     monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
-    for value in ("../../x", "README.md", "a" * 300, "x\x1by"):
+    try:
+        for value in ("../../x", "README.md", "a" * 300, "x\x1by"):
+            profiles.machine_id.cache_clear()
+            monkeypatch.setenv(profiles.MACHINE_ID_ENV, value)
+            code, out, err = cli_main("profile", "--save", capsys=capsys)
+            assert code == 2 and "PCABENCH_MACHINE_ID" in err, err
+    finally:
+        monkeypatch.delenv(profiles.MACHINE_ID_ENV)
         profiles.machine_id.cache_clear()
-        monkeypatch.setenv(profiles.MACHINE_ID_ENV, value)
-        code, out, err = cli_main("profile", "--save", capsys=capsys)
-        assert code == 2 and "PCABENCH_MACHINE_ID" in err, err
-    profiles.machine_id.cache_clear()
-    monkeypatch.delenv(profiles.MACHINE_ID_ENV)
     assert sorted(p.name for p in tmp_path.rglob("*")) in ([], ["home"], ["hardware_profiles", "home"])
     provenance.git_commit.cache_clear()
     monkeypatch.setenv("PCABENCH_COMMIT", "abc\x1b[2J")
@@ -193,6 +195,37 @@ def test_environment_values_that_become_paths_are_checked_like_store_rows(monkey
             provenance.git_commit()
     finally:
         provenance.git_commit.cache_clear()
+
+
+BAD_NAMES = """
+from solvers.linkedlist_cpu import LinkedListCPU
+
+class Newline(LinkedListCPU):
+    name = "two\\nlines"
+
+class Path(LinkedListCPU):
+    name = "../../forged"
+"""
+
+
+def test_a_plugin_whose_name_would_not_read_back_is_left_out(tmp_path, monkeypatch):
+    from solvers import registry
+
+    from .test_registry import install
+
+    site = install(tmp_path / "site", "badname_solver", BAD_NAMES,
+                   {"newline": "badname_solver:Newline", "path": "badname_solver:Path"})
+    monkeypatch.syspath_prepend(str(site))
+    registry.cache_clear()
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            found = registry()
+    finally:
+        registry.cache_clear()
+        sys.modules.pop("badname_solver", None)
+    assert "two\nlines" not in found and "../../forged" not in found
+    assert sum("not a plain name" in str(w.message) for w in caught) == 2
 
 
 # ---------------------------------------------------------------- the store folder's entries
@@ -239,6 +272,7 @@ def test_a_solver_that_prints_cannot_break_the_child_protocol(tmp_path, monkeypa
     row = sweep_module.run_child(spec, 120, "abc", "m", stream=None)
     assert row["status"] == "ok" and row["solver"] == "linkedlist-cpu", row
     assert "hello from the solver" in row["message"] and "forged" in row["message"]  # kept, never parsed
+    assert "a line on stderr" in row["message"] and "step " not in row["message"]
     assert store.validate(row) == ""
 
 
