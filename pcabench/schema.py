@@ -52,6 +52,7 @@ class Field:
     max_len: int = MAX_TEXT
     empty: bool = True  # whether "" is allowed
     path: bool = False  # the value becomes part of a path: not a reserved name
+    above: bool = False  # the range excludes ``low`` (a length: > 0)
 
 
 def _name(required=False, empty=True, path=False, max_len=MAX_NAME, pattern=NAME):
@@ -72,7 +73,7 @@ FIELDS: dict[str, Field] = {
     "precision": Field(("str",), choices=PRECISIONS),
     "model": Field(("str",), choices=MODELS),
     "integrator": Field(("str",), choices=INTEGRATORS),
-    "dx": Field(("number",), True, low=0, high=1e3),
+    "dx": Field(("number",), True, low=0, high=1e3, above=True),
     "n_particles": Field(("int",), True, low=0, high=2**31 - 1),
     "steps": _STEPS,
     "t_end": Field(("number", "null"), low=0, high=1e12),
@@ -101,7 +102,7 @@ FIELDS: dict[str, Field] = {
 
 _SCENE_NUMBER = Field(("number",), True, low=-1e12, high=1e12)
 SCENE_FIELDS: dict[str, Field] = {
-    "dx": Field(("number",), True, low=0, high=1e3),
+    "dx": Field(("number",), True, low=0, high=1e3, above=True),
     "steps": Field(("int", "null"), True, low=1, high=MAX_STEPS),
     "t_end": Field(("number", "null"), True, low=0, high=1e12),
     "strip_height": Field(("number", "null"), low=0, high=1e12),
@@ -156,12 +157,13 @@ def check_value(key: str, spec: Field, value) -> str:
         return f"{key!r} is {'a JSON ' + kind if kind != 'null' else 'null'}, not {' or '.join(spec.types)}"
     if kind in ("int", "number"):
         if kind == "int" and abs(value) > 1 << 62:
-            return f"{key!r} is out of range (got an integer of {len(str(value))} digits)"
+            return f"{key!r} is out of range (got an integer of {value.bit_length()} bits)"
         if not math.isfinite(value):
             return f"{key!r} must be finite (got {value!r})"
-        if (spec.low is not None and value < spec.low) or (spec.high is not None and value > spec.high) \
-                or (key in ("dx",) and value <= 0):
-            return f"{key!r} must be in [{spec.low:g}, {spec.high:g}] (got {value!r:.40})" if spec.high is not None \
+        if (spec.low is not None and (value <= spec.low if spec.above else value < spec.low)) \
+                or (spec.high is not None and value > spec.high):
+            low = f"{'(' if spec.above else '['}{spec.low:g}"
+            return f"{key!r} must be in {low}, {spec.high:g}] (got {value!r:.40})" if spec.high is not None \
                 else f"{key!r} must be >= {spec.low:g} (got {value!r:.40})"
     if kind == "str":
         why = text_problem(value, MESSAGE_CONTROL if key == "message" else CONTROL)
