@@ -390,6 +390,7 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
+    out = own_folder(out, "--out")  # never a link: the check writes and bundles everything in it
     if rehearse:
         from numba.core import config
 
@@ -401,7 +402,6 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
     from .reports import write_reports
     from .sweep import sweep
 
-    out = own_folder(out, "--out")  # never a link: the check writes and bundles everything in it
     budget = Budget(budget_s)
     _cuda, cupy = device_backend()  # raises SolverUnavailable with a clear message (no GPU, no simulator)
     state = {"budget_s": budget_s, "commit": git_commit(), "rehearsal": rehearse or simulated(), "stages": []}

@@ -19,6 +19,7 @@ import math
 import re
 from dataclasses import dataclass
 
+from solvers.registry import SOLVER_NAME
 from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, PRECISIONS
 
 from .record import STATUSES, STEP_STAGES
@@ -53,6 +54,7 @@ class Field:
     empty: bool = True  # whether "" is allowed
     path: bool = False  # the value becomes part of a path: not a reserved name
     above: bool = False  # the range excludes ``low`` (a length: > 0)
+    form: str = "a name of letters, digits, '.', '_', '-'"  # what ``pattern`` allows, in words
 
 
 def _name(required=False, empty=True, path=False, max_len=MAX_NAME, pattern=NAME):
@@ -69,7 +71,7 @@ _ERROR = Field(("number", "null"), low=0, high=1e300)
 
 FIELDS: dict[str, Field] = {
     "schema": Field(("int",), low=1),
-    "solver": _name(required=True, empty=False, max_len=64),
+    "solver": _name(required=True, empty=False, max_len=64, pattern=SOLVER_NAME),  # as the registry checks
     "precision": Field(("str",), choices=PRECISIONS),
     "model": Field(("str",), choices=MODELS),
     "integrator": Field(("str",), choices=INTEGRATORS),
@@ -93,10 +95,10 @@ FIELDS: dict[str, Field] = {
     "message": Field(("str",), max_len=MAX_MESSAGE),
     "profile_id": _name(required=True, empty=False, path=True),
     "host": _name(max_len=64, path=True),
-    "commit": _name(max_len=64, pattern=COMMIT),
+    "commit": Field(("str",), pattern=COMMIT, max_len=64, form="letters, digits, '.', '_', '+', '-'"),
     "versions": Field(("dict",)),
     "preset": _name(max_len=32),
-    "timestamp": Field(("str",), pattern=TIMESTAMP, max_len=40),
+    "timestamp": Field(("str",), pattern=TIMESTAMP, max_len=40, form="of the form YYYY-MM-DDTHH:MM:SS+00:00"),
     "run_id": Field(("str",), max_len=64, empty=False),
 }
 
@@ -176,9 +178,7 @@ def check_value(key: str, spec: Field, value) -> str:
         if spec.choices is not None and value not in spec.choices:
             return f"{key!r} must be one of {', '.join(spec.choices)} (got {value!r})"
         if value and spec.pattern is not None and not spec.pattern.fullmatch(value):
-            what = "a name of letters, digits, '.', '_', '-'" if spec.pattern is NAME else "of the form " + \
-                ("YYYY-MM-DDTHH:MM:SS+00:00" if spec.pattern is TIMESTAMP else "letters, digits, '.', '_', '+', '-'")
-            return f"{key!r} must be {what} (got {value!r:.80})"
+            return f"{key!r} must be {spec.form} (got {value!r:.80})"
         if spec.path and reserved_name(value):
             return f"{key!r} {value!r} is a name pcabench keeps for its own files"
     return ""

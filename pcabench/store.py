@@ -15,7 +15,8 @@ writer at a time.
   also keeps ``<store>.reserve``, space given up to store the record that
   meets a full disk, after which the sweep stops.
 - Nothing is written through a symbolic link: a store, lock, reserve or
-  ``.torn`` file that is one is refused.
+  ``.torn`` file that is one, or that is not a regular file (a FIFO), is
+  refused.
 - Every row carries ``schema`` (:data:`SCHEMA`) and is checked against the
   one declared schema (``pcabench/schema.py``: types, ranges, finite numbers,
   allowed characters, lengths, names safe as file names) on write (a record
@@ -115,13 +116,20 @@ def store_name(profile_id: str, host: str | None = None) -> str:
 
 
 def _open(path, flags: int, mode: int = 0o644) -> int:
-    """``os.open`` that refuses a symbolic link (StoreError naming the path)."""
+    """``os.open`` that refuses a symbolic link, a FIFO or a device (StoreError naming the path): never
+    blocks on a FIFO, never writes where a link points."""
     try:
-        return os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC, mode)
+        fd = os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK, mode)
     except OSError as exc:
         if exc.errno == errno.ELOOP:
             raise StoreError(f"{path} is a symbolic link; pcabench writes only regular files") from None
+        if exc.errno == errno.ENXIO:  # a FIFO with no reader
+            raise StoreError(f"{path} is not a regular file; pcabench writes only regular files") from None
         raise
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise StoreError(f"{path} is not a regular file; pcabench writes only regular files")
+    return fd
 
 
 def check_writable(path) -> Path:

@@ -132,8 +132,8 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
         with os.fdopen(read_end, "rb") as f:
             data = f.read(RECORD_LIMIT + 1)
             while f.read(1 << 16):  # a record past the limit: drain the rest, keep none of it
-                data = b""
-        record.append(data)
+                pass
+        record.append(data if len(data) <= RECORD_LIMIT else b"")
 
     readers = [threading.Thread(target=_drain, args=(proc.stdout, out), daemon=True),
                threading.Thread(target=_drain, args=(proc.stderr, err, relay), daemon=True),

@@ -247,6 +247,8 @@ def test_a_fifo_or_a_link_to_dev_zero_in_the_store_folder_is_skipped_with_a_warn
         assert name in code.stderr
     with pytest.raises(OSError, match="larger than"):
         store.read_regular(results / "m.jsonl", limit=10)
+    with pytest.raises(store.StoreError, match="not a regular file"):  # a study on it: refused, not hung
+        store.check_writable(results / "fifo.jsonl")
 
 
 # ---------------------------------------------------------------- the child protocol
@@ -364,7 +366,7 @@ def test_gpu_check_out_link_is_refused(tmp_path, capsys):
     outside.mkdir()
     (tmp_path / "out").symlink_to(outside)
     code, _, err = cli_main("gpu-check", "--out", str(tmp_path / "out"), "--results", str(tmp_path / "r"),
-                            "--reports", str(tmp_path / "rep"), "--rehearse", capsys=capsys)
+                            "--reports", str(tmp_path / "rep"), capsys=capsys)
     assert code == 2 and "symbolic link" in err, err
     assert list(outside.iterdir()) == []
 
