@@ -4,7 +4,8 @@ The store checks a row against it on write (a record that would not read
 back is never written) and on read (a row that fails is skipped with one
 warning naming the line and the field), so nothing downstream of the store
 sees an unchecked value. Keys it does not know are kept if they are plain
-values (a later pcabench's extra fields: strings, numbers, booleans, null);
+values (a later pcabench's extra fields: strings, numbers, booleans, null, or
+a flat object of those);
 the ``scene`` dict's known keys are checked, its other keys (a named scene's
 parameters) may hold strings or numbers.
 
@@ -196,6 +197,20 @@ def _plain(key: str, value) -> str:
     return "" if kind in ("null", "bool") else f"{key!r} is a JSON {kind}; an extra key holds a plain value"
 
 
+def _extra(key: str, value) -> str:
+    """Why the value of a top-level key the schema does not know cannot be kept ('' if it can): a plain
+    value, or a flat object of plain values (a later pcabench's parameters)."""
+    if _kind(value) != "dict":
+        return _plain(key, value)
+    if len(value) > 200:
+        return f"{key!r} holds {len(value)} entries, more than 200"
+    for k, v in value.items():
+        why = _key(k) or _plain(f"{key}.{k}", v)
+        if why:
+            return f"{key!r} {why}"
+    return ""
+
+
 def _key(key) -> str:
     if not isinstance(key, str):
         return f"a key {key!r} that is not a string"
@@ -239,7 +254,7 @@ def check(row) -> str:
             return why
     for key, value in row.items():
         if key not in FIELDS:
-            why = _key(key) or _plain(key, value)
+            why = _key(key) or _extra(key, value)
             if why:
                 return why
     stages = row["stages"]

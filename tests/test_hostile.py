@@ -175,7 +175,9 @@ def test_the_schema_tolerates_a_named_scene_and_extra_plain_keys():
     row = good_row()
     row["scene"] = dict(row["scene"], name="tube", tube_length=12.5, wall="rigid")
     row["scene_name"] = "tube"
+    row["scene_parameters"] = {"tube_length": 12.5, "wall": "rigid"}
     assert store.validate(row) == ""
+    assert "scene_parameters" in store.validate(dict(row, scene_parameters={"deep": {"er": 1}}))
     row["scene"]["bad"] = {"nested": 1}
     assert "scene" in store.validate(row)
 
