@@ -272,13 +272,13 @@ def cmd_run(args) -> int:
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
-    with solver_output_to_stderr(args.json), run_budget(args.run_budget):
-        try:
+    try:
+        with solver_output_to_stderr(args.json), run_budget(args.run_budget):
             record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
-        except RunBudgetSpent:
-            from .sweep import failed_record
+    except RunBudgetSpent:
+        from .sweep import failed_record
 
-            record = failed_record(spec, "timeout", f"past the run budget of {args.run_budget:g} s", machine_id())
+        record = failed_record(spec, "timeout", f"past the run budget of {args.run_budget:g} s", machine_id())
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
