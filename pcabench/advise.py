@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import shlex
 
 import numpy as np
 
@@ -39,25 +40,27 @@ def scene_of(r) -> dict:
 
 
 def command(r, t_end: float) -> str:
-    """The ``pcabench run`` command line that reproduces stored run ``r``."""
+    """The ``pcabench run`` command line that reproduces stored run ``r``, every word quoted for the shell
+    (shlex): a stored row from a shared store cannot plant shell syntax in a line the user pastes."""
     s = scene_of(r)
-    parts = [f"pcabench run --solver {r['solver']} --dx {s['dx']:g} --t-end {t_end:g} --model {r['model']}"]
+    words = ["pcabench", "run", "--solver", str(r["solver"]), "--dx", f"{s['dx']:g}", "--t-end", f"{t_end:g}",
+             "--model", str(r["model"])]
     if r.get("scene", Scene.default("name")) != Scene.default("name"):
-        parts.append(f"--scene {r['scene']}")
+        words += ["--scene", str(r["scene"])]
     if "mach" in r and not np.isclose(float(r["mach"]), Scene.default("mach")):
-        parts.append(f"--mach {float(r['mach']):g}")
+        words += ["--mach", f"{float(r['mach']):g}"]
     for option, key in (("--kernel", "kernel"), ("--h-factor", "h_factor"), ("--cutoff", "cutoff_factor"),
                         ("--cfl", "cfl"), ("--integrator", "integrator")):
         value = s[key]
         if value is not None and value != Scene.default(key):
-            parts.append(f"{option} {value:g}" if isinstance(value, float) else f"{option} {value}")
+            words += [option, f"{value:g}" if isinstance(value, float) else str(value)]
     if s["strip_height"] is not None and not (isinstance(s["strip_height"], float) and math.isnan(s["strip_height"])):
-        parts.append(f"--strip-height {s['strip_height']:g}")
+        words += ["--strip-height", f"{s['strip_height']:g}"]
     if r["precision"] != Scene.default("precision"):
-        parts.append(f"--precision {r['precision']}")
+        words += ["--precision", str(r["precision"])]
     if int(r["threads"]) > 1:
-        parts.append(f"--threads {int(r['threads'])}")
-    return " ".join(parts)
+        words += ["--threads", str(int(r["threads"]))]
+    return shlex.join(words)
 
 
 def error_column(model: str) -> str:
@@ -172,7 +175,8 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
         _, s, p = best
         out.update(kernel=getattr(s, "kernel", "gaussian"), h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,
                    predicted_error=p.predicted_error,
-                   study=(f"pcabench study --solver {DEFAULT_SOLVER} --model {model} --t-end {t_end:g} --strip "
-                          f"--kernel {getattr(s, 'kernel', 'gaussian')} --h-factor {s.h_factor:g} --cfl {s.cfl:g} "
-                          f"--dx {s.dx:g} {s.dx / 2:g}"))
+                   study=shlex.join(["pcabench", "study", "--solver", DEFAULT_SOLVER, "--model", model, "--t-end",
+                                     f"{t_end:g}", "--strip", "--kernel", getattr(s, "kernel", "gaussian"),
+                                     "--h-factor", f"{s.h_factor:g}", "--cfl", f"{s.cfl:g}", "--dx", f"{s.dx:g}",
+                                     f"{s.dx / 2:g}"]))
     return out

@@ -1,6 +1,11 @@
-"""A sweep's child process: run one spec and print its record as one JSON line on stdout.
+"""A sweep's child process: run one spec and send its record on a channel of its own.
 
-    python -m pcabench.child '<RunSpec JSON>'
+    python -m pcabench.child --record-fd FD '<RunSpec JSON>'
+
+The record goes, as one JSON object, to the file descriptor FD (a pipe the
+sweep passes in), never to stdout: what a solver prints on stdout or stderr
+cannot be taken for a record (the sweep keeps it, cut, in the record's
+message). Without ``--record-fd`` the record is printed on stdout (by hand).
 
 The child never writes the store: the sweep (its parent) is the only writer,
 so a progress line always reports the record this child made. Its record
@@ -10,6 +15,7 @@ and ``PCABENCH_COMMIT``, set by the parent).
 from __future__ import annotations
 
 import json
+import os
 import sys
 import warnings
 
@@ -29,9 +35,19 @@ def run_spec(spec: RunSpec) -> dict:
 
 
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
+    argv = list(sys.argv[1:] if argv is None else argv)
     warnings.filterwarnings("ignore", category=PluginWarning)  # the sweep (the parent) said it once
-    print(json.dumps(run_spec(RunSpec.from_json(argv[0])), sort_keys=True), flush=True)
+    fd = None
+    if argv[:1] == ["--record-fd"]:
+        fd, argv = int(argv[1]), argv[2:]
+        os.set_inheritable(fd, False)  # the solver's own subprocesses do not get it
+    data = (json.dumps(run_spec(RunSpec.from_json(argv[0])), sort_keys=True) + "\n").encode("utf-8")
+    if fd is None:
+        sys.stdout.buffer.write(data)
+        sys.stdout.flush()
+        return 0
+    with os.fdopen(fd, "wb") as f:  # closed here: the record is whole before anything at exit can print
+        f.write(data)
     return 0
 
 

@@ -13,10 +13,12 @@ allowed range, never a traceback).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
 import os
 import re
+import signal
 import sys
 import tempfile
 import warnings
@@ -246,6 +248,49 @@ def home_option() -> str:
     return "PCABENCH_HOME" if os.environ.get("PCABENCH_HOME") else "the pcabench home"
 
 
+class RunBudgetSpent(BaseException):
+    """``pcabench run --run-budget`` ran out (a BaseException: a run records every Exception as its own)."""
+
+
+@contextlib.contextmanager
+def run_budget(seconds: float | None):
+    """RunBudgetSpent in this (main) thread once ``seconds`` have passed (checked between Python steps of
+    the run, so a step of compiled code ends first); nothing if ``seconds`` is None."""
+    if seconds is None:
+        yield
+        return
+
+    def spent(signum, frame):
+        raise RunBudgetSpent()
+
+    before = signal.signal(signal.SIGALRM, spent)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, before)
+
+
+@contextlib.contextmanager
+def solver_output_to_stderr(on: bool):
+    """With ``on``, whatever the run prints on stdout (Python's sys.stdout and file descriptor 1, so compiled
+    code too) goes to stderr: `run --json` prints exactly one object on stdout, whatever the solver prints."""
+    if not on:
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 # ---------------------------------------------------------------- commands
 def cmd_run(args) -> int:
     from .profiles import machine_id
@@ -259,10 +304,18 @@ def cmd_run(args) -> int:
         if args.fields.strip() and not args.fields.endswith(".npz"):
             args.fields += ".npz"  # as numpy.savez names it
         check_output_path(args.fields, "--fields")
+    if args.run_budget is not None and not args.run_budget > 0:
+        raise OptionError(f"--run-budget must be > 0 seconds (got {args.run_budget})")
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     progress = None if args.quiet else Progress(args.solver)
-    record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
+    try:
+        with solver_output_to_stderr(args.json), run_budget(args.run_budget):
+            record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
+    except RunBudgetSpent:
+        from .sweep import failed_record
+
+        record = failed_record(spec, "timeout", f"past the run budget of {args.run_budget:g} s", machine_id())
     if args.json:
         out = {key: getattr(record, key) for key in record.CONTRACT}
         out["threads"] = record.threads
@@ -602,6 +655,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fields", help="write the final fields (x, y, u, v, drho, t) to this .npz")
     p.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
+    p.add_argument("--run-budget", type=number("--run-budget"),
+                   help="seconds before the run stops and is reported as a timeout (exit 1; default: no limit)")
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser("study", help="run a sweep (each run in its own process) and write the report",

@@ -57,6 +57,7 @@ from solvers.integrators import step_program
 
 from .record import STEP_STAGES, step_seconds
 from .run import run
+from .safeio import fresh, own_folder, write_file
 from .spec import ALL_CORES, SERIAL, RunSpec
 from .store import store_name
 
@@ -199,7 +200,7 @@ def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
                           **plan.scene)
             fields = {}
             for solver in (DEFAULT_SOLVER, GPU_SOLVER):
-                path = out / f"compare_{solver}.npz"
+                path = fresh(out / f"compare_{solver}.npz")
                 rec = run(RunSpec(solver, scene), fields_path=path)
                 if rec.status != "ok":
                     raise RuntimeError(f"{solver} {model} {precision}: {rec.status} {rec.message}")
@@ -299,7 +300,7 @@ def graph_vs_plain(dx: float, precision: str, steps: int, rounds: int, scene_ove
 def run_logged(cmd: list[str], log: Path, timeout: float, env=None) -> dict:
     """``cmd`` with its output in ``log``; its exit code (124 past ``timeout``) and seconds."""
     t0 = time.perf_counter()
-    with open(log, "w") as f:
+    with open(fresh(log), "w") as f:
         try:
             rc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, timeout=max(timeout, 1.0),
                                 env=env).returncode
@@ -389,6 +390,7 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
+    out = own_folder(out, "--out")  # never a link: the check writes and bundles everything in it
     if rehearse:
         from numba.core import config
 
@@ -400,8 +402,6 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
     from .reports import write_reports
     from .sweep import sweep
 
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     budget = Budget(budget_s)
     _cuda, cupy = device_backend()  # raises SolverUnavailable with a clear message (no GPU, no simulator)
     state = {"budget_s": budget_s, "commit": git_commit(), "rehearsal": rehearse or simulated(), "stages": []}
@@ -429,7 +429,7 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
         else:
             profile["measured"] = measure_ceilings(cupy)
         profiles.save(profile)
-        (out / "profile.json").write_text(json.dumps(profile, indent=2) + "\n")
+        write_file(out / "profile.json", json.dumps(profile, indent=2) + "\n")
 
     def compare():
         state["compare"] = compare_with_cpu(plan, out)
@@ -507,8 +507,8 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
 
     state["elapsed_s"] = budget.elapsed()
     text = markdown(profile, state)
-    (out / "gpu_check.md").write_text(text)
-    (out / "gpu_check.json").write_text(json.dumps(state, indent=1, default=str) + "\n")
+    write_file(out / "gpu_check.md", text)
+    write_file(out / "gpu_check.json", json.dumps(state, indent=1, default=str) + "\n")
     print(text, flush=True)
     try:
         for p in write_reports(Path(results), Path(reports)):
@@ -524,7 +524,7 @@ def bundle(out: Path, results: Path, reports: Path, machine: str) -> Path:
     """One tarball of what to bring back: the check's files, this machine's store and profile, the reports."""
     from . import paths
 
-    path = out / "gpu_check.tar.gz"
+    path = fresh(out / "gpu_check.tar.gz")
     with tarfile.open(path, "w:gz") as tar:
         for f in sorted(out.iterdir()):
             if f.name != path.name and (f.is_file() or f.is_dir()):

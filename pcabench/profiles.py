@@ -32,6 +32,7 @@ from pathlib import Path
 
 from . import paths
 
+PROFILE_BYTES = 1 << 24  # a stored profile larger than this is not read
 MACHINE_ID_ENV = "PCABENCH_MACHINE_ID"  # the id a sweep gives its children
 FAKE_GPU_ENV = "PCABENCH_FAKE_GPU"  # test hook: a card name gpu_info() reports
 
@@ -140,7 +141,11 @@ def profile_id(cpu: str, gpu: dict | None = None) -> str:
 def machine_id() -> str:
     """This machine's id, computed once per process: ``PCABENCH_MACHINE_ID`` if set (a sweep's child is
     given its parent's), else the GPU (when one is visible) and the CPU model, as in :func:`capture`."""
-    return os.environ.get(MACHINE_ID_ENV) or profile_id(_cpu_model(), gpu_info())
+    if os.environ.get(MACHINE_ID_ENV):
+        from .provenance import checked_env
+
+        return checked_env(MACHINE_ID_ENV, "profile_id")  # checked like a store row's: it names files
+    return profile_id(_cpu_model(), gpu_info())
 
 
 def capture(with_gpu: bool = True) -> dict:
@@ -174,12 +179,14 @@ def _folders() -> list[Path]:
 
 def stored() -> dict:
     """Every stored profile by id; a file that is not a JSON object is skipped with one warning naming it."""
+    from .store import read_regular
+
     out = {}
     for folder in _folders():
         for p in sorted(folder.glob("*.json")):
-            try:
-                profile = json.loads(p.read_bytes().decode("utf-8"))
-            except (OSError, ValueError) as exc:  # unreadable, not UTF-8, not JSON
+            try:  # a regular file of bounded size: a link, a FIFO or a device is skipped
+                profile = json.loads(read_regular(p, limit=PROFILE_BYTES).decode("utf-8"))
+            except (OSError, ValueError, RecursionError) as exc:  # unreadable, not UTF-8, not JSON
                 profile = f"{type(exc).__name__}: {exc}"
             if isinstance(profile, dict):
                 out[p.stem] = profile
@@ -198,9 +205,13 @@ def load(pid: str) -> dict:
 
 
 def save(profile: dict, directory: Path | None = None) -> Path:
-    """Write ``profile`` as ``<id>.json`` into ``directory`` (default: the user's profiles folder)."""
+    """Write ``profile`` as ``<id>.json`` into ``directory`` (default: the user's profiles folder): its id
+    checked as a store row's ``profile_id`` (StoreError), the file written whole, a link at its name replaced,
+    never followed."""
+    from .safeio import write_file
+    from .store import check_name
+
     directory = Path(directory) if directory else paths.user_profiles()
+    name = check_name(profile.get("id"), "profile id")
     directory.mkdir(parents=True, exist_ok=True)
-    path = directory / f"{profile['id']}.json"
-    path.write_text(json.dumps(profile, indent=2, sort_keys=True) + "\n")
-    return path
+    return write_file(directory / f"{name}.json", json.dumps(profile, indent=2, sort_keys=True) + "\n")

@@ -16,6 +16,19 @@ PACKAGES = ("pcabench", "numpy", "numba", "numba-cuda", "cupy-cuda12x", "cupy-cu
 CODE = (":(top)solvers", ":(top)pcabench", ":(top)pyproject.toml")
 
 
+def checked_env(variable: str, field: str) -> str:
+    """The environment variable ``variable``, checked like the record field ``field`` it becomes
+    (pcabench/schema.py); StoreError naming the variable if it would not read back."""
+    from . import schema
+    from .store import StoreError
+
+    value = os.environ[variable]
+    why = schema.check_value(field, schema.FIELDS[field], value)
+    if why:
+        raise StoreError(f"{variable}={value!r:.120}: {why}")
+    return value
+
+
 @functools.lru_cache(maxsize=None)
 def git_commit() -> str:
     """The commit of the source tree (with '+dirty' if its code has local changes), or 'unknown'.
@@ -24,8 +37,8 @@ def git_commit() -> str:
     profiles and documents are not, so a sweep that appends to a tracked
     results file, or an edited README, does not make later runs dirty.
     """
-    if os.environ.get("PCABENCH_COMMIT"):
-        return os.environ["PCABENCH_COMMIT"]  # a copy without git history (e.g. a GPU machine)
+    if os.environ.get("PCABENCH_COMMIT"):  # a copy without git history (e.g. a GPU machine)
+        return checked_env("PCABENCH_COMMIT", "commit")
     here = Path(__file__).resolve().parent
     try:
         proc = subprocess.run(["git", "rev-parse", "--verify", "HEAD"], cwd=here, capture_output=True,

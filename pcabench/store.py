@@ -15,12 +15,18 @@ writer at a time.
   also keeps ``<store>.reserve``, space given up to store the record that
   meets a full disk, after which the sweep stops.
 - Nothing is written through a symbolic link: a store, lock, reserve or
-  ``.torn`` file that is one is refused.
-- Every row carries ``schema`` (:data:`SCHEMA`) and is validated on load
-  (:func:`validate`: types, ranges, finite numbers, names safe as file names,
-  no control characters): a bad row is skipped with one warning naming the
-  file and line, a row of a newer schema is reported as such, and nothing
-  crashes on them.
+  ``.torn`` file that is one, or that is not a regular file (a FIFO), is
+  refused.
+- Every row carries ``schema`` (:data:`SCHEMA`) and is checked against the
+  one declared schema (``pcabench/schema.py``: types, ranges, finite numbers,
+  allowed characters, lengths, names safe as file names) on write (a record
+  that would not read back is refused, :class:`InvalidRecord`) and on load
+  (:func:`validate`): a bad row is skipped with one warning naming the file,
+  line and field; a row of a newer schema is kept in the file and skipped
+  with one warning; nothing crashes on them.
+- Only regular files of the store folder are read, up to
+  :data:`MAX_STORE_BYTES` each: a link, a FIFO or a device named ``*.jsonl``
+  is skipped with one warning.
 - Stores taken on different machines merge by concatenation: a record keeps
   its ``run_id`` wherever it is copied, and duplicates are dropped on load.
 """
@@ -32,25 +38,21 @@ import hashlib
 import json
 import math
 import os
-import re
 import shutil
+import stat
 import sys
 import warnings
 from pathlib import Path
 
 from solvers import Scene, SceneError
-from solvers.scene import MAX_STEPS
 
-from .record import STATUSES, STEP_STAGES
+from . import schema
+from .schema import SCHEMA
 
-SCHEMA = 2  # version of the row format; rows from before versioning are schema 1
-REQUIRED = {"solver": str, "status": str, "n_particles": int, "steps": int, "dx": (int, float),
-            "stages": dict, "scene": dict, "profile_id": str}
 MIN_FREE_BYTES = 1 << 20  # a sweep needs room for its records: refuse to start with less free space
 RESERVE_BYTES = 1 << 18  # <store>.reserve: room for the record that meets a full disk
-MAX_SECONDS = 1e9  # a stage time above this (31 years) is not a measurement
-NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*", re.ASCII)  # a machine or host name, safe as a file name
-CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
+MAX_STORE_BYTES = 1 << 30  # a store file larger than this is not read (a link to /dev/zero, a stray dump)
+NAME = schema.NAME  # a machine or host name, safe as a file name
 
 
 class StoreWarning(UserWarning):
@@ -62,6 +64,10 @@ FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)  # the disk (or the quota, or t
 
 class StoreError(OSError):
     """The store cannot be written (one line naming the path)."""
+
+
+class InvalidRecord(StoreError):
+    """A record that would not read back (it fails the schema): never written."""
 
 
 def run_id(row: dict) -> str:
@@ -84,6 +90,8 @@ def _clean(value):
 def to_row(record) -> dict:
     """The stored form of a run record (a RunRecord or dict): JSON-safe (NaN as null), schema and run_id."""
     row = _clean(record.as_dict() if hasattr(record, "as_dict") else dict(record))
+    if isinstance(row.get("message"), str):
+        row["message"] = schema.clean_text(row["message"])
     row.setdefault("schema", SCHEMA)
     row.setdefault("run_id", run_id(row))
     return row
@@ -93,7 +101,10 @@ def check_name(name, what: str) -> str:
     """``name`` if it is safe as a file name (letters, digits, ``. _ -``; not starting with a dot or dash);
     else StoreError naming ``what``."""
     if not isinstance(name, str) or not NAME.fullmatch(name):
-        raise StoreError(f"{what} {name!r} is not a safe name (letters, digits, '.', '_', '-')")
+        raise StoreError(f"{what} {name!r:.120} is not a safe name (letters, digits, '.', '_', '-')")
+    why = schema.check_value(what, schema.PATH_NAME, name)
+    if why:
+        raise StoreError(why)
     return name
 
 
@@ -105,13 +116,20 @@ def store_name(profile_id: str, host: str | None = None) -> str:
 
 
 def _open(path, flags: int, mode: int = 0o644) -> int:
-    """``os.open`` that refuses a symbolic link (StoreError naming the path)."""
+    """``os.open`` that refuses a symbolic link, a FIFO or a device (StoreError naming the path): never
+    blocks on a FIFO, never writes where a link points."""
     try:
-        return os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC, mode)
+        fd = os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK, mode)
     except OSError as exc:
         if exc.errno == errno.ELOOP:
             raise StoreError(f"{path} is a symbolic link; pcabench writes only regular files") from None
+        if exc.errno == errno.ENXIO:  # a FIFO with no reader
+            raise StoreError(f"{path} is not a regular file; pcabench writes only regular files") from None
         raise
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise StoreError(f"{path} is not a regular file; pcabench writes only regular files")
+    return fd
 
 
 def check_writable(path) -> Path:
@@ -137,10 +155,11 @@ def _write_all(fd: int, data: bytes) -> None:
 
 
 def _complete(line: bytes) -> bool:
-    """Whether ``line`` is a whole record (a crash cuts a record's closing brace off, so a cut one never is)."""
+    """Whether ``line`` is a whole JSON object (a crash cuts a record's closing brace off, so a cut one never
+    is). Whether it is a valid record is for the reader to say: a record of a newer schema is whole."""
     try:
-        return validate(json.loads(line.decode("utf-8"), parse_constant=_no_constant)) == ""
-    except ValueError:
+        return isinstance(json.loads(line.decode("utf-8")), dict)
+    except (ValueError, RecursionError):
         return False
 
 
@@ -201,6 +220,9 @@ def append(record, path) -> dict:
     """
     row = to_row(record)
     path = Path(path)
+    why = validate(row)
+    if why:
+        raise InvalidRecord(f"results store {path}: a record that would not read back was not stored ({why})")
     line = (json.dumps(row, sort_keys=True, allow_nan=False) + "\n").encode("utf-8")
     freed = False
     try:
@@ -305,52 +327,48 @@ def _no_constant(name):
 
 
 def validate(row) -> str:
-    """Why ``row`` is not a usable run record ('' if it is): types, ranges, finite numbers, safe names."""
-    if not isinstance(row, dict):
-        return f"not a record but a JSON {type(row).__name__}"
-    version = row.get("schema", 1)
-    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-        return f"'schema' must be an integer >= 1 (got {version!r})"
-    if version > SCHEMA:
-        return f"a row of a newer pcabench (schema {version}; this one reads up to {SCHEMA}): upgrade to read it"
-    for key, kind in REQUIRED.items():
-        if key not in row:
-            return f"missing {key!r}"
-        if not isinstance(row[key], kind) or isinstance(row[key], bool):
-            return f"{key!r} is {type(row[key]).__name__}, not {getattr(kind, '__name__', 'a number')}"
-    bad = [key for key, value in [*row.items(), *row["scene"].items()]
-           if key != "message" and isinstance(value, str) and CONTROL.search(value)]
-    if bad:
-        return f"{bad[0]!r} holds control characters"
-    if row["status"] not in STATUSES:
-        return f"'status' must be one of {', '.join(STATUSES)} (got {row['status']!r})"
-    for key in ("profile_id", "host"):  # they name the machine's files and report folder
-        if (key == "profile_id" or row.get(key)) and not NAME.fullmatch(str(row.get(key))):
-            return f"{key!r} must be a name of letters, digits, '.', '_', '-' (got {row.get(key)!r})"
-    if not 0 <= row["steps"] <= MAX_STEPS:
-        return f"'steps' must be in [0, {MAX_STEPS}] (got {row['steps']})"
-    if not 0 <= row["n_particles"] <= 2**31 - 1:
-        return f"'n_particles' must be in [0, 2^31-1] (got {row['n_particles']})"
-    if not 0 < row["dx"] < math.inf:
-        return f"'dx' must be a finite number > 0 (got {row['dx']})"
-    threads = row.get("threads")
-    if threads is not None and (not isinstance(threads, int) or isinstance(threads, bool) or threads < 1):
-        return f"'threads' must be an integer >= 1 (got {threads!r})"
-    for stage, seconds in row["stages"].items():
-        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool) or not 0 <= seconds <= MAX_SECONDS:
-            return f"stage {stage!r} must be a time in [0, {MAX_SECONDS:g}] s (got {seconds!r})"
-    missing = [s for s in STEP_STAGES if s not in row["stages"]]
-    if missing:
-        return f"stages lack {', '.join(missing)}"
-    if "dx" not in row["scene"]:
-        return "'scene' lacks dx"
+    """Why ``row`` is not a usable run record ('' if it is): the schema (``pcabench/schema.py``), then the
+    scene's own checks."""
+    why = schema.check(row)
+    if why:
+        return why
     fields = Scene.__dataclass_fields__
     try:
         Scene(**{k: v for k, v in row["scene"].items() if k in fields and fields[k].compare},
               memory_limit_bytes=sys.maxsize)
-    except (SceneError, TypeError) as exc:
+    except (SceneError, TypeError, ValueError, OverflowError) as exc:
         return f"'scene' is not a valid scene ({exc})"
     return ""
+
+
+def read_regular(path, limit: int = MAX_STORE_BYTES, follow: bool = False) -> bytes:
+    """The bytes of the regular file ``path`` (a link is not followed unless ``follow``); OSError naming
+    it if it is a link, not a regular file (a FIFO, a device) or larger than ``limit`` bytes."""
+    flags = os.O_RDONLY | os.O_CLOEXEC | os.O_NONBLOCK | (0 if follow else os.O_NOFOLLOW)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise OSError(errno.ELOOP, "a symbolic link, not followed", str(path)) from None
+        raise
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise OSError(errno.EINVAL, "not a regular file", str(path))
+        if st.st_size > limit:
+            raise OSError(errno.EFBIG, f"larger than {limit} bytes", str(path))
+        chunks, left = [], limit + 1
+        while left > 0:
+            chunk = os.read(fd, min(left, 1 << 20))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+        if left <= 0:
+            raise OSError(errno.EFBIG, f"larger than {limit} bytes", str(path))
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
 
 
 def read_rows(paths) -> list[dict]:
@@ -364,11 +382,17 @@ def read_rows(paths) -> list[dict]:
     seen, rows = set(), []
     for path in paths:
         path = Path(path)
-        files = sorted(path.glob("*.jsonl")) if path.is_dir() else [path]
+        folder = path.is_dir()
+        files = sorted(path.glob("*.jsonl")) if folder else [path]
         for file in files:
-            if not file.exists():
+            if not folder and not file.exists():
                 continue
-            lines = file.read_bytes().split(b"\n")
+            try:  # an entry of a folder: a regular file, not a link; a named file: followed, but regular
+                data = read_regular(file, follow=not folder)
+            except OSError as exc:
+                warnings.warn(f"{file}: {exc.strerror or exc}; skipped", StoreWarning, stacklevel=2)
+                continue
+            lines = data.split(b"\n")
             if lines and lines[-1] == b"":
                 lines.pop()  # the newline that ends the last record
             for number, raw in enumerate(lines, 1):
@@ -383,6 +407,8 @@ def read_rows(paths) -> list[dict]:
                     why = f"not JSON ({exc.msg}; a torn or hand-edited line?)"
                 except ValueError as exc:  # NaN or Infinity
                     why = f"not standard JSON ({exc})"
+                except RecursionError:
+                    why = "not a record (nested too deeply)"
                 else:
                     why = validate(row)
                 if why:

@@ -19,6 +19,7 @@ import ctypes
 import json
 import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -76,47 +77,103 @@ def exit_status(returncode: int, oom_before: int | None, oom_after: int | None) 
     return "error", f"exit code {returncode}"
 
 
+RECORD_LIMIT = 1 << 20  # the most bytes a child's record may take on its channel
+OUTPUT_KEPT = 2000  # characters of a solver's stdout and stderr kept in its record's message
+PROGRESS = re.compile(r"\r[^\r\n]*: step \d+/\d+ [^\r\n]*\n?")  # pcabench.progress's lines
+
+
+def _drain(stream, keep: list, relay=None) -> None:
+    """Read ``stream`` to its end, keeping the last :data:`OUTPUT_KEPT` characters in ``keep`` (and passing
+    every chunk to ``relay``)."""
+    for raw in iter(lambda: stream.read1(4096), b""):
+        text = raw.decode("utf-8", "replace")
+        if relay is not None:
+            relay(text)
+        keep.append(text)
+        while len(keep) > 1 and sum(map(len, keep[1:])) > OUTPUT_KEPT:
+            del keep[0]
+
+
+def _cut(chunks: list) -> str:
+    text = "".join(chunks).strip()
+    return text if len(text) <= OUTPUT_KEPT else "..." + text[-OUTPUT_KEPT:]
+
+
 def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:
     """Run ``spec`` in a child process, relaying its progress to ``stream``; its record as a row.
 
-    The child's record carries ``commit`` and ``machine`` (the parent's :func:`~pcabench.profiles.machine_id`).
+    The child sends its record on a pipe of its own (``--record-fd``), never on stdout: whatever the solver
+    prints on stdout or stderr is kept (cut) in the record's message and never parsed. The child's record
+    carries ``commit`` and ``machine`` (the parent's :func:`~pcabench.profiles.machine_id`).
 
     Raises subprocess.TimeoutExpired (the child is killed first) past ``timeout`` seconds.
     """
-    cmd = [sys.executable, "-m", "pcabench.child", spec.to_json()]
+    read_end, write_end = os.pipe()
+    cmd = [sys.executable, "-m", "pcabench.child", "--record-fd", str(write_end), spec.to_json()]
     env = {**os.environ, "PCABENCH_COMMIT": commit, MACHINE_ID_ENV: machine}  # every run carries the sweep's
     oom_before = oom_kills()
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env,
-                            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
-    tail = []
-
-    def relay():  # the child's progress lines go on to the user; the end is kept for the record
-        for raw in iter(lambda: proc.stderr.read1(4096), b""):
-            text = raw.decode("utf-8", "replace")
-            if stream is not None:
-                stream.write(text)
-                stream.flush()
-            tail.append(text)
-            del tail[:-50]
-
-    reader = threading.Thread(target=relay, daemon=True)
-    reader.start()
     try:
-        out, _ = proc.communicate(timeout=timeout)
+        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                env=env, pass_fds=(write_end,),
+                                preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
+    except BaseException:
+        os.close(read_end)
+        raise
+    finally:
+        os.close(write_end)  # the child holds it now: the pipe ends when the child does
+    out, err, record = [], [], []
+
+    def relay(text):  # the child's progress lines go on to the user
+        if stream is not None:
+            stream.write(text)
+            stream.flush()
+
+    def read_record():
+        with os.fdopen(read_end, "rb") as f:
+            data = f.read(RECORD_LIMIT + 1)
+            while f.read(1 << 16):  # a record past the limit: drain the rest, keep none of it
+                pass
+        record.append(data if len(data) <= RECORD_LIMIT else b"")
+
+    readers = [threading.Thread(target=_drain, args=(proc.stdout, out), daemon=True),
+               threading.Thread(target=_drain, args=(proc.stderr, err, relay), daemon=True),
+               threading.Thread(target=read_record, daemon=True)]
+    for reader in readers:
+        reader.start()
+    try:
+        proc.wait(timeout=timeout)
     except BaseException:
         proc.kill()
         proc.wait()
         raise
     finally:
-        reader.join(timeout=5)
-        if stream is not None and tail and not tail[-1].endswith("\n"):
+        for reader in readers:
+            reader.join(timeout=5)
+        if stream is not None and err and not err[-1].endswith("\n"):
             stream.write("\n")  # end the child's last progress line
-    lines = out.decode("utf-8", "replace").strip().splitlines()
-    if proc.returncode == 0 and lines:
-        return json.loads(lines[-1])
-    status, what = exit_status(proc.returncode, oom_before, oom_kills())
-    stderr = "".join(tail).strip()[-400:]
-    return store.to_row(failed_record(spec, status, what + (f": {stderr}" if stderr else ""), machine))
+    said = PROGRESS.sub("", "".join(err)).strip()  # stderr less the child's own progress lines
+    printed = "".join(f"\nthe solver's {name} (cut): {_cut([text])}" for name, text in
+                      (("stdout", "".join(out).strip()), ("stderr", said)) if text)
+    data = record[0] if record else b""
+    if proc.returncode == 0 and data:
+        try:
+            row = json.loads(data.decode("utf-8"))
+        except (ValueError, RecursionError) as exc:
+            row = None
+            what = f"its record could not be read ({type(exc).__name__})"
+        else:
+            what = ""
+        if isinstance(row, dict):
+            if printed:
+                row["message"] = (str(row.get("message") or "") + printed).strip()
+            return store.to_row(row)
+        what = what or "its record is not a JSON object"
+    else:
+        status, what = exit_status(proc.returncode, oom_before, oom_kills())
+        if proc.returncode == 0:
+            what = "it sent no record"
+    status = "error" if proc.returncode == 0 else status
+    return store.to_row(failed_record(spec, status, what + printed, machine))
 
 
 def run_here(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:
@@ -263,6 +320,10 @@ def run_specs(specs: list[RunSpec], executor: Executor, stores, rows: list[dict]
                   file=stream, flush=True)
             queue.clear()
             continue
+        why = store.validate(store.to_row(row))
+        if why:  # a record that would not read back is never written: the run is stored as an error
+            row = store.to_row(failed_record(spec, "error", f"the run's record would not read back ({why})",
+                                             machine))
         row = stores.append(row)
         stored.append(row)
         known.append(row)

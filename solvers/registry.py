@@ -22,6 +22,7 @@ import ast
 import importlib
 import inspect
 import pkgutil
+import re
 import warnings
 from functools import lru_cache
 from importlib import metadata
@@ -31,6 +32,7 @@ from .interface import Solver
 from .scene import SceneError
 
 ENTRY_POINT_GROUP = "pcabench.solvers"
+SOLVER_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}", re.ASCII)  # the record's solver field (pcabench/schema.py)
 DEFAULT_SOLVER = "linkedlist-cpu"  # what a study runs when no solver is named: the paper's cell list, on the CPU
 
 
@@ -84,6 +86,9 @@ def _plugins(taken: set) -> list[type[Solver]]:
         elif not cls.__dict__.get("name"):  # a subclass of a built-in inherits its name: not its own
             warn(" left out: the class sets no name of its own" + (f" (it would inherit {cls.name!r})"
                                                                     if cls.name else ""))
+        elif not isinstance(cls.name, str) or not SOLVER_NAME.fullmatch(cls.name):
+            warn(f" left out: the solver name {cls.name!r:.80} is not a plain name (letters, digits, '.', '_', "
+                 "'-', at most 64): it names stored records")
         elif cls.name in taken:
             warn(f" left out: the solver name {cls.name!r} is taken")
         else:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from pcabench import profiles, store
 from pcabench.errors import NoResults
+from pcabench.safeio import own_folder, write_file
 from solvers import DEFAULT_SCENE
 
 from . import figures as F
@@ -37,7 +38,7 @@ def report_for(ctx: Context) -> Path:
     """The report of one machine's runs (``ctx.name``: its profile id, with its host where a profile has
     several): each section's rows computed once, then its Markdown and its figures from them."""
     out, df = ctx.out, ctx.df_scenes if ctx.df_scenes is not None else ctx.df
-    out.mkdir(parents=True, exist_ok=True)
+    own_folder(out, "report folder")  # a link there is refused: nothing is written or deleted where it points
     body, figs = [], []
     for section in SECTIONS:
         if ctx.df.empty and not section.all_scenes:
@@ -57,9 +58,7 @@ def report_for(ctx: Context) -> Path:
              "`pcabench report`.", "", *body, "## Figures", ""]
     for p in figs:
         lines += [f"![{p.stem}]({p.name})", ""]
-    path = out / "report.md"
-    path.write_text("\n".join(lines) + "\n")
-    return path
+    return write_file(out / "report.md", "\n".join(lines) + "\n")
 
 
 def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
@@ -114,8 +113,7 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
               f"the Quadro M4000's and GeForce GT730's Table 6 ({P.CONVERSION['Table 6']}).", ""]
     figs = [F.fig14(ours, reports_dir, "all systems"), F.cards_figure(cards, reports_dir)]
     lines += [f"![{p.stem}]({p.name})\n" for p in figs]
-    path = reports_dir / "cards.md"
-    path.write_text("\n".join(lines) + "\n")
+    path = write_file(reports_dir / "cards.md", "\n".join(lines) + "\n")
     return [path, *figs]
 
 
@@ -158,5 +156,5 @@ def write_reports(results_dir: Path, reports_dir: Path, scene: str | None = None
     if gpu:  # the committed reference has them; a user's results do not: link only pages that exist
         index += ["", "GPU check tables, notes and Nsight Compute profiles: "
                   + ", ".join(f"[gpu/{p.name}](gpu/{p.name})" for p in gpu) + "."]
-    (reports_dir / "README.md").write_text("\n".join(index) + "\n")
+    write_file(reports_dir / "README.md", "\n".join(index) + "\n")
     return paths + [reports_dir / "README.md"]

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
+from pcabench.safeio import save_figure
 from pcabench.stability import UNSTABLE_BY_PREDICTION
 
 from . import paper as P
@@ -88,7 +89,7 @@ def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, nro
         labels = sorted(handles, key=lambda lab: "(published)" in lab)  # measured first, the paper's after
         fig.legend([handles[lab] for lab in labels], labels, loc="outside right center", fontsize=7, frameon=False)
     _suptitle(fig, title)
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)  # whole or not at all; a link at its name is replaced, not followed
     plt.close(fig)
 
 
@@ -295,7 +296,7 @@ def _shares(path, title, xlabel, rows, published, stages):
     axes[-1].set_xlabel(xlabel)
     fig.legend(loc="outside lower center", ncols=len(stages), fontsize=8, frameon=False)
     _suptitle(fig, title)
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)  # whole or not at all; a link at its name is replaced, not followed
     plt.close(fig)
     return path
 
