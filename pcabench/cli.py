@@ -637,6 +637,12 @@ def cmd_gpu_check(args) -> int:
                      rehearse=args.rehearse)
 
 
+def cmd_check_solver(args) -> int:
+    from .conformance import main as check_solver
+
+    return check_solver(args.name, quick=args.quick, as_json=args.json)
+
+
 # ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="pcabench", description=DESCRIPTION, epilog=EXIT_HELP,
@@ -763,6 +769,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rehearse", action="store_true",
                    help="the same script in numba's CUDA simulator at a few hundred particles (no GPU needed)")
     p.set_defaults(func=cmd_gpu_check)
+
+    p = sub.add_parser("check-solver", help="the conformance suite: is a solver (yours too) right?",
+                       description="Checks a registered solver against the all-pair reference, its neighbour "
+                                   "count, memory bound, threads, stage timing, blow-up report and its claims "
+                                   "(pcabench/conformance.py); one line per check: ok, FAILED: why, skipped: why. "
+                                   "Exit 0 when none fails, 1 when one fails.")
+    p.add_argument("name", metavar="NAME", help="a solver's name: " + ", ".join(registry()))
+    p.add_argument("--quick", action="store_true",
+                   help="the defaults and each claimed value once, not every combination")
+    p.add_argument("--json", action="store_true", help="one JSON object: solver, ok, checks")
+    p.set_defaults(func=cmd_check_solver)
     return parser
 
 

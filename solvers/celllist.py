@@ -10,6 +10,9 @@ one contiguous range. Particles that never move are searched once.
 A subclass says only how cells are sorted (:meth:`sort_cells`) and how a
 kernel is launched (:meth:`launch`: cell_ids, continuity, momentum and
 neighbours here, besides the base's coefficients, kick and advance).
+linkedlist-cpu splits its sort into steps a variant overrides one at a time
+(``cell_ids``, ``cell_order``, ``permute``); ``pcabench check-solver``
+(pcabench/conformance.py) checks a variant against the all-pair reference.
 """
 from __future__ import annotations
 

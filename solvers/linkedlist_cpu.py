@@ -149,16 +149,32 @@ class LinkedListCPU(CellListSolver):
         return sweeps(self.scene.precision, self.scene.kernel, self.threads > 1)[name](*args)
 
     def sort_cells(self) -> None:
-        """Counting sort by cell (x-sorted within each cell for the pair list), then the pair list if used."""
+        """SNP in four steps, each its own method: the cell of every particle (:meth:`cell_ids`), the order
+        by cell (:meth:`cell_order`), every per-particle array into that order (:meth:`permute`), then the
+        pair list if used (x-sorted within each cell first: the list scans x-sorted stencil rows)."""
         a = self.arrays
         self.cell_ids()
-        counting_sort(self.cell, self.ncells, self.begin, self.order, self.sorted_cell)
-        if self.pairs is not None:  # the list scans x-sorted stencil rows
+        order, begin = self.cell_order()
+        if begin is not self.begin:
+            self.begin[:] = begin
+        if order is not self.order:  # a variant's own order: the cells in it by one gather
+            self.order = np.ascontiguousarray(order, dtype=np.int64)
+            np.take(self.cell, self.order, out=self.sorted_cell)
+        if self.pairs is not None:
             pairlist.sort_cells_by_x(self.order, self.begin, a["lx"], a["sx"], self.scene.dx)
         self.permute(self.order)
         self.cell, self.sorted_cell = self.sorted_cell, self.cell
         if self.pairs is not None:
             self.pairs.build(*self.geometry(), self.k)
+
+    def cell_order(self) -> tuple:
+        """(cellParticleOrder, cellBegin) for the cells in ``self.cell`` (particleIndex): the permutation
+        that puts the particles in cell order, stable (by particle within a cell), and the first position
+        of every cell with the end sentinel (``ncells + 1`` entries). Here a counting sort into the
+        solver's own arrays (which also leaves the cells in that order in ``self.sorted_cell``); a variant
+        overrides this method alone and may return arrays of its own."""
+        counting_sort(self.cell, self.ncells, self.begin, self.order, self.sorted_cell)
+        return self.order, self.begin
 
     def gathered(self, arr, order):
         """``arr`` reordered on the solver's threads, into the spare array; ``arr`` becomes the spare.

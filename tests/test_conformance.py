@@ -1,0 +1,142 @@
+"""The conformance suite (pcabench/conformance.py): every built-in solver passes it, the README's plug-in
+example passes it, and a deliberately broken solver fails the check it breaks.
+
+The GPU solver runs it in numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1) in a subprocess, through the
+command line, as CI does.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from pcabench.conformance import CHECK_NAMES, assert_conforms, check_solver
+from solvers import SceneError, registry
+from solvers.linkedlist_cpu import LinkedListCPU
+
+from .conftest import cli_main
+from .test_registry import readme_example
+
+ROOT = Path(__file__).resolve().parents[1]
+CPU_SOLVERS = [name for name, cls in registry().items() if cls.device == "cpu"]
+GPU_SOLVERS = [name for name, cls in registry().items() if cls.device == "gpu"]
+
+
+def failures(results) -> list[str]:
+    return [r.line() for r in results if r.failed]
+
+
+@pytest.mark.parametrize("name", CPU_SOLVERS)
+def test_every_builtin_cpu_solver_conforms(name):
+    results = check_solver(name, quick=True)
+    assert [r.name for r in results] == list(CHECK_NAMES)
+    assert not failures(results), failures(results)
+    status = {r.name: r.status for r in results}
+    assert status["agreement"] == status["claims"] == status["stages"] == "ok"
+    assert status["threads"] == ("ok" if registry()[name].threaded else "skipped")
+
+
+@pytest.mark.parametrize("name", GPU_SOLVERS)
+def test_the_gpu_solver_conforms_in_the_simulator(name):
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", PYTHONPATH=os.pathsep.join(
+        [str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+    proc = subprocess.run([sys.executable, "-m", "pcabench.cli", "check-solver", name, "--quick", "--json"],
+                          capture_output=True, text=True, env=env, cwd=ROOT, timeout=1800)
+    assert proc.returncode == 0, (proc.stdout[-3000:], proc.stderr[-3000:])
+    data = json.loads(proc.stdout.strip().splitlines()[-1])
+    status = {c["name"]: c["status"] for c in data["checks"]}
+    assert data["ok"] and status["agreement"] == status["claims"] == status["neighbours"] == "ok", data
+
+
+def readme_solver():
+    """The README's plug-in class ("Add your own solver"), defined here, not registered."""
+    namespace = {}
+    exec(compile(readme_example(), "argsort_solver.py", "exec"), namespace)  # noqa: S102 - our own README
+    return namespace["ArgsortCellList"]
+
+
+def test_the_readme_plugin_conforms_as_a_class():
+    cls = readme_solver()
+    assert "cell_order" in cls.__dict__ and "sort_cells" not in cls.__dict__  # it overrides one step of SNP
+    assert cls.name not in registry()
+    results = assert_conforms(cls, quick=True)
+    assert {r.name: r.status for r in results}["stages"] == "ok"  # the harness ran it under its name
+    assert cls.name not in registry()  # and the registry is as it was
+
+
+class ScaledMomentum(LinkedListCPU):
+    """Broken on purpose: its momentum sweep is 1 % too strong."""
+
+    name = "scaled-momentum"
+
+    def _sweep(self, continuity, momentum):
+        super()._sweep(continuity, momentum)
+        if momentum:
+            self.arrays["ax"] *= 1.01
+            self.arrays["ay"] *= 1.01
+
+
+class RefusesFloat32(LinkedListCPU):
+    """Broken on purpose: it claims float32 but refuses it."""
+
+    name = "refuses-float32"
+
+    def check_scene(self, scene):
+        super().check_scene(scene)
+        if scene.precision == "float32":
+            raise SceneError("precision: float32 is not done yet")
+
+
+class ClaimsTooLittle(LinkedListCPU):
+    """Broken on purpose: it says it offers the verlet integrator alone, yet its supports() accepts any."""
+
+    name = "claims-too-little"
+    integrators = ("verlet",)
+
+    @classmethod
+    def supports(cls, scene):
+        pass
+
+
+def test_a_broken_momentum_sweep_fails_the_agreement_check():
+    results = check_solver(ScaledMomentum, quick=True, only=("agreement",))
+    assert [r.status for r in results] == ["failed"]
+    assert "velocity differs" in results[0].message
+    with pytest.raises(AssertionError, match="agreement: FAILED"):
+        assert_conforms(ScaledMomentum, only=("agreement",))
+
+
+def test_a_false_claim_fails_the_claims_check():
+    (refused,) = check_solver(RefusesFloat32, quick=True, only=("claims",))
+    assert refused.failed and "float32" in refused.message and "refused" in refused.message
+    (loose,) = check_solver(ClaimsTooLittle, quick=True, only=("claims",))
+    assert loose.failed and "integrator euler is not claimed but supports() accepts it" in loose.message
+
+
+def test_a_solver_that_cannot_run_here_is_skipped_not_failed():
+    from solvers import SolverUnavailable
+
+    class NoDevice(LinkedListCPU):
+        name = "no-device"
+
+        @classmethod
+        def available(cls):
+            raise SolverUnavailable("no such device on this machine")
+
+    results = check_solver(NoDevice, quick=True)
+    assert {r.status for r in results} == {"skipped"} and all("no such device" in r.message for r in results)
+
+
+def test_the_command_line(capsys):
+    rc, out, err = cli_main("check-solver", "allpair-cpu", "--quick", capsys=capsys)
+    lines = out.strip().splitlines()
+    assert rc == 0, out + err
+    assert [line.split(":")[0] for line in lines[:-1]] == list(CHECK_NAMES)
+    assert "threads: skipped: allpair-cpu is serial" in out and "agreement: ok" in out
+    assert lines[-1].startswith("allpair-cpu: conforms")
+    rc, out, err = cli_main("check-solver", "no-such-solver", capsys=capsys)
+    assert rc == 2 and len(err.strip().splitlines()) == 1 and "no-such-solver" in err and "Traceback" not in err
