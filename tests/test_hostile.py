@@ -306,8 +306,8 @@ def test_run_json_prints_exactly_one_object_whatever_the_solver_prints(tmp_path,
 
 
 def test_run_takes_a_run_budget(capsys):
-    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "0.05", "--steps", "100000", "--model", "linear",
-                              "--run-budget", "3", "--json", "--quiet", capsys=capsys)
+    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "0.05", "--steps", "100000", "--model",
+                              "linear", "--run-budget", "3", "--json", "--quiet", capsys=capsys)
     assert code == 1 and json.loads(out)["status"] == "timeout", (out, err)
     code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--run-budget", "0",
                               capsys=capsys)
