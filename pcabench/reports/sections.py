@@ -568,15 +568,16 @@ def _scene_text(data, ctx) -> list[str]:
              md_table(["scene", "model", "target", "fastest method", "dx", "time (s)", "error", "predicted",
                        "CFL / stable", "paper's method: dx", "time (s)", "paper / fastest"], rows)
              if rows else "No run of a scene at t = 10 s reaches 10 %.", ""]
-    by_scene = {}
+    by_target = {}
     for r in data["fastest"]:
-        by_scene.setdefault((r["model"], r["target"]), {})[r["scene"]] = r["best"]["method"]
-    same = [(m, t, v) for (m, t), v in by_scene.items() if len(v) > 1]
-    if same:
-        lines += ["Does the method fastest on the plane pulse stay fastest in 2D? "
-                  + "; ".join(f"{m} to {pct(t)}: " + ("the same method" if len(set(v.values())) == 1 else
-                                                      ", ".join(f"{s}: {meth}" for s, meth in sorted(v.items())))
-                              for m, t, v in sorted(same)) + ".", ""]
+        by_target.setdefault((r["model"], r["target"]), {})[r["scene"]] = r["best"]["method"]
+    both = {k: v for k, v in by_target.items() if len(v) > 1}
+    if both:
+        differ = [f"{m} to {pct(t)} ({'; '.join(f'{s}: {meth}' for s, meth in sorted(v.items()))})"
+                  for (m, t), v in sorted(both.items()) if len(set(v.values())) > 1]
+        lines += [f"Does the method fastest on the plane pulse stay fastest in 2D? In {len(both) - len(differ)} of "
+                  f"{len(both)} (model, target) pairs both scenes name the same method"
+                  + (f"; they differ for {', '.join(differ)}." if differ else "."), ""]
     needs = [[r["scene"], fmt(r["mach"], "g"), pct(r["target"]), pct(r["floor"]),
               *(("-" if r.get(model) is None else
                  f"{fmt(r[model]['seconds'], '.3g')} s (dx {fmt(r[model]['dx'], 'g')})" if r[model]["reaches"] else
