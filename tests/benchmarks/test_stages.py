@@ -99,17 +99,21 @@ def test_list_build(benchmark, name, precision):
 # ---------------------------------------------------------------- one step of every scene (small sizes)
 SCENE_CASES = {"plane-pulse": {"dx": 1.0}, "acoustic-pulse": {"dx": 1.0, "x_min": -16.0, "x_max": 16.0,
                                                              "y_min": -16.0, "y_max": 16.0}}
+# how closely the run's error must be the prediction's: exact on the periodic square; the plane pulse's tail
+# meets the free left end at -10 m, which the prediction's unbounded lattice lacks (3e-6 measured)
+SCENE_AGREEMENT = {"plane-pulse": 1e-4, "acoustic-pulse": 1e-8}
 
 
 @pytest.mark.parametrize("scene", SCENE_CASES)
 def test_scene_step(benchmark, scene):
     """One Verlet step of each scene (linked list, float64, linear, about 1,000 particles), and its primary
-    error after the timed steps against the scene's exact solution: a change that breaks a scene shows."""
+    error after 10 steps against the scene's exact solution, which must be the prediction's (exact for the
+    linear model while the pulse is clear of the ends): a change that breaks a scene shows."""
     from pcabench.run import run
     from pcabench.spec import RunSpec
     from solvers.integrators import step_program
 
-    s = Scene(name=scene, steps=20, model="linear", cfl=0.5, **SCENE_CASES[scene])
+    s = Scene(name=scene, steps=10, model="linear", **SCENE_CASES[scene])
     solver = make_solver("linkedlist-cpu")
     solver.input(s)
     solver.warmup()
@@ -125,7 +129,10 @@ def test_scene_step(benchmark, scene):
 
     benchmark.group = f"scene {scene} N={s.n_particles}"
     benchmark.pedantic(step, rounds=ROUNDS, iterations=1, warmup_rounds=1)
-    record = run(RunSpec("linkedlist-cpu", s))  # the scene's error measures after 20 steps, by the harness
+    record = run(RunSpec("linkedlist-cpu", s))  # the scene's error measures after 10 steps, by the harness
     benchmark.extra_info.update({"scene": scene, "n_particles": s.n_particles, "mse": record.mse,
                                  "errors": record.errors, "profile_id": machine_id()})
-    assert record.status == "ok" and record.mse < 0.3
+    from solvers.dispersion import predict
+
+    assert record.status == "ok" and record.mse == pytest.approx(predict(s).predicted_error,
+                                                                   rel=SCENE_AGREEMENT[scene])
