@@ -149,6 +149,7 @@ def test_two_sweeps_on_one_store_never_duplicate(tmp_path):
 
 def test_a_killed_parent_takes_its_running_child_with_it(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "pcabench.cli", "study", "--dx", "0.25", "--steps", "100000",
+                             "--model", "linear",  # (a lagrangian run this long would pass the pulse's breaking time)
                              "--no-report", "--results", str(tmp_path)],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     child = None
