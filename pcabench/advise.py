@@ -23,7 +23,7 @@ import numpy as np
 from solvers import DEFAULT_SOLVER, Scene
 from solvers.dispersion import predict, stable_cfl
 
-from .reports.tables import comparable, default_numerics, latest, numerics_label
+from .reports.tables import comparable, default_numerics, error_column, latest, numerics_label
 from .stability import assess, e_foldings
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid).
@@ -62,11 +62,6 @@ def command(r, t_end: float) -> str:
         words += ["--threads", str(int(r["threads"]))]
     return shlex.join(words)
 
-
-def error_column(model: str) -> str:
-    """What "error" means for ``model``: against the linear pulse, or for lagrangian against the isothermal
-    solution, the equations it solves (its error against the linear pulse never falls below their 9.8 %)."""
-    return "mse_isothermal" if model == "lagrangian" else "mse"
 
 
 def reaching(df, t_end: float, model: str):

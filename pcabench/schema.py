@@ -23,7 +23,8 @@ from dataclasses import dataclass
 from solvers.registry import SOLVER_NAME
 from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, PRECISIONS
 
-from .record import STATUSES, STEP_STAGES
+STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
+STEP_STAGES = ("snp", "pi", "su")  # the stages of a time step; input, init and output happen once per run
 
 SCHEMA = 2  # version of the row format; rows from before versioning are schema 1
 MAX_SECONDS = 1e9  # a time above this (31 years) is not a measurement
