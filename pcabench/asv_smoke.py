@@ -40,7 +40,7 @@ def scratch_config(results: Path, root: Path = ROOT, name: str = "smoke") -> Pat
 
 
 def main(argv=None) -> int:
-    from .cli import Parser  # the command line's parser: a usage error is one line, exit code 2
+    from .parser import Parser  # a usage error is one line, exit code 2
 
     p = Parser(prog="python -m pcabench.asv_smoke", description=__doc__.split("\n")[0])
     p.add_argument("--machine", help="asv's machine name (default: `pcabench profile --asv`, which writes it)")

@@ -42,6 +42,7 @@ from solvers import (
 
 from . import __version__, jsonout, memory, paths
 from .errors import NoResults
+from .parser import EXIT_BAD_INPUT, Parser
 from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
 from .store import StoreError
@@ -52,7 +53,7 @@ tables and figures, and ask which stored run reaches an error fastest (advise) o
 largest stable step the dispersion relation predicts (accuracy)."""
 
 # exit codes: each one means one thing
-EXIT_OK, EXIT_RUN_FAILED, EXIT_BAD_INPUT, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 2, 3, 4, 130
+EXIT_OK, EXIT_RUN_FAILED, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 3, 4, 130
 EXIT_HELP = f"""exit codes:
   {EXIT_OK}    ok
   {EXIT_RUN_FAILED}    the run failed: unstable (with its step), out-of-memory or error, recorded, never a
@@ -83,12 +84,6 @@ integrators:
   euler   forward Euler: grows at any dt
   rk2     explicit midpoint"""
 
-
-class Parser(argparse.ArgumentParser):
-    """argparse, but a usage error is one line naming the option, and exit code 2."""
-
-    def error(self, message):
-        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 # ---------------------------------------------------------------- option types

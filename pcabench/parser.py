@@ -1,0 +1,16 @@
+"""The command lines' argument parser: a usage error is one line naming the option, and exit code 2.
+
+Shared by ``pcabench`` (cli.py) and the smaller entry points (asv_smoke.py) without either importing the
+other."""
+from __future__ import annotations
+
+import argparse
+
+EXIT_BAD_INPUT = 2  # bad input: one line naming the parameter and its allowed range, before any work
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line naming the option, and exit code 2."""
+
+    def error(self, message):
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
