@@ -2,10 +2,15 @@
 
 Bad input is :class:`~pcabench.spec.OptionError` (a harness option) or
 :class:`~solvers.scene.SceneError` (a scene or solver parameter); a store that
-cannot be read or written is :class:`~pcabench.store.StoreError`.
+cannot be read or written is :class:`StoreError` (raised by the store and by what checks names that become
+store paths).
 """
 from __future__ import annotations
 
 
 class NoResults(Exception):
     """There are no stored runs to work from (an empty or missing results folder)."""
+
+
+class StoreError(OSError):
+    """The store cannot be written (one line naming the path)."""

@@ -20,7 +20,7 @@ def checked_env(variable: str, field: str) -> str:
     """The environment variable ``variable``, checked like the record field ``field`` it becomes
     (pcabench/schema.py); StoreError naming the variable if it would not read back."""
     from . import schema
-    from .store import StoreError
+    from .errors import StoreError
 
     value = os.environ[variable]
     why = schema.check_value(field, schema.FIELDS[field], value)

@@ -47,6 +47,7 @@ from pathlib import Path
 from solvers import Scene, SceneError
 
 from . import schema
+from .errors import StoreError  # noqa: F401 - raised here, re-exported for callers
 from .schema import SCHEMA
 
 MIN_FREE_BYTES = 1 << 20  # a sweep needs room for its records: refuse to start with less free space
@@ -60,10 +61,6 @@ class StoreWarning(UserWarning):
 
 
 FULL = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)  # the disk (or the quota, or the file size limit) is full
-
-
-class StoreError(OSError):
-    """The store cannot be written (one line naming the path)."""
 
 
 class InvalidRecord(StoreError):

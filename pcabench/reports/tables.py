@@ -366,7 +366,6 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
     predicted stable CFL (``past_limit``: at or past it, a run is unstable by prediction whatever its error,
     pcabench/stability.py; it is drawn and listed as such, never on the front).
     """
-    from pcabench.advise import error_column
     from pcabench.stability import assess
 
     pts = latest(df[(df.status == "ok") & df.protocol.str.startswith("t =") & df.model.isin(FRONT_MODELS)])
