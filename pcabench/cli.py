@@ -1,7 +1,7 @@
 """The ``pcabench`` command line: the only module that knows about argparse.
 
     pcabench run --solver linkedlist-cpu --dx 0.1 --t-end 10
-    pcabench study --quick | --paper | --stability | --front [quick|full] | --dx 1 0.5 ...
+    pcabench study --quick | --paper | --stability [short|long] | --front [quick|full] | --dx 1 0.5 ...
     pcabench report [--reference]
     pcabench profile [--save | --asv]
     pcabench gpu-check --out DIR
@@ -353,8 +353,8 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")
            if opt != "scene") or args.strip:
         raise OptionError("--dx is needed to build a matrix from the scene options (or use a preset alone)")
-    name = "paper" if args.paper else "stability" if args.stability else \
-        {None: "quick", "quick": "front", "full": "front-full"}[args.front]
+    name = "paper" if args.paper else {"short": "stability", "long": "stability-long"}[args.stability] \
+        if args.stability else {None: "quick", "quick": "front", "full": "front-full"}[args.front]
     if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not name.startswith("front")):
         raise OptionError("--scene with a preset: one scene, with --front (the other presets are the paper's scene)")
     return name, preset(name, scene[0])
@@ -666,8 +666,9 @@ def build_parser() -> argparse.ArgumentParser:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="a few minutes on a laptop CPU (default)")
     g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets")
-    g.add_argument("--stability", action="store_true",
-                   help="CFL x integrator x h/dx, run length and float32: the stability map")
+    g.add_argument("--stability", nargs="?", const="short", choices=("short", "long"),
+                   help="short: CFL x integrator x h/dx, run length and float32, the stability map (92 runs); "
+                        "long: each model at CFL 4.4-5 to t = 300 s, the moving models' own limit (24 runs)")
     g.add_argument("--front", nargs="?", const="quick", choices=("quick", "full"),
                    help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
                         "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the "
@@ -679,7 +680,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--results", type=folder("--results"), default=str(paths.user_results()), help=results_help)
     p.add_argument("--reports", type=folder("--reports"), default=str(paths.user_reports()), help=reports_help)
     p.add_argument("--run-budget", type=number("--run-budget"), help="seconds per run before it is a timeout "
-                   "(default: quick 120, paper 900, stability 120, matrix 900)")
+                   "(default: quick 120, paper 900, stability 120, stability long 300, matrix 900)")
     p.add_argument("--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0,
                    help="seconds for the whole sweep")
     p.add_argument("--no-report", action="store_true", help="store the runs, do not write the reports")

@@ -474,6 +474,39 @@ def _stability_map(rows, ctx):
     return F.stability_map(*rows, ctx.out, ctx.name, INACCURATE_ABOVE)
 
 
+# ---------------------------------------------------------------- the moving models' limit over long runs
+def _long_runs_text(rows, ctx) -> list[str]:
+    if not rows:
+        return []
+    table = []
+    for r in rows:
+        blew = "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in r["blew_up_at"]) or "none"
+        method = f"{r['kernel']}, h = {r['h_factor']:g} dx, {r['integrator']}"
+        table.append([r["model"], method, f"{r['dx']:g}", f"{r['t_end']:g} s ({r['steps']} steps)",
+                      ", ".join(f"{c:g}" for c in r["cfls"]), _limit_words(r["predicted"]),
+                      fmt(r["bounded_to"], "g") if r["bounded_to"] is not None else "none", blew,
+                      fmt(r["e_foldings"], ".2g") if r["e_foldings"] is not None else "-",
+                      fmt(r["held"], "g") if r["held"] is not None else "prediction"])
+    lines = ["## Stability of the moving models over long runs", "",
+             "`pcabench study --stability long`: each model of the paper's method at the CFLs around the predicted "
+             "limit of its linear part, to t = 300 s on the 2D acoustic pulse in a 20 m periodic square, where the "
+             "sound neither leaves nor breaks, so the moving models' nonlinear terms act for the whole run. The "
+             "linear model is the control: the prediction is exact for it. 'e-foldings' is how far the most "
+             "unstable linear mode grew at the largest bounded CFL over the run (0 below the predicted limit; "
+             "round-off needs about 37 to reach the pulse's size). The last column is the limit advise, the front "
+             "and the tables use for that model (pcabench/stability.py: its MEASURED_LIMITS where lower than "
+             "the prediction).", "",
+             md_table(["model", "method", "dx", "run", "CFLs run", "predicted stable CFL (linear part)",
+                       "bounded up to CFL", "blew up at CFL", "e-foldings", "limit used"], table), ""]
+    for r in rows:
+        if r["blew_up_from"] is not None and r["blew_up_from"] < r["predicted"]:
+            lines.append(f"- **{r['model']}** blew up below its linear part's predicted {r['predicted']:.3g}, from "
+                         f"CFL {r['blew_up_from']:g}: its nonlinear terms set its limit"
+                         + (f", which advise takes as {r['held']:g}." if r["held"] is not None else
+                            "; advise still uses the prediction for it (add it to MEASURED_LIMITS)."))
+    return lines + [""]
+
+
 # ---------------------------------------------------------------- float32 against float64
 def _float32_text(rows, ctx) -> list[str]:
     if not rows:
@@ -522,6 +555,8 @@ SECTIONS = (
             (lambda rows, ctx: F.speed_vs_accuracy(rows["points"], rows["front"], ctx.out, ctx.name),)),
     Section("simplifications", lambda ctx: T.simplifications(ctx.df), _simplifications_text),
     Section("stability", lambda ctx: T.stability(ctx.df, INACCURATE_ABOVE), _stability_text, (_stability_map,)),
+    Section("long-runs", lambda ctx: T.long_run_limits(ctx.df_scenes if ctx.df_scenes is not None else ctx.df),
+            _long_runs_text, all_scenes=True),
     Section("float32", lambda ctx: T.float32_vs_float64(ctx.df), _float32_text),
     Section("failed", _failed_rows, _failed_text),
 )

@@ -580,6 +580,38 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
     return points, limits
 
 
+def long_run_limits(df) -> list[dict]:
+    """Each model's stable CFL measured by the long-run preset (``pcabench study --stability long``) beside the
+    prediction of its linear part and the limit pcabench/stability.py holds for it (what advise uses).
+
+    Per model and method: the CFLs run, the largest that ended bounded below the first blow-up, the smallest
+    that blew up (and its step), the steps run, and the e-foldings of the most unstable linear mode over the
+    run at the largest bounded CFL (0 below the predicted limit).
+    """
+    from pcabench.stability import MEASURED_LIMITS, assess, e_foldings, measured_limit
+
+    runs = latest(df[df.preset == "stability-long"]) if "preset" in df else df.iloc[:0]
+    keys = ["scene", "model", "kernel", "h_factor", "cutoff_factor", "integrator", "precision", "dx", "t_end"]
+    out = []
+    for key, g in runs.groupby(keys, sort=False):
+        row = dict(zip(keys, key))
+        g = g.sort_values("cfl")
+        blew = [(float(r.cfl), _step_or_none(r.failed_step)) for _, r in g.iterrows() if r.status == "unstable"]
+        first_blow = blew[0][0] if blew else None
+        bounded = [float(r.cfl) for _, r in g.iterrows() if r.status == "ok"
+                   and (first_blow is None or r.cfl < first_blow)]
+        top = g[g.cfl == max(bounded)].iloc[0] if bounded else None
+        held = measured_limit(row) if row["model"] in {m for m, *_ in MEASURED_LIMITS} else None
+        row.update(cfls=[float(c) for c in g.cfl], predicted=assess({**row, "model": "linear", "cfl": 1.0})[
+                       "stable_cfl"], bounded_to=max(bounded) if bounded else None, blew_up_from=first_blow,
+                   first_step=blew[0][1] if blew else None, blew_up_at=blew,
+                   steps=int(g.steps.max()), other=[(float(r.cfl), r.status) for _, r in g.iterrows()
+                                                    if r.status not in ("ok", "unstable")],
+                   e_foldings=e_foldings(top, int(top.steps)) if top is not None else None, held=held)
+        out.append(row)
+    return out
+
+
 def float32_vs_float64(df, tolerance: float = 0.10) -> list[dict]:
     """float32 against float64 for the same runs: the ratio of errors, and where float32 stops converging."""
     runs = default_numerics(latest(df[df.status == "ok"]))
