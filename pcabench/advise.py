@@ -20,7 +20,7 @@ import shlex
 
 import numpy as np
 
-from solvers import DEFAULT_SOLVER, Scene
+from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, scene_kind
 from solvers.dispersion import predict, stable_cfl
 
 from .reports.tables import comparable, default_numerics, error_column, latest, numerics_label
@@ -175,3 +175,69 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
                                      "--h-factor", f"{s.h_factor:g}", "--cfl", f"{s.cfl:g}", "--dx", f"{s.dx:g}",
                                      f"{s.dx / 2:g}"]))
     return out
+
+
+def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene: str) -> tuple[str, bool]:
+    """``pcabench advise``'s answer in words: the text for :func:`advise`'s result ``out``, and whether a run
+    reached the error."""
+    lines = []
+    primary = scene_kind(scene).primary
+    scene_words = "" if scene == DEFAULT_SCENE else f"{scene}, "
+    head = (f"{scene_words}{model} to a relative RMS error of {primary} <= {error:g} "
+            f"(against {out['error_against']}) at "
+            f"t = {t_end:g} s on {out['machine']}"
+            + (f", {domain} domain" if domain else ""))
+    if not out["found"]:
+        s = out["suggestion"]
+        lines.append(f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted "
+                     "stable CFL.")
+        lines += unstable_lines(out["unstable_by_prediction"], "runs that reach it")
+        if "front" in s:
+            lines.append(f"{s['note']}:\n  {s['front']}")
+            return "\n".join(lines), False
+        if "study" not in s:
+            lines.append("no method of the searched grid is predicted to reach it")
+        else:
+            lines.append(f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, "
+                         f"CFL {s['cfl']:g}, dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); "
+                         f"run:\n  {s['study']}")
+        lines.append(f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)" if s["paper_dx"] else
+                     f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m "
+                     "(the smallest searched)")
+        return "\n".join(lines), False
+    lines.append(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
+                 f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
+                 + (f"stable {out['stable_cfl']:.3g} measured over long runs" if out["limit_from"] == "long runs" else
+                    f"predicted stable {out['stable_cfl']:.3g}{'' if model == 'linear' else ' (its linear part)'}")
+                 + f", dx {out['dx']:g}, "
+                 f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
+                 f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
+                 f"commit {out['commit'][:7]})\n  {out['command']}")
+    if out["is_paper_configuration"]:
+        lines.append("  this is the paper's configuration: none faster reaches the error")
+    elif out["paper_seconds"]:
+        lines.append(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
+                     f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}")
+    else:
+        other = {"strip": "full", "full": "strip"}[out["domain"]]
+        lines.append(f"  no stored run of the paper's configuration on the {out['domain']} domain with the same "
+                     f"threads and commit reaches it; `pcabench advise --domain {other}` looks at the {other} "
+                     "domain's runs")
+    lines += unstable_lines(out["unstable_by_prediction"], "faster runs")
+    return "\n".join(lines), True
+
+
+def unstable_lines(rows, what: str) -> list[str]:
+    """The lines naming advise's runs past their predicted stable CFL that reached the error: never advised."""
+    lines = []
+    if rows:
+        lines.append(f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a "
+                     "longer run or a finer dx grows them without bound)")
+    for r in rows:
+        which = (f"predicted stable {r['stable_cfl']:.3g}" if r["limit_from"] == "prediction"
+                 else f"stable {r['stable_cfl']:.3g} measured over long runs")
+        limit = f"CFL {r['cfl']:g} is past the {which}" if r["stable_cfl"] > 0 else "its integrator grows at every CFL"
+        lines.append(f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
+                     f"bounded only because its {r['steps']} steps gave the most unstable mode "
+                     f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)")
+    return lines

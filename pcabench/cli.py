@@ -13,12 +13,9 @@ allowed range, never a traceback).
 from __future__ import annotations
 
 import argparse
-import contextlib
-import dataclasses
 import math
 import os
 import re
-import signal
 import sys
 import tempfile
 import warnings
@@ -243,56 +240,15 @@ def home_option() -> str:
     return "PCABENCH_HOME" if os.environ.get("PCABENCH_HOME") else "the pcabench home"
 
 
-class RunBudgetSpent(BaseException):
-    """``pcabench run --run-budget`` ran out (a BaseException: a run records every Exception as its own)."""
-
-
-@contextlib.contextmanager
-def run_budget(seconds: float | None):
-    """RunBudgetSpent in this (main) thread once ``seconds`` have passed (checked between Python steps of
-    the run, so a step of compiled code ends first); nothing if ``seconds`` is None."""
-    if seconds is None:
-        yield
-        return
-
-    def spent(signum, frame):
-        raise RunBudgetSpent()
-
-    before = signal.signal(signal.SIGALRM, spent)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, before)
-
-
-@contextlib.contextmanager
-def solver_output_to_stderr(on: bool):
-    """With ``on``, whatever the run prints on stdout (Python's sys.stdout and file descriptor 1, so compiled
-    code too) goes to stderr: `run --json` prints exactly one object on stdout, whatever the solver prints."""
-    if not on:
-        yield
-        return
-    sys.stdout.flush()
-    saved = os.dup(1)
-    os.dup2(2, 1)
-    try:
-        with contextlib.redirect_stdout(sys.stderr):
-            yield
-    finally:
-        sys.stdout.flush()
-        os.dup2(saved, 1)
-        os.close(saved)
-
-
 # ---------------------------------------------------------------- commands
 def cmd_run(args) -> int:
     from .profiles import machine_id
-    from .run import run
+    from .run import RunBudgetSpent, run, run_budget, solver_output_to_stderr
     from .store import to_row
 
     scene = scene_from_args(args)
+    from .study import check_specs
+
     # resolved once, and checked: the solver can run here (a GPU for a GPU solver), before anything is printed
     spec, = check_specs([RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto")])
     if args.fields is not None:
@@ -321,22 +277,7 @@ def cmd_run(args) -> int:
         out["message"] = record.message
         print(jsonout.dumps(to_row(out)))  # strict JSON: null, never NaN
     else:
-        print(record.stage_table())
-        print(f"particles        {record.n_particles:,}")
-        print(f"steps            {record.steps} (t = {record.t_end:.6g} s)")
-        print(f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)")
-        print(f"mean neighbours  {record.mean_neighbours:.2f}")
-        primary = scene.kind.primary
-        print(f"MSE (rel. RMS)   {record.mse:.6g}" + ("" if primary == "u" else f" of {primary}"))
-        print(f"ME (max)         {record.me:.6g} {'m/s' if primary == 'u' else 'kg/m^3' if primary == 'drho' else ''}")
-        for name, value in record.errors.items():
-            print(f"{name.replace('_', ' '):<17}{value:.6g}")
-        if record.mse_isothermal is not None:
-            print(f"MSE against the isothermal solution (the equations lagrangian solves) {record.mse_isothermal:.6g}")
-        print(f"status           {record.status}"
-              + (f" at step {record.failed_step}" if record.failed_step else ""))
-        if record.message:
-            print(f"message          {record.message.splitlines()[0]}")
+        print(record.text(scene))
     return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
 
 
@@ -360,34 +301,9 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     return name, preset(name, scene[0])
 
 
-def bounded_spec(spec: RunSpec) -> RunSpec:
-    """``spec`` resolved with its scene bounded by the memory available here (a SceneError if it does not
-    fit), so that ``auto`` takes the pair list only where it fits."""
-    return dataclasses.replace(spec, scene=memory.bounded(spec.scene)).resolved()
-
-
-def check_specs(specs: list[RunSpec]) -> list[RunSpec]:
-    """Every spec resolved, its memory and its solver checked before the first run (exits 2 or 3, not
-    mid-sweep)."""
-    from solvers import make_solver
-
-    resolved, solvers = [], {}
-    for spec in specs:
-        spec = bounded_spec(spec)
-        key = (spec.solver, spec.threads, spec.pair_loop)
-        if key not in solvers:
-            solvers[key] = make_solver(*key)
-        solvers[key].check_scene(spec.scene)
-        resolved.append(spec)
-    return resolved
-
-
 def cmd_study(args) -> int:
-    from . import profiles
     from .presets import RUN_BUDGET
-    from .reports import summary, write_reports
-    from .store import check_writable, store_name
-    from .sweep import sweep
+    from .study import bounded_spec, check_specs, run_study
 
     name, specs = study_specs(args)
     if args.cluster:  # the workers check their own solvers (a GPU run needs a GPU worker, not a GPU here)
@@ -403,35 +319,8 @@ def cmd_study(args) -> int:
         check_folder(paths.user_profiles(), home_option())  # where the sweep saves this machine's profile
     if not args.no_report:
         check_folder(args.reports, "--reports")  # before the sweep, not after it
-    if args.cluster:
-        from .cluster import cluster_sweep, dask_distributed
-
-        dask_distributed()  # one line naming the extra, before anything else
-        print(f"pcabench study ({name}): {len(specs)} runs on the Dask cluster {args.cluster}, "
-              f"{run_budget:.0f} s per run at most, stores in {args.results}", file=sys.stderr, flush=True)
-        cluster_sweep(specs, Path(args.results), run_budget, args.cluster, retry_failed=args.retry_failed,
-                      sweep_budget=args.sweep_budget)
-    else:
-        profile = profiles.capture()
-        store_path = Path(args.results) / store_name(profile["id"])
-        check_writable(store_path)
-        profiles.save(profile)
-        print(f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
-              f"store {store_path}", file=sys.stderr, flush=True)
-        sweep(specs, store_path, run_budget, args.sweep_budget, retry_failed=args.retry_failed)
-    if args.no_report:
-        return 0
-    written = write_reports(Path(args.results), Path(args.reports))
-    for p in written:
-        print(f"wrote {p}", file=sys.stderr)
-    if not args.cluster:
-        table = summary(Path(args.results), profile["id"])
-        if table:
-            print(table)
-        report = next((p for p in written if p.name == "report.md" and p.parent.name.startswith(profile["id"])), None)
-        if report:
-            print(f"\nReport with every table and figure: {report}")
-    return 0
+    return run_study(name, specs, Path(args.results), None if args.no_report else Path(args.reports), run_budget,
+                     args.sweep_budget, cluster=args.cluster, retry_failed=args.retry_failed)
 
 
 def cmd_report(args) -> int:
@@ -518,7 +407,7 @@ ROUNDED_AS_PRINTED = ("error", "seconds", "stable_cfl", "paper_seconds", "paper_
 
 def cmd_advise(args) -> int:
     from . import runs
-    from .advise import advise
+    from .advise import advice_text, advise
     from .profiles import machine_id
     from .reports.frame import load as load_frame
 
@@ -553,60 +442,9 @@ def cmd_advise(args) -> int:
             shown["cfl_fraction"] = round(out["cfl_fraction"], 2)  # printed as "0.66 of the predicted stable"
         print(jsonout.dumps({**out, **shown}, sort_keys=True))
         return EXIT_OK if out["found"] else EXIT_RUN_FAILED
-    primary = scene_kind(args.scene).primary
-    scene_words = "" if args.scene == DEFAULT_SCENE else f"{args.scene}, "
-    head = (f"{scene_words}{args.model} to a relative RMS error of {primary} <= {args.error:g} "
-            f"(against {out['error_against']}) at "
-            f"t = {args.t_end:g} s on {machine}"
-            + (f", {args.domain} domain" if args.domain else ""))
-    if not out["found"]:
-        s = out["suggestion"]
-        print(f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL.")
-        _print_unstable(out["unstable_by_prediction"], "runs that reach it")
-        if "front" in s:
-            print(f"{s['note']}:\n  {s['front']}")
-            return EXIT_RUN_FAILED
-        if "study" not in s:
-            print("no method of the searched grid is predicted to reach it")
-        else:
-            print(f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, CFL {s['cfl']:g}, "
-                  f"dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); run:\n  {s['study']}")
-        print(f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)" if s["paper_dx"] else
-              f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)")
-        return EXIT_RUN_FAILED
-    print(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
-          f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
-          + (f"stable {out['stable_cfl']:.3g} measured over long runs" if out["limit_from"] == "long runs" else
-             f"predicted stable {out['stable_cfl']:.3g}{'' if args.model == 'linear' else ' (its linear part)'}")
-          + f", dx {out['dx']:g}, "
-          f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
-          f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
-          f"commit {out['commit'][:7]})\n  {out['command']}")
-    if out["is_paper_configuration"]:
-        print("  this is the paper's configuration: none faster reaches the error")
-    elif out["paper_seconds"]:
-        print(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
-              f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}")
-    else:
-        other = {"strip": "full", "full": "strip"}[out["domain"]]
-        print(f"  no stored run of the paper's configuration on the {out['domain']} domain with the same threads "
-              f"and commit reaches it; `pcabench advise --domain {other}` looks at the {other} domain's runs")
-    _print_unstable(out["unstable_by_prediction"], "faster runs")
-    return EXIT_OK
-
-
-def _print_unstable(rows, what: str) -> None:
-    """advise's runs past their predicted stable CFL that reached the error: named, never advised."""
-    if rows:
-        print(f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a longer run "
-              "or a finer dx grows them without bound)")
-    for r in rows:
-        which = (f"predicted stable {r['stable_cfl']:.3g}" if r["limit_from"] == "prediction"
-                 else f"stable {r['stable_cfl']:.3g} measured over long runs")
-        limit = f"CFL {r['cfl']:g} is past the {which}" if r["stable_cfl"] > 0 else "its integrator grows at every CFL"
-        print(f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
-              f"bounded only because its {r['steps']} steps gave the most unstable mode "
-              f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)")
+    text, found = advice_text(out, args.error, args.t_end, args.model, args.domain, args.scene)
+    print(text)
+    return EXIT_OK if found else EXIT_RUN_FAILED
 
 
 def cmd_profile(args) -> int:

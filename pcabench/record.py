@@ -90,3 +90,24 @@ class RunRecord:
             lines.append(f"{s:<8}{self.stages[s]:12.4f}{per_txt}{share:>15}")
         lines.append(f"{'jit':<8}{self.jit_seconds:12.4f}   (compilation, outside the timed stages)")
         return "\n".join(lines)
+
+    def text(self, scene) -> str:
+        """``pcabench run``'s report of this run of ``scene``: the stage table, the run's size, its errors
+        (in the scene's primary field: u in m/s, drho in kg/m^3) and its status."""
+        primary = scene.kind.primary
+        unit = {"u": "m/s", "drho": "kg/m^3"}.get(primary, "")
+        lines = [self.stage_table(),
+                 f"particles        {self.n_particles:,}",
+                 f"steps            {self.steps} (t = {self.t_end:.6g} s)",
+                 f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
+                 f"mean neighbours  {self.mean_neighbours:.2f}",
+                 f"MSE (rel. RMS)   {self.mse:.6g}" + ("" if primary == "u" else f" of {primary}"),
+                 f"ME (max)         {self.me:.6g} {unit}"]
+        lines += [f"{name.replace('_', ' '):<17}{value:.6g}" for name, value in self.errors.items()]
+        if self.mse_isothermal is not None:
+            lines.append(f"MSE against the isothermal solution (the equations lagrangian solves) "
+                         f"{self.mse_isothermal:.6g}")
+        lines.append(f"status           {self.status}" + (f" at step {self.failed_step}" if self.failed_step else ""))
+        if self.message:
+            lines.append(f"message          {self.message.splitlines()[0]}")
+        return "\n".join(lines)

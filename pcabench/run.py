@@ -6,7 +6,11 @@ out-of-memory is recorded as ``out-of-memory``. Neither is a crash.
 """
 from __future__ import annotations
 
+import contextlib
 import math
+import os
+import signal
+import sys
 
 from solvers import SceneError, make_solver
 from solvers.integrators import step_program
@@ -79,3 +83,46 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> Ru
 
             record.message += "\n" + traceback.format_exc(limit=8)
     return record
+
+
+class RunBudgetSpent(BaseException):
+    """``pcabench run --run-budget`` ran out (a BaseException: a run records every Exception as its own)."""
+
+
+@contextlib.contextmanager
+def run_budget(seconds: float | None):
+    """RunBudgetSpent in this (main) thread once ``seconds`` have passed (checked between Python steps of
+    the run, so a step of compiled code ends first); nothing if ``seconds`` is None."""
+    if seconds is None:
+        yield
+        return
+
+    def spent(signum, frame):
+        raise RunBudgetSpent()
+
+    before = signal.signal(signal.SIGALRM, spent)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, before)
+
+
+@contextlib.contextmanager
+def solver_output_to_stderr(on: bool):
+    """With ``on``, whatever the run prints on stdout (Python's sys.stdout and file descriptor 1, so compiled
+    code too) goes to stderr: `run --json` prints exactly one object on stdout, whatever the solver prints."""
+    if not on:
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)

@@ -13,7 +13,7 @@ import warnings
 
 import pytest
 
-from pcabench import cli, memory, store
+from pcabench import cli, memory, store, study
 from pcabench import sweep as sweep_module
 from pcabench.profiles import machine_id
 from pcabench.record import RunRecord
@@ -443,7 +443,7 @@ def test_pair_loop_list_is_checked_against_the_memory_available(monkeypatch, cap
     err = capsys.readouterr().err
     assert exc.value.code == 2 and "pair list" in err and "--pair-loop gather" in err, err
     assert len(err.strip().splitlines()) == 1
-    assert cli.check_specs([RunSpec("linkedlist-cpu", scene)])[0].pair_loop == "gather"  # auto falls back
+    assert study.check_specs([RunSpec("linkedlist-cpu", scene)])[0].pair_loop == "gather"  # auto falls back
 
 
 # ---------------------------------------------------------------- one line, never a traceback
