@@ -48,7 +48,6 @@ def test_a_new_section_is_one_entry_with_its_rows_text_and_figure(tmp_path, monk
         return path
 
     monkeypatch.setattr(sections, "SECTIONS", (*sections.SECTIONS, sections.Section("mine", rows, text, (figure,))))
-    monkeypatch.setattr("pcabench.reports.build.SECTIONS", sections.SECTIONS)
     write_reports(_results(tmp_path), tmp_path / "out")
     report = (tmp_path / "out" / "machine-a" / "report.md").read_text()
     assert "## My table" in report and "runs on machine-a" in report and "![my_figure](my_figure.png)" in report

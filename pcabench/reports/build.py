@@ -18,7 +18,8 @@ from . import frame
 from . import paper as P
 from . import tables as T
 from .md import fmt, md_table
-from .sections import SECTIONS, Context, table6_md
+from . import sections
+from .sections import Context, table6_md
 
 
 def _machine(pid: str) -> str:
@@ -40,7 +41,7 @@ def report_for(ctx: Context) -> Path:
     out, df = ctx.out, ctx.df_scenes if ctx.df_scenes is not None else ctx.df
     own_folder(out, "report folder")  # a link there is refused: nothing is written or deleted where it points
     body, figs = [], []
-    for section in SECTIONS:
+    for section in sections.SECTIONS:  # read at each report: a section appended to the registry is in it
         if ctx.df.empty and not section.all_scenes:
             continue  # this machine ran other scenes only
         rows = section.rows(ctx)

@@ -1,0 +1,123 @@
+"""CONTRIBUTING.md's recipes run as they stand, and each does what it says.
+
+Each recipe is the one ```python block under its heading ("## Add a solver", ...). It runs here, in this
+process, with a temporary ``PCABENCH_HOME`` and temporary folder, on a tiny scene; then its claim is
+checked from outside: the solver it registers is in the solver registry and agrees with allpair-cpu, the
+scene is in the scene registry with finite initial fields, the section is in the report it writes, the
+preset expands to runs that a sweep stores. Every recipe unregisters what it registered: the registries
+are checked to be as they were.
+"""
+from __future__ import annotations
+
+import re
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from pcabench import presets, store
+from pcabench.conformance import registered
+from pcabench.reports import sections
+from pcabench.run import run
+from pcabench.spec import RunSpec
+from solvers import Scene, registry, solver_names
+from solvers.scenes import scene_names
+
+ROOT = Path(__file__).resolve().parents[1]
+RECIPES = ("Add a solver", "Add a scene", "Add a report section", "Add a preset")
+
+
+def recipe(title: str) -> str:
+    """The one Python block under CONTRIBUTING.md's heading ``## {title}``."""
+    text = (ROOT / "CONTRIBUTING.md").read_text()
+    part = re.search(rf"^## {re.escape(title)}\n(.*?)(?=^## |\Z)", text, re.S | re.M)
+    assert part, f"CONTRIBUTING.md has no section '## {title}'"
+    blocks = re.findall(r"^```python\n(.*?)^```", part.group(1), re.S | re.M)
+    assert len(blocks) == 1, f"'## {title}' holds {len(blocks)} python blocks, not one"
+    return blocks[0]
+
+
+@pytest.fixture
+def run_recipe(tmp_path, monkeypatch):
+    """``run_recipe(title)``: the recipe executed in a namespace of its own (returned), in a scratch home."""
+    monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # the recipe's mkdtemp() lands in the test's folder
+    solvers_before, scenes_before = dict(registry()), scene_names()
+    sections_before, presets_before = sections.SECTIONS, (dict(presets.PRESETS), dict(presets.RUN_BUDGET))
+
+    def execute(title: str) -> dict:
+        namespace = {"__name__": "__recipe__"}
+        exec(compile(recipe(title), f"CONTRIBUTING.md: {title}", "exec"), namespace)  # noqa: S102 - our own docs
+        return namespace
+
+    yield execute
+    # each recipe unregisters what it registered
+    assert dict(registry()) == solvers_before and scene_names() == scenes_before
+    assert sections.SECTIONS is sections_before or sections.SECTIONS == sections_before
+    assert (presets.PRESETS, presets.RUN_BUDGET) == presets_before
+
+
+def test_every_recipe_has_one_block_and_the_kernel_heading_waits_for_its_change():
+    for title in RECIPES:
+        assert recipe(title).strip()
+    text = (ROOT / "CONTRIBUTING.md").read_text()
+    assert "\n## Add a kernel\n" in text and "\n## Dev workflow\n" in text
+    for command in ("python -m pytest", "ruff check .", ".ci/run", "asv"):
+        assert command in text, command
+
+
+def test_the_solver_recipe_registers_a_solver_that_agrees_with_allpair(run_recipe, tmp_path):
+    ns = run_recipe("Add a solver")
+    cls = ns["TakeGather"]
+    assert ns["ours"].solver == cls.name == "take-gather-cpu" and ns["ours"].status == "ok"
+    assert cls.name not in solver_names()  # unregistered once its block ended
+    scene = Scene(dx=1.0, steps=5)
+    with registered(cls):
+        assert solver_names()[-1] == cls.name
+        ours = run(RunSpec(cls.name, scene), fields_path=tmp_path / "ours.npz")
+    reference = run(RunSpec("allpair-cpu", scene), fields_path=tmp_path / "allpair.npz")
+    assert ours.status == reference.status == "ok"
+    a, b = np.load(tmp_path / "ours.npz"), np.load(tmp_path / "allpair.npz")
+    for name in ("x", "y", "u", "v", "drho"):  # particle-id order: the same particles, the same fields
+        assert np.allclose(a[name], b[name], rtol=0, atol=1e-12 * max(1.0, float(np.abs(b[name]).max()))), name
+    assert np.max(np.abs(a["u"])) > 0.01  # the pulse is there: not two empty fields agreeing
+
+
+def test_the_scene_recipe_registers_a_scene_with_finite_initial_fields(run_recipe):
+    ns = run_recipe("Add a scene")
+    kind = ns["StandingWave"]()
+    assert kind.name not in scene_names()  # unregistered once its block ended
+    assert ns["record"].status == "ok" and 0 < ns["record"].mse < 0.05
+    assert ns["record"].scene["name"] == kind.name
+    with ns["registered_scene"](kind):
+        assert kind.name in scene_names()
+        scene = Scene(name=kind.name, dx=0.5, steps=2, model="linear")
+        assert scene.periodic_x and scene.n_particles == 40 * 40
+        x, y = np.meshgrid(scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx,
+                           scene.y_lo + (np.arange(scene.ny) + 0.5) * scene.dx)
+        u, v, drho = kind.initial_fields(scene, x, y, np)
+    assert all(np.all(np.isfinite(f)) for f in (u, v, drho))
+    assert np.isclose(np.abs(drho).max(), scene.rho0 * scene.mach, rtol=1e-2) and not u.any() and not v.any()
+    assert kind.name not in scene_names()
+
+
+def test_the_section_recipe_adds_its_section_to_the_report(run_recipe):
+    before = [s.name for s in sections.SECTIONS]
+    ns = run_recipe("Add a report section")
+    assert isinstance(ns["mine"], sections.Section) and ns["mine"].name not in before
+    assert [s.name for s in sections.SECTIONS] == before  # unregistered once its block ended
+    report = (ns["folder"] / "reports" / "my-laptop" / "report.md").read_text()
+    assert report.rstrip().split("\n## ")[-1].startswith("Figures")  # the report's own end
+    table = report.split("## Runs by status")[1].split("\n## ")[0]
+    assert "| ok | 1 |" in table
+
+
+def test_the_preset_recipe_expands_to_runs_that_a_sweep_stores(run_recipe):
+    ns = run_recipe("Add a preset")
+    assert "tiny" not in presets.PRESETS and "tiny" not in presets.RUN_BUDGET  # unregistered
+    specs = ns["specs"]
+    assert [s.scene.dx for s in specs] == [1.0, 0.8, 0.5] and {s.preset for s in specs} == {"tiny"}
+    rows = store.read_rows(ns["store_path"])
+    assert len(rows) == 3 and {r["preset"] for r in rows} == {"tiny"} and {r["status"] for r in rows} == {"ok"}
+    assert sorted(r["n_particles"] for r in rows) == sorted(s.scene.n_particles for s in specs)
