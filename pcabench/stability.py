@@ -1,9 +1,10 @@
 """A run's predicted stability: the largest stable CFL of its method, and how far past it the run went.
 
 The limit comes from the dispersion relation (solvers/dispersion.py
-``stable_cfl``): exact for the `linear` model; for `fixed` and `lagrangian`
-it is their linear part's, the limit used for them too (design section 4)
-unless long runs measured a lower one (:data:`MEASURED_LIMITS`).
+``stable_cfl``): exact for the `linear` model on a periodic lattice; for
+`fixed` and `lagrangian` it is their linear part's (design section 4). Where
+long runs of a scene measured a lower one (free ends, or a moving model's
+nonlinear terms: :data:`MEASURED_LIMITS`), that one is used.
 A run at or past its predicted limit is unstable, whatever its error: if it
 ended bounded, its run was too short for round-off to grow, and
 :func:`e_foldings` says how far the most unstable mode had grown (round-off,
@@ -21,14 +22,12 @@ import numpy as np
 ROUND_OFF_E_FOLDINGS = math.log(1e16)  # ~37: from float64 round-off to the pulse's size
 UNSTABLE_BY_PREDICTION = "unstable by prediction"
 
-# The moving models over long runs, where their nonlinear terms can grow what the linear part keeps bounded:
-# (model, kernel, h/dx, cutoff/h, integrator) -> (the smallest CFL that blew up, the largest that stayed
-# bounded). Measured 2026-12-01 at t = 300 s, dx = 0.25 on a 5 m strip (about 250 steps), serial, with
-# `pcabench run --solver linkedlist-cpu --dx 0.25 --t-end 300 --model MODEL --cfl CFL --strip-height 5`:
-# lagrangian bounded at 4.7, blew up at 4.75 (step 236), 4.8 (142), 4.9 (47); fixed bounded at 4.5 and 4.6,
-# blew up at 4.7 (step 149), 4.8 (47), 4.9 (23). The linear prediction for this method is 4.97.
-MEASURED_LIMITS = {("lagrangian", "gaussian", 2.13, 3.0, "verlet"): (4.75, 4.7),
-                   ("fixed", "gaussian", 2.13, 3.0, "verlet"): (4.7, 4.6)}
+# Long runs (``pcabench study --stability long``: t = 300 s, dx = 0.25, the paper's method, serial), where the
+# prediction's periodic lattice is not the whole story: free ends (the paper's scene) and the moving models'
+# nonlinear terms can grow what the periodic linear lattice keeps bounded.
+# (scene, model, kernel, h/dx, cutoff/h, integrator) -> (the smallest CFL that blew up, the largest that stayed
+# bounded below it). Only where that is below the prediction (4.97 for this method); measured 2026-12-01.
+MEASURED_LIMITS = {__MEASURED__}
 
 
 def _value(r, key, default=None):
@@ -67,18 +66,21 @@ def method_of(r) -> tuple[str, float, float, str]:
 
 
 def measured_limit(r) -> float | None:
-    """The smallest CFL at which long runs of ``r``'s model and method blew up (:data:`MEASURED_LIMITS`), or None."""
+    """The smallest CFL at which long runs of ``r``'s scene, model and method blew up (:data:`MEASURED_LIMITS`),
+    or None (a run without a scene is of the paper's)."""
+    from solvers import DEFAULT_SCENE
+
     kernel, h, cut, integrator = method_of(r)
-    for (model, k, hh, cc, integ), (limit, _bounded) in MEASURED_LIMITS.items():
-        if (model, k, integ) == (_value(r, "model", ""), kernel, integrator) and math.isclose(h, hh) \
-                and (k != "gaussian" or math.isclose(cut, cc)):
+    mine = (str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", ""), kernel, integrator)
+    for (scene, model, k, hh, cc, integ), (limit, _bounded) in MEASURED_LIMITS.items():
+        if (scene, model, k, integ) == mine and math.isclose(h, hh) and (k != "gaussian" or math.isclose(cut, cc)):
             return limit
     return None
 
 
 def stable_limit(r) -> float:
-    """The largest stable CFL of run ``r``'s method: predicted (0: its integrator grows at any step), or for a
-    moving model the limit measured over long runs where that is lower (:data:`MEASURED_LIMITS`)."""
+    """The largest stable CFL of run ``r``'s method: predicted (0: its integrator grows at any step), or the
+    limit long runs of its scene and model measured where that is lower (:data:`MEASURED_LIMITS`)."""
     linear, measured = _limits(*method_of(r))[0], measured_limit(r)
     return linear if measured is None else min(linear, measured)
 
