@@ -146,18 +146,18 @@ def test_the_long_run_table_measures_each_models_limit_below_its_first_blow_up(t
 
     path = tmp_path / "long" / "m.jsonl"
     runs = {"linear": {4.6: ("ok", None), 4.9: ("ok", None), 5.0: ("unstable", 200)},
-            "lagrangian": {4.6: ("ok", None), 4.7: ("unstable", 236), 4.8: ("ok", None), 4.9: ("unstable", 47)}}
+            "fixed": {4.6: ("ok", None), 4.7: ("unstable", 236), 4.8: ("ok", None), 4.9: ("unstable", 47)}}
     for model, by_cfl in runs.items():
         for cfl, (status, step) in by_cfl.items():
             store.append(row(name="acoustic-pulse", model=model, preset="stability-long", dx=1.0, t_end=30.0,
                              x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0, cfl=cfl, status=status,
                              failed_step=step, steps=60), path)
     rows = {r["model"]: r for r in T.long_run_limits(frame.load(path.parent))}
-    lin, lag = rows["linear"], rows["lagrangian"]
+    lin, fixed = rows["linear"], rows["fixed"]
     assert lin["predicted"] == pytest.approx(4.97, abs=0.01) and lin["bounded_to"] == 4.9
     assert lin["blew_up_from"] == 5.0 and lin["e_foldings"] < 1e-9 and lin["held"] is None
-    assert lag["bounded_to"] == 4.6 and lag["blew_up_from"] == 4.7 and lag["first_step"] == 236  # not 4.8
-    assert lag["held"] == 4.75  # pcabench/stability.py's MEASURED_LIMITS for the paper's lagrangian method
+    assert fixed["bounded_to"] == 4.6 and fixed["blew_up_from"] == 4.7 and fixed["first_step"] == 236  # not 4.8
+    assert fixed["held"] == 4.75  # pcabench/stability.py's MEASURED_LIMITS: fixed on the 2D pulse
     text = "\n".join(sections._long_runs_text(list(rows.values()), None))
-    assert "**lagrangian** blew up below its linear part's predicted 4.97, from CFL 4.7" in text
+    assert "**fixed** on acoustic-pulse blew up below the predicted 4.97, from CFL 4.7" in text
     assert "**linear** blew up below" not in text

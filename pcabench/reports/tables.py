@@ -588,10 +588,10 @@ def long_run_limits(df) -> list[dict]:
     that blew up (and its step), the steps run, and the e-foldings of the most unstable linear mode over the
     run at the largest bounded CFL (0 below the predicted limit).
     """
-    from pcabench.stability import MEASURED_LIMITS, assess, e_foldings, measured_limit
+    from pcabench.stability import assess, e_foldings, measured_limit
 
     runs = latest(df[df.preset == "stability-long"]) if "preset" in df else df.iloc[:0]
-    keys = ["scene", "model", "kernel", "h_factor", "cutoff_factor", "integrator", "precision", "dx", "t_end"]
+    keys = ["scene", "mach", "model", "kernel", "h_factor", "cutoff_factor", "integrator", "precision", "dx", "t_end"]
     out = []
     for key, g in runs.groupby(keys, sort=False):
         row = dict(zip(keys, key))
@@ -601,7 +601,7 @@ def long_run_limits(df) -> list[dict]:
         bounded = [float(r.cfl) for _, r in g.iterrows() if r.status == "ok"
                    and (first_blow is None or r.cfl < first_blow)]
         top = g[g.cfl == max(bounded)].iloc[0] if bounded else None
-        held = measured_limit(row) if row["model"] in {m for m, *_ in MEASURED_LIMITS} else None
+        held = measured_limit(row)
         row.update(cfls=[float(c) for c in g.cfl], predicted=assess({**row, "model": "linear", "cfl": 1.0})[
                        "stable_cfl"], bounded_to=max(bounded) if bounded else None, blew_up_from=first_blow,
                    first_step=blew[0][1] if blew else None, blew_up_at=blew,
