@@ -29,7 +29,8 @@ from solvers import Scene, SceneError, kernel, kernel_named, kernel_names, regis
 from solvers.backend import cpu_pairs
 from solvers.dispersion import predict, stable_cfl
 from solvers.kernel import GRAD0, INV_H2
-from solvers.kernels import Kernel, register, unregister
+from solvers.kernels import Kernel, KernelPluginWarning, register, unregister
+from solvers.kernels import registry as kernel_registry
 
 from .conftest import run_fields
 from .test_gpu import _max_rel, _simulate
@@ -325,3 +326,28 @@ def test_register_refuses_what_cannot_be_a_kernel(quintic):
     with pytest.raises(ValueError, match="only those can be removed"):
         unregister("gaussian")
     assert kernel_names() == (*BUILTIN, quintic)
+
+
+def test_an_installed_plugin_kernel_is_found_through_its_entry_point(tmp_path, monkeypatch):
+    """A package declaring ``[project.entry-points."pcabench.kernels"]``, as pip leaves it installed (a
+    dist-info on sys.path); one that does not load is left out with one warning."""
+    site = tmp_path / "site"
+    info = site / "plugin_kernel-0.1.dist-info"
+    info.mkdir(parents=True)
+    (site / "plugin_kernel.py").write_text("from tests.test_kernels import Quintic\n\n\n"
+                                           "class PluginQuintic(Quintic):\n    name = 'plugin-quintic'\n")
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: plugin-kernel\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(f"[{kernel_registry.ENTRY_POINT_GROUP}]\n"
+                                           "plugin-quintic = plugin_kernel:PluginQuintic\n"
+                                           "broken = plugin_kernel:Missing\n")
+    monkeypatch.syspath_prepend(str(site))
+    kernel_registry._found.cache_clear()
+    try:
+        with pytest.warns(KernelPluginWarning, match="'broken' .* left out: it does not load"):
+            names = kernel_names()
+        assert names == (*BUILTIN, "plugin-quintic")
+        assert Scene(dx=0.5, kernel="plugin-quintic").cutoff == pytest.approx(3 * 0.5 * Scene.default("h_factor"))
+    finally:
+        monkeypatch.undo()
+        kernel_registry._found.cache_clear()
+    assert kernel_names() == BUILTIN
