@@ -20,14 +20,14 @@ import shlex
 
 import numpy as np
 
-from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, scene_kind
+from solvers import DEFAULT_KERNEL, DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind
 from solvers.dispersion import predict, stable_cfl
 
 from .reports.tables import comparable, default_numerics, error_column, latest, numerics_label
 from .stability import assess, e_foldings
 
-# The configurations the prediction searches when no stored run reaches a target (a small, cheap grid).
-SEARCH_KERNELS = ("gaussian", "wendland-c2", "wendland-c4")
+# The configurations the prediction searches when no stored run reaches a target (a small, cheap grid), for
+# every registered kernel.
 SEARCH_H = (1.3, 1.6, 2.13)
 SEARCH_DX = (1.0, 0.5, 0.4, 0.25, 0.2, 0.125, 0.1, 0.05, 0.025)
 SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
@@ -35,7 +35,7 @@ SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
 
 def scene_of(r) -> dict:
     """A stored run's scene parameters (the defaults where the row predates them)."""
-    return {"kernel": r.get("kernel") or "gaussian", "h_factor": r["h_factor"], "cutoff_factor": r["cutoff_factor"],
+    return {"kernel": r.get("kernel") or DEFAULT_KERNEL, "h_factor": r["h_factor"], "cutoff_factor": r["cutoff_factor"],
             "cfl": r["cfl"], "integrator": r["integrator"], "dx": r["dx"], "strip_height": r["strip_height"]}
 
 
@@ -74,7 +74,7 @@ def reaching(df, t_end: float, model: str):
 def paper_configuration(df):
     """Rows of the paper's numerics: default integrator, CFL, h/dx and cutoff, and the Gaussian kernel."""
     d = default_numerics(df)
-    return d[d["kernel"].fillna("gaussian") == "gaussian"] if "kernel" in d else d
+    return d[d["kernel"].fillna(DEFAULT_KERNEL) == DEFAULT_KERNEL] if "kernel" in d else d
 
 
 def _unstable_row(r, column: str) -> dict:
@@ -146,7 +146,7 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
     """From the prediction: the cheapest configuration of a small grid predicted to reach ``error`` at ``t_end``
     (cost ~ particles x steps x neighbours on the thinnest strip), and the paper configuration's dx."""
     best, paper = None, None
-    for kern, h, dx in itertools.product(SEARCH_KERNELS, SEARCH_H, SEARCH_DX):
+    for kern, h, dx in itertools.product(kernel_names(), SEARCH_H, SEARCH_DX):
         try:
             base = Scene(dx=dx, t_end=t_end, model="linear", kernel=kern, h_factor=h, memory_limit_bytes=2**62)
         except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
@@ -168,10 +168,10 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
            "note": "predicted from the dispersion relation of the linear part"}
     if best is not None:
         _, s, p = best
-        out.update(kernel=getattr(s, "kernel", "gaussian"), h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,
+        out.update(kernel=s.kernel, h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,
                    predicted_error=p.predicted_error,
                    study=shlex.join(["pcabench", "study", "--solver", DEFAULT_SOLVER, "--model", model, "--t-end",
-                                     f"{t_end:g}", "--strip", "--kernel", getattr(s, "kernel", "gaussian"),
+                                     f"{t_end:g}", "--strip", "--kernel", s.kernel,
                                      "--h-factor", f"{s.h_factor:g}", "--cfl", f"{s.cfl:g}", "--dx", f"{s.dx:g}",
                                      f"{s.dx / 2:g}"]))
     return out

@@ -25,12 +25,13 @@ from solvers import (
     DEFAULT_SCENE,
     DEFAULT_SOLVER,
     INTEGRATORS,
-    KERNELS,
     MODELS,
     PRECISIONS,
     Scene,
     SceneError,
     SolverUnavailable,
+    kernel_named,
+    kernel_names,
     registry,
     scene_kind,
     scene_names,
@@ -131,9 +132,11 @@ def add_method_options(p: argparse.ArgumentParser, many: bool = False) -> None:
     n = {"nargs": "+"} if many else {}
     d = Scene.default
     p.add_argument("--integrator", choices=INTEGRATORS, **n, help=f"default {d('integrator')}")
-    p.add_argument("--kernel", choices=KERNELS, **n,
-                   help=f"SPH kernel (default {d('kernel')}, truncated at --cutoff; the Wendland kernels are cut "
-                        f"at their compact support 2h)")
+    compact = "; ".join(f"{k} is cut at its compact support {kernel_named(k).support:g}h"
+                        for k in kernel_names() if kernel_named(k).support is not None)
+    p.add_argument("--kernel", choices=kernel_names(), **n,  # every registered kernel (solvers/kernels/)
+                   help=f"SPH kernel (default {d('kernel')}, truncated at --cutoff" + (f"; {compact})" if compact
+                                                                                         else ")"))
     p.add_argument("--cutoff", type=number("--cutoff"), **n,
                    help=f"the Gaussian's cutoff in units of h (default {d('cutoff_factor'):g})")
     p.add_argument("--h-factor", type=number("--h-factor"), **n, help=f"h / dx (default {d('h_factor'):g})")

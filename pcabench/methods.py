@@ -15,7 +15,7 @@ import itertools
 import math
 from functools import lru_cache
 
-from solvers import DEFAULT_SCENE, KERNELS, Scene
+from solvers import DEFAULT_SCENE, Scene, kernel_names
 from solvers.dispersion import predict, stable_cfl
 
 H_FACTORS = (1.0, 1.1, 1.2, 1.3, 1.4, 1.6, 2.0, 2.13)
@@ -36,14 +36,18 @@ def _stable(kernel: str, h_factor: float) -> float:
     return stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h_factor, model="linear", memory_limit_bytes=2**62))
 
 
-@lru_cache(maxsize=64)
 def fastest(error: float, t_end: float, model: str = "linear", name: str = DEFAULT_SCENE,
             per_kernel: int = 1) -> tuple[dict, ...]:
     """The cheapest methods (kernel, h_factor, cfl, dx; the paper's domain of scene ``name``) predicted to reach
-    a relative RMS ``error`` at ``t_end``, ``per_kernel`` for each kernel, cheapest first, each with its
-    predicted error, its stable CFL and its cost."""
+    a relative RMS ``error`` at ``t_end``, ``per_kernel`` for each registered kernel, cheapest first, each with
+    its predicted error, its stable CFL and its cost."""
+    return _fastest(error, t_end, model, name, per_kernel, kernel_names())
+
+
+@lru_cache(maxsize=64)
+def _fastest(error: float, t_end: float, model: str, name: str, per_kernel: int, kernels: tuple) -> tuple[dict, ...]:
     found = []
-    for kernel, h, share in itertools.product(KERNELS, H_FACTORS, CFL_SHARES):
+    for kernel, h, share in itertools.product(kernels, H_FACTORS, CFL_SHARES):
         limit = _stable(kernel, h)
         if share > MARGIN[model] or limit <= 0:
             continue

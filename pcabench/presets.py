@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import itertools
 
-from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, solver_class
+from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, solver_class
 
 from .spec import ALL_CORES, SERIAL, RunSpec
 
@@ -127,12 +127,13 @@ def stability_long() -> list[RunSpec]:
             for scene, setting in LONG_SCENES.items() for model in LONG_MODELS for cfl in LONG_CFL]
 
 
-# The speed-accuracy front at t = 10 s on the strip, serial: kernel x h/dx x CFL x dx x precision x model.
-# CFL 6 is past every configuration's predicted stable step: the front shows where methods fail.
+# The speed-accuracy front at t = 10 s on the strip, serial: kernel x h/dx x CFL x dx x precision x model, the
+# kernels every registered one (:func:`front_axes`). CFL 6 is past every configuration's predicted stable step:
+# the front shows where methods fail.
 FRONT = {
-    "quick": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0, 6.0),
+    "quick": dict(h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0, 6.0),
                   dx=(0.4, 0.2, 0.1), precision=("float64", "float32"), model=("linear", "lagrangian")),
-    "full": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.0, 1.3, 1.6, 2.13, 2.6),
+    "full": dict(h_factor=(1.0, 1.3, 1.6, 2.13, 2.6),
                  cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0), dx=(0.4, 0.2, 0.1, 0.05, 0.025),
                  precision=("float64", "float32"), model=("linear", "lagrangian")),
 }
@@ -158,10 +159,11 @@ def fast_methods(model: str) -> tuple[dict, ...]:
 
 # The 2D acoustic pulse's front (40 m periodic square, t = 10 s, serial): no strip (the pulse spreads in y), so
 # fewer and coarser runs; the paper's method at dx 0.1 beside them. CFL 3 is past the stable step of h = 1.3 dx.
+# The kernels: every registered one, as on the strip.
 FRONT_2D = {
-    "quick": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0),
+    "quick": dict(h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0),
                   dx=(0.5, 0.25, 0.125), precision=("float64",), model=("linear", "lagrangian")),
-    "full": dict(kernel=("gaussian", "wendland-c2", "wendland-c4"), h_factor=(1.0, 1.3, 1.6, 2.13),
+    "full": dict(h_factor=(1.0, 1.3, 1.6, 2.13),
                  cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0), dx=(0.5, 0.25, 0.125, 0.1), precision=("float64", "float32"),
                  model=("linear", "lagrangian")),
 }
@@ -179,20 +181,25 @@ def model_needs(scene: str) -> list[RunSpec]:
             for dx in MODEL_DX.get(scene, (0.25,)) for mach in MODEL_MACH for model in ("linear", "lagrangian")]
 
 
+def front_axes(size: str = "quick", scene: str = DEFAULT_SCENE) -> dict:
+    """The front's axes on ``scene``: every registered kernel (solvers/kernels/), then FRONT's or FRONT_2D's."""
+    return {"kernel": kernel_names(), **(FRONT if scene == DEFAULT_SCENE else FRONT_2D)[size]}
+
+
 def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     """Time to solution against error at t = 10 s: the product of FRONT[size] on the strip, smallest N first;
     then the paper's scene with its method and the predicted fastest ones, serial, in the same sweep. Another
     scene: its own product (FRONT_2D) on its own domain, the paper's method beside it, and which model it
     needs at several amplitudes."""
     if scene != DEFAULT_SCENE:
-        axes = FRONT_2D[size]
+        axes = front_axes(size, scene)
         names = [k for k in axes if k != "dx"]
         runs = [_spec(name=scene, dx=dx, t_end=FRONT_T_END, **dict(zip(names, values)))
                 for dx in sorted(axes["dx"], reverse=True) for values in itertools.product(*(axes[k] for k in names))]
         runs += [_spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model)
                  for model in ("linear", "lagrangian") for dx in PAPER_METHOD_2D_DX]
         return runs + model_needs(scene)
-    axes = FRONT[size]
+    axes = front_axes(size, scene)
     names = [k for k in axes if k != "dx"]
     runs = [_spec(dx=dx, t_end=FRONT_T_END, strip=True, **dict(zip(names, values)))
             for dx in sorted(axes["dx"], reverse=True) for values in itertools.product(*(axes[k] for k in names))]

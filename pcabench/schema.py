@@ -20,6 +20,7 @@ import math
 import re
 from dataclasses import dataclass
 
+from solvers.kernels.registry import KERNEL_NAME
 from solvers.registry import SOLVER_NAME
 from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, PRECISIONS
 
@@ -116,7 +117,7 @@ SCENE_FIELDS: dict[str, Field] = {
     **{k: Field(("number",), low=-1e12, high=1e12) for k in (
         "x_min", "x_max", "y_min", "y_max", "rho0", "c0", "mach", "pulse_width", "pulse_center", "h_factor",
         "cutoff_factor", "cfl", "blowup_factor", "height")},
-    "kernel": _name(max_len=32),
+    "kernel": _name(max_len=32, pattern=KERNEL_NAME),  # as the kernel registry checks
     "model": Field(("str",), choices=MODELS),
     "integrator": Field(("str",), choices=INTEGRATORS),
     "precision": Field(("str",), choices=PRECISIONS),

@@ -40,9 +40,10 @@ def _value(r, key, default=None):
 
 def _scene(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, dx: float = 1.0):
     from solvers import Scene
+    from solvers.kernels import truncated
 
     method = {"kernel": kernel, "h_factor": h_factor, "integrator": integrator}
-    if kernel == "gaussian":  # the Wendland kernels are cut at their own support
+    if truncated(kernel):  # a kernel of compact support (the Wendland kernels) is cut there
         method["cutoff_factor"] = cutoff_factor
     return Scene(dx=dx, t_end=1.0, model="linear", memory_limit_bytes=2**62, **method)
 
@@ -61,7 +62,7 @@ def method_of(r) -> tuple[str, float, float, str]:
     """(kernel, h/dx, cutoff/h, integrator) of a stored run or a front point (Scene's defaults where missing)."""
     from solvers import Scene
 
-    return (str(_value(r, "kernel", "gaussian")), float(_value(r, "h_factor", Scene.default("h_factor"))),
+    return (str(_value(r, "kernel", Scene.default("kernel"))), float(_value(r, "h_factor", Scene.default("h_factor"))),
             float(_value(r, "cutoff_factor", Scene.default("cutoff_factor"))),
             str(_value(r, "integrator", Scene.default("integrator"))))
 
@@ -70,11 +71,12 @@ def measured_limit(r) -> float | None:
     """The smallest CFL at which long runs of ``r``'s scene, model and method blew up (:data:`MEASURED_LIMITS`),
     or None (a run without a scene is of the paper's)."""
     from solvers import DEFAULT_SCENE
+    from solvers.kernels import truncated
 
     kernel, h, cut, integrator = method_of(r)
     mine = (str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", ""), kernel, integrator)
     for (scene, model, k, hh, cc, integ), (limit, _bounded) in MEASURED_LIMITS.items():
-        if (scene, model, k, integ) == mine and math.isclose(h, hh) and (k != "gaussian" or math.isclose(cut, cc)):
+        if (scene, model, k, integ) == mine and math.isclose(h, hh) and (not truncated(k) or math.isclose(cut, cc)):
             return limit
     return None
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 import threading
 from functools import lru_cache
 
+from .kernels import DEFAULT_KERNEL
+
 _numba_threads = threading.local()  # the thread count this Python thread last gave numba through use_threads
 
 
@@ -20,7 +22,7 @@ def use_threads(n: int, decided: bool = False) -> None:
 
 
 @lru_cache(maxsize=None)
-def cpu_pairs(precision: str, kernel: str = "gaussian"):
+def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL):
     """The pair functions for numba's CPU target in ``precision`` with ``kernel``'s G, inlined into the
     sweeps that call them."""
     import numba

@@ -31,7 +31,6 @@ from functools import lru_cache
 
 import numpy as np
 
-from . import kernel
 from .analytic import errors as analytic_errors
 from .integrators import step_program
 
@@ -46,8 +45,7 @@ def lattice_offsets(scene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     a, b = np.meshgrid(np.arange(-reach, reach + 1), np.arange(-reach, reach + 1), indexing="ij")
     r = np.hypot(a, b) * scene.dx
     keep = (r < scene.cutoff) & (r > 0)
-    name = getattr(scene, "kernel", "gaussian")
-    return a[keep].astype(float), b[keep].astype(float), kernel.gradient_factor(name, r[keep], scene.h)
+    return a[keep].astype(float), b[keep].astype(float), scene.sph_kernel.gradient(r[keep], scene.h)
 
 
 SYMBOL_CHUNK = 1 << 21  # wavenumbers x neighbours evaluated at once (16 MiB of phases)

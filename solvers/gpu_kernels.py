@@ -14,6 +14,7 @@ from numba import cuda, int32
 
 from .gpu_device import device_backend, simulated
 from .kernel import exp_neg_math
+from .kernels import DEFAULT_KERNEL
 from .pairs import make_pairs
 
 SCAN_ITEMS = 4  # cells per thread in one pass of the cellBegin scan
@@ -31,7 +32,7 @@ def _device_function(fastmath: bool):
 
 
 @lru_cache(maxsize=None)
-def kernels(precision: str, kernel: str = "gaussian"):
+def kernels(precision: str, kernel: str = DEFAULT_KERNEL):
     """The device kernels for ``precision`` and ``kernel`` (compiled by numba-cuda on first launch).
 
     float32 kernels use fastmath (the hardware's approximate expf, ~2 ulp);

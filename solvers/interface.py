@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import kernel
+from .kernels import kernel_names
 from .scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
 
 STAGES = ("input", "init", "snp", "pi", "su", "output")
@@ -54,6 +55,14 @@ class SolverUnavailable(RuntimeError):
     """The solver cannot run on this machine (no GPU, missing library)."""
 
 
+class EveryKernel:
+    """The class attribute ``kernels`` of a solver that runs any kernel: every registered kernel's name, read at
+    each access, so that a kernel registered later (solvers/kernels/) is offered too."""
+
+    def __get__(self, obj, owner=None) -> tuple:
+        return kernel_names()
+
+
 class Solver(abc.ABC):
     """Base class: state, system update, output. Subclasses: ``snp``, ``_sweep`` and ``launch``.
 
@@ -69,7 +78,7 @@ class Solver(abc.ABC):
     precisions: tuple = PRECISIONS
     models: tuple = MODELS
     integrators: tuple = INTEGRATORS
-    kernels: tuple = kernel.KERNELS
+    kernels: tuple = EveryKernel()  # a tuple of kernel names restricts a solver; by default, every registered one
     boundaries: tuple = ("free-x", "periodic-y")  # the boundary kinds it can run (solvers/scenes/base.py)
     pair_loops: tuple = ("gather",)  # how it can visit pairs (gather, list, all-pairs); the first is its default
     threaded: bool = False  # runs on more than one CPU thread (--threads N|all); else serial

@@ -3,7 +3,7 @@
 :func:`make_pairs` builds the pair functions with one backend's decorator
 (``numba.njit(inline="always")`` for the CPU solvers,
 ``numba.cuda.jit(device=True)`` for the GPU solver and its simulator), that
-backend's exp(-x) and one kernel's G (solvers/kernel.py, chosen at compile
+backend's exp(-x) and one kernel's G (solvers/kernels/, chosen at compile
 time), so that every solver evaluates exactly the same expressions. The functions call each other as
 closure variables: numba compiles them as constants of the caller.
 
@@ -22,13 +22,14 @@ Rates (design, section 1), with rho = rho0 + nonlin * drho (nonlin = 0 in the
 vol_j = m_j / rho_j and pr_j = c0^2 drho_j / rho_j^2:
     d(drho_i)/dt = rho_i sum_j vol_j (u_i - u_j) . r_ij G_ij
     du_i/dt      = -sum_j m_j (pr_i + pr_j) G_ij r_ij
-with grad_i W_ij = G_ij r_ij (``gradient``, solvers/kernel.py). ``k`` is the constant tuple
+with grad_i W_ij = G_ij r_ij (``gradient``, the kernel's compiled G). ``k`` is the constant tuple
 of :func:`solvers.kernel.constants`, read by its named slots.
 """
 import math
 from types import ModuleType
 
-from .kernel import C0SQ, NONLIN, NX, NY, RC2, RHO0, SPACING, ZERO, make_gradient
+from .kernel import C0SQ, NONLIN, NX, NY, RC2, RHO0, SPACING, ZERO
+from .kernels import kernel_named
 
 
 def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
@@ -38,7 +39,7 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
     They come back as attributes of a module object, which numba resolves inside the jitted sweeps
     that call them (it cannot type a plain namespace).
     """
-    gradient = jit(make_gradient(kernel, precision, jit(exp_neg)))
+    gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg)))
 
     @jit
     def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):

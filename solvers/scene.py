@@ -4,8 +4,9 @@ Defaults are the reference paper's: a square lattice of spacing ``dx`` on
 x in [-10, 40] m, y in [-10, 10] m (periodic in y, free left/right edges),
 a medium at rest (rho0 = 1 kg/m^3, c0 = 1 m/s) carrying a right-travelling
 Gaussian pulse of Mach 0.05, a Gaussian kernel with h = 2.13 dx truncated at
-3 h, and dt = 0.2 dx / c0. The kernel may instead be a Wendland kernel
-(solvers/kernel.py), whose compact support 2h is then the cutoff.
+3 h, and dt = 0.2 dx / c0. The kernel may instead be any registered kernel
+(solvers/kernels/); one of compact support (the Wendland kernels: 2h) is cut
+there instead.
 
 A scene states its particle count and memory before anything is allocated
 (:meth:`Scene.memory_bytes`) and rejects nonsense with a message that names
@@ -19,7 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, replace
 
-from .kernel import KERNELS, SUPPORT
+from .kernels import DEFAULT_KERNEL, Kernel, kernel_named
 from .scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
@@ -72,8 +73,8 @@ class Scene:
     pulse_width: float = 3.0  # the 3 in exp(-((x - c0 t)/3)^2), m
     pulse_center: float = 0.0  # pulse position at t = 0, m
     h_factor: float = 2.13  # h = h_factor * dx
-    cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h (the Gaussian's truncation; Wendland: the default only)
-    kernel: str = "gaussian"  # one of KERNELS (solvers/kernel.py)
+    cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h (a truncated kernel's, the Gaussian; else the default)
+    kernel: str = DEFAULT_KERNEL  # a registered kernel's name (solvers/kernels/)
     cfl: float = 0.2  # dt = cfl * dx / c0 (lowered slightly to land on t_end)
     model: str = "lagrangian"
     integrator: str = "verlet"
@@ -137,10 +138,13 @@ class Scene:
              f"(got {self.cutoff_factor})")
         need(self.cutoff_factor <= 5.0,
              f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7")
-        need(self.kernel in KERNELS, f"kernel must be one of {', '.join(KERNELS)} (got {self.kernel!r})")
-        need(self.kernel not in SUPPORT or self.cutoff_factor == self.default("cutoff_factor"),
+        try:
+            support = kernel_named(self.kernel).support
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
+        need(support is None or self.cutoff_factor == self.default("cutoff_factor"),
              f"cutoff_factor applies to the truncated Gaussian only: {self.kernel} is cut at its compact support "
-             f"{SUPPORT.get(self.kernel, 0):g}h (got cutoff_factor {self.cutoff_factor:g})")
+             f"{support or 0:g}h (got cutoff_factor {self.cutoff_factor:g})")
         reach = self.cutoff_ratio(self.kernel, self.cutoff_factor)
         need(self.h_factor * reach > 1,
              f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
@@ -217,6 +221,11 @@ class Scene:
     def cutoff(self) -> float:
         """Interaction radius, m: the kernel's support (:meth:`cutoff_ratio` h)."""
         return self.cutoff_ratio(self.kernel, self.cutoff_factor) * self.h
+
+    @property
+    def sph_kernel(self) -> Kernel:
+        """The kernel ``kernel`` names (solvers/kernels/): W, G and the compiled G of this scene's method."""
+        return kernel_named(self.kernel)
 
     @property
     def nx(self) -> int:
@@ -310,11 +319,12 @@ class Scene:
 
     @classmethod
     def cutoff_ratio(cls, kernel: str | None = None, cutoff_factor: float | None = None) -> float:
-        """cutoff / h, the one rule: a Wendland kernel's compact support (``SUPPORT``), else the
-        Gaussian's truncation ``cutoff_factor`` (None: the defaults)."""
-        kernel = cls.default("kernel") if kernel is None else kernel
-        cutoff_factor = cls.default("cutoff_factor") if cutoff_factor is None else cutoff_factor
-        return SUPPORT.get(kernel, cutoff_factor)
+        """cutoff / h, the one rule: the kernel's compact support (``Kernel.support``: the Wendland kernels'),
+        else the truncation ``cutoff_factor`` (the Gaussian's; None: the defaults)."""
+        support = kernel_named(cls.default("kernel") if kernel is None else kernel).support
+        if support is not None:
+            return support
+        return cls.default("cutoff_factor") if cutoff_factor is None else cutoff_factor
 
     @classmethod
     def thinnest_strip(cls, dx: float, cutoff_factor: float | None = None,

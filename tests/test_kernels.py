@@ -1,5 +1,6 @@
-"""The kernels (solvers/kernel.py): their lattice sums, the compiled G against the reference forms, every
-solver on a Wendland kernel, convergence, and the scene and harness plumbing of ``kernel``.
+"""The kernels (solvers/kernels/): each class's W integrates to 1 and G = W'(r)/r, their lattice sums, the
+compiled G against the reference forms, every solver on a Wendland kernel, convergence, the scene and harness
+plumbing of ``kernel``, and a kernel of one's own (a quintic spline registered for a test) joining it all.
 
 The lattice bounds are measured values with a little margin, at Scene's default h = 2.13 dx (dx = 1):
 
@@ -13,17 +14,28 @@ bias about the gradient sum's deviation), the Gaussian's including its truncatio
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
+from scipy import integrate
 
 from pcabench import cli
-from pcabench.presets import matrix
+from pcabench.methods import fastest
+from pcabench.presets import front_axes, matrix
 from pcabench.run import run
 from pcabench.spec import RunSpec, identity, row_identity, scene_from_row
-from solvers import Scene, SceneError, kernel
+from solvers import Scene, SceneError, kernel, kernel_named, kernel_names, registry
 from solvers.backend import cpu_pairs
+from solvers.dispersion import predict, stable_cfl
+from solvers.kernel import GRAD0, INV_H2
+from solvers.kernels import Kernel, KernelPluginWarning, register, unregister
+from solvers.kernels import registry as kernel_registry
 
+from .conftest import run_fields
 from .test_gpu import _max_rel, _simulate
+
+BUILTIN = ("gaussian", "wendland-c2", "wendland-c4")
 
 WENDLAND = ("wendland-c2", "wendland-c4")
 # (bound on |sum_j V W_ij - 1|, bound on |sum_j V x_ij^2 G_ij + 1|): the table above, with about 20 % margin
@@ -40,20 +52,46 @@ def _lattice(name: str, dx: float = 1.0):
 
 
 # ------------------------------------------------------------ (a), (b): the lattice sums
-@pytest.mark.parametrize("name", kernel.KERNELS)
+def test_the_builtin_kernels_are_registered_the_gaussian_first():
+    assert kernel_names() == BUILTIN and Scene.default("kernel") == "gaussian"
+    for name in BUILTIN:
+        kern = kernel_named(name)
+        assert kern.name == name and kern.__class__.__doc__ and kern.summary
+    assert kernel_named("gaussian").support is None
+    assert [kernel_named(n).support for n in WENDLAND] == [2.0, 2.0]
+    with pytest.raises(ValueError, match=r"^kernel must be one of gaussian, wendland-c2, wendland-c4 \(got 'cubic'\)$"):
+        kernel_named("cubic")
+
+
+@pytest.mark.parametrize("name", BUILTIN)
+def test_w_integrates_to_one_over_the_plane_and_g_is_its_slope_over_r(name):
+    """int 2 pi r W(r) dr = 1 (the Gaussian untruncated, to 8h), W = norm / h^2 at r = 0, and G = W'(r) / r
+    against a central difference of W."""
+    kern, h = kernel_named(name), 0.7
+    reach = (kern.support or 8.0) * h
+    total, _ = integrate.quad(lambda r: 2 * math.pi * r * kern.value(r, h), 0.0, reach, epsabs=1e-13, limit=200)
+    assert total == pytest.approx(1.0, abs=1e-10)
+    assert kern.value(0.0, h) == pytest.approx(kern.norm / h**2, rel=1e-14)
+    r, e = np.linspace(0.05, 0.98 * reach / h, 40) * h, 1e-6 * h
+    slope = (kern.value(r + e, h) - kern.value(r - e, h)) / (2 * e)
+    assert np.allclose(slope, r * kern.gradient(r, h), rtol=1e-6, atol=1e-9 / h**3)
+    assert kern.grad0(h) == pytest.approx(float(kern.gradient(1e-9 * h, h)), rel=1e-8)
+
+
+@pytest.mark.parametrize("name", BUILTIN)
 def test_lattice_sum_of_w_is_one(name):
     scene, x, y, vol = _lattice(name)
-    deviation = vol * kernel.value(name, np.hypot(x, y), scene.h).sum() - 1.0
+    deviation = vol * kernel_named(name).value(np.hypot(x, y), scene.h).sum() - 1.0
     bound = LATTICE_BOUND[name][0]
     assert abs(deviation) < bound
     assert abs(deviation) > bound / 10  # the stated order, not a loose bound
 
 
-@pytest.mark.parametrize("name", kernel.KERNELS)
+@pytest.mark.parametrize("name", BUILTIN)
 def test_gradient_is_consistent_on_the_lattice(name):
     """sum_j V x_ij (grad_i W_ij)^T = -I, grad_i W_ij = G_ij x_ij."""
     scene, x, y, vol = _lattice(name)
-    g = kernel.gradient_factor(name, np.hypot(x, y), scene.h)
+    g = kernel_named(name).gradient(np.hypot(x, y), scene.h)
     xx, yy, xy = (vol * a * b * g for a, b in ((x, x), (y, y), (x, y)))
     bound = LATTICE_BOUND[name][1]
     assert bound / 10 < abs(xx.sum() + 1.0) < bound
@@ -64,27 +102,28 @@ def test_gradient_is_consistent_on_the_lattice(name):
 def test_wendland_kernels_have_compact_support_2h():
     h = 0.7
     for name in WENDLAND:
-        scene = Scene(dx=h / Scene.default("h_factor"), kernel=name)
+        scene, kern = Scene(dx=h / Scene.default("h_factor"), kernel=name), kernel_named(name)
         assert scene.cutoff == pytest.approx(2 * scene.h)
-        assert kernel.value(name, 2 * h, h) == 0.0 and kernel.gradient_factor(name, 2 * h, h) == 0.0
-        r, e = np.linspace(0.05, 1.95, 20) * h, 1e-6 * h  # G = W'(r) / r
-        slope = (kernel.value(name, r + e, h) - kernel.value(name, r - e, h)) / (2 * e)
-        assert np.allclose(slope, r * kernel.gradient_factor(name, r, h), rtol=1e-6, atol=1e-9 / h**3)
+        assert kern.value(2 * h, h) == 0.0 and kern.gradient(2 * h, h) == 0.0
 
 
 # ------------------------------------------------------------ (e): the compiled G, and every CPU solver
 @pytest.mark.parametrize("precision,tol", [("float64", 1e-13), ("float32", 1e-6)])
-@pytest.mark.parametrize("name", kernel.KERNELS)
+@pytest.mark.parametrize("name", BUILTIN)
 def test_compiled_gradient_matches_the_reference(name, precision, tol):
-    scene = Scene(dx=0.1, kernel=name)
+    check_compiled_gradient(name, precision, tol)
+
+
+def check_compiled_gradient(name, precision, tol):
+    scene, kern = Scene(dx=0.1, kernel=name), kernel_named(name)
     k = kernel.constants(scene, np.dtype(precision))
     gradient = cpu_pairs(precision, name).gradient
     r = np.random.default_rng(7).uniform(0.0, scene.cutoff, 400)
     got = np.array([gradient(np.dtype(precision).type(ri * ri), k) for ri in r])
-    want = kernel.gradient_factor(name, r, scene.h)
-    scale = abs(kernel.gradient_factor(name, 0.0, scene.h))  # G(0): absolute, as (1 - q/2)^n cancels near 2h
+    want = kern.gradient(r, scene.h)
+    scale = abs(kern.grad0(scene.h))  # G(0): absolute, as (1 - q/2)^n cancels near 2h
     assert np.max(np.abs(got - want)) < tol * scale
-    assert k[kernel.GRAD0] == pytest.approx(-scale, rel=tol)
+    assert k[GRAD0] == pytest.approx(-scale, rel=tol)
 
 
 @pytest.mark.parametrize("name", WENDLAND)
@@ -112,7 +151,7 @@ CONVERGENCE_DX = (0.4, 0.2)
 ERROR_AT_02 = {"gaussian": 0.070, "wendland-c2": 0.040, "wendland-c4": 0.031}
 
 
-@pytest.mark.parametrize("name", kernel.KERNELS)
+@pytest.mark.parametrize("name", BUILTIN)
 def test_linear_converges_at_second_order_for_each_kernel(name):
     errors = []
     for dx in CONVERGENCE_DX:
@@ -175,8 +214,140 @@ def test_kernel_option_runs_and_the_matrix_takes_kernel_lists(capsys):
     for s in specs:  # the strip follows the kernel's support
         assert s.scene.strip_height == Scene.thinnest_strip(0.2, h_factor=s.scene.h_factor, kernel=s.scene.kernel)
     assert "kernel=wendland-c4" in next(s.label for s in specs if s.scene.kernel == "wendland-c4")
-    assert {s.scene.kernel for s in matrix(dxs=[0.5], kernel=list(kernel.KERNELS))} == set(kernel.KERNELS)
+    assert {s.scene.kernel for s in matrix(dxs=[0.5], kernel=list(BUILTIN))} == set(BUILTIN)
     code = cli.main(["run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "2", "--kernel",
                      "wendland-c2", "--json", "--quiet"])
     out = capsys.readouterr().out
     assert code == 0 and '"kernel": "wendland-c2"' in out
+
+
+# ------------------------------------------------------------ a kernel of one's own: one class, registered
+class Quintic(Kernel):
+    """Morris's (1996) quintic spline in 2D, support 3h: W = 7 / (478 pi h^2) [(3 - q)^5 - 6 (2 - q)^5 +
+    15 (1 - q)^5] (1/m^2, each term where positive, q = r/h); G = W'(r) / r = -7 / (478 pi h^4 q) [5 (3 - q)^4
+    - 30 (2 - q)^4 + 75 (1 - q)^4] (1/m^4), whose bracket vanishes at q = 0: G(0) = -120 * 7 / (478 pi h^4)."""
+
+    name = "test-quintic"
+    summary = "Morris's quintic spline, support 3h (a test's plug-in)"
+    support = 3.0
+    norm = 7.0 / (478.0 * math.pi)
+
+    def value(self, r, h):
+        q = np.asarray(r, dtype=np.float64) / h
+        return self.norm / h**2 * sum(c * np.maximum(a - q, 0.0) ** 5 for a, c in ((3, 1), (2, -6), (1, 15)))
+
+    def gradient(self, r, h):
+        q = np.asarray(r, dtype=np.float64) / h
+        bracket = sum(c * np.maximum(a - q, 0.0) ** 4 for a, c in ((3, 5), (2, -30), (1, 75)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return -self.norm / h**4 * np.where(q > 0, bracket / np.where(q > 0, q, 1.0), 120.0)
+
+    def compiled_gradient(self, dtype, exp_neg):
+        t = np.dtype(dtype).type
+        zero, one, two, three = t(0.0), t(1.0), t(2.0), t(3.0)
+        c2, c1, c0 = t(30.0 / 120.0), t(75.0 / 120.0), t(5.0 / 120.0)  # the bracket over G(0)'s 120
+
+        def gradient(r2, k):  # G(0) [5 a^4 - 30 b^4 + 75 c^4] / (120 q), a, b, c = 3 - q, 2 - q, 1 - q
+            q = math.sqrt(r2 * k[INV_H2])
+            if q == zero:
+                return k[GRAD0]
+            a, b, c = three - q, max(two - q, zero), max(one - q, zero)
+            a2, b2, c2_ = a * a, b * b, c * c
+            return k[GRAD0] * (c0 * a2 * a2 - c2 * b2 * b2 + c1 * c2_ * c2_) / q
+        return gradient
+
+
+@pytest.fixture
+def quintic():
+    """The quintic spline registered for one test, then removed (the other tests see the built-ins only)."""
+    register(Quintic)
+    try:
+        yield Quintic.name
+    finally:
+        unregister(Quintic.name)
+    assert Quintic.name not in kernel_names()
+
+
+def test_a_registered_kernel_joins_the_front_the_prediction_and_the_solvers(quintic, tmp_path):
+    assert kernel_names() == (*BUILTIN, quintic)
+    kern = kernel_named(quintic)
+    total, _ = integrate.quad(lambda r: 2 * math.pi * r * kern.value(r, 1.0), 0.0, 3.0, points=[1, 2], epsabs=1e-13)
+    assert total == pytest.approx(1.0, abs=1e-10)
+    r, e = np.linspace(0.05, 2.95, 40), 1e-6
+    slope = (kern.value(r + e, 1.0) - kern.value(r - e, 1.0)) / (2 * e)
+    assert np.allclose(slope, r * kern.gradient(r, 1.0), rtol=1e-6, atol=1e-9)
+    for precision, tol in (("float64", 1e-12), ("float32", 1e-4)):  # the bracket ~ 120 q cancels near q = 0
+        check_compiled_gradient(quintic, precision, tol)
+    # the command line, the scene (cut at its support 3h), the solvers' claims
+    args = cli.build_parser().parse_args(["run", "--solver", "allpair-cpu", "--dx", "0.5", "--kernel", quintic])
+    assert args.kernel == quintic
+    scene = Scene(dx=0.5, x_min=-10, x_max=20, steps=10, model="linear", kernel=quintic)
+    assert scene.cutoff == pytest.approx(3 * scene.h)
+    assert quintic in registry()["allpair-cpu"].kernels and quintic in registry()["linkedlist-cpu"].kernels
+    # the dispersion prediction, its stable CFL, the front preset and the prediction's method search
+    p = predict(scene.replace(t_end=10.0, steps=None, dx=0.2, x_min=None, x_max=None))
+    assert math.isfinite(p.predicted_error) and 0 < p.predicted_error < 1 and p.stable_cfl > 0
+    assert stable_cfl(scene) == p.stable_cfl
+    assert front_axes()["kernel"] == (*BUILTIN, quintic)
+    assert front_axes("quick", "acoustic-pulse")["kernel"] == (*BUILTIN, quintic)
+    assert quintic in {m["kernel"] for m in fastest(0.05, 10.0)}
+    # a short linear run: the all-pair search and the cell list agree to round-off
+    ref, ref_fields = run_fields(scene, "allpair-cpu", tmp_path)
+    got, got_fields = run_fields(scene, "linkedlist-cpu", tmp_path)
+    assert ref.status == got.status == "ok", (ref.message, got.message)
+    assert got.mean_neighbours == pytest.approx(ref.mean_neighbours)
+    assert ref.mean_neighbours == pytest.approx(np.pi * 9 * Scene.default("h_factor") ** 2, rel=0.05)  # 3h disc
+    for field in ("u", "drho", "x"):
+        assert _max_rel(got_fields[field], ref_fields[field]) < 1e-12, field
+    assert np.abs(ref_fields["u"]).max() > 0.01  # the pulse moved
+
+
+def test_register_refuses_what_cannot_be_a_kernel(quintic):
+    class Nameless(Quintic):
+        name = ""
+
+    class Taken(Quintic):
+        name = "gaussian"
+
+    class Odd(Quintic):
+        name = "no spaces"
+
+    class Wide(Quintic):
+        name = "test-wide"
+        support = 9.0
+
+    class Other(Quintic):  # the registered name again, another class: caches are by name
+        name = "test-quintic"
+
+    for cls, why in ((Nameless, "no name of its own"), (Taken, "'gaussian' is taken"), (Odd, "not a plain name"),
+                     (Wide, "support 9.0"), (Other, "is taken"), (Kernel, "not a concrete Kernel")):
+        with pytest.raises(ValueError, match=why):
+            register(cls)
+    with pytest.raises(ValueError, match="only those can be removed"):
+        unregister("gaussian")
+    assert kernel_names() == (*BUILTIN, quintic)
+
+
+def test_an_installed_plugin_kernel_is_found_through_its_entry_point(tmp_path, monkeypatch):
+    """A package declaring ``[project.entry-points."pcabench.kernels"]``, as pip leaves it installed (a
+    dist-info on sys.path); one that does not load is left out with one warning."""
+    site = tmp_path / "site"
+    info = site / "plugin_kernel-0.1.dist-info"
+    info.mkdir(parents=True)
+    (site / "plugin_kernel.py").write_text("from tests.test_kernels import Quintic\n\n\n"
+                                           "class PluginQuintic(Quintic):\n    name = 'plugin-quintic'\n")
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: plugin-kernel\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(f"[{kernel_registry.ENTRY_POINT_GROUP}]\n"
+                                           "plugin-quintic = plugin_kernel:PluginQuintic\n"
+                                           "broken = plugin_kernel:Missing\n")
+    monkeypatch.syspath_prepend(str(site))
+    kernel_registry._found.cache_clear()
+    try:
+        with pytest.warns(KernelPluginWarning, match="'broken' .* left out: it does not load"):
+            names = kernel_names()
+        assert names == (*BUILTIN, "plugin-quintic")
+        assert Scene(dx=0.5, kernel="plugin-quintic").cutoff == pytest.approx(3 * 0.5 * Scene.default("h_factor"))
+    finally:
+        monkeypatch.undo()
+        kernel_registry._found.cache_clear()
+    assert kernel_names() == BUILTIN

@@ -20,6 +20,7 @@ from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
 from pcabench.safeio import save_figure
 from pcabench.stability import UNSTABLE_BY_PREDICTION
+from solvers import kernel_names
 
 from . import paper as P
 from . import tables as T
@@ -383,7 +384,15 @@ def _groups(rows, keys):
     return list(seen.items())
 
 
-KERNEL_COLOURS = {"gaussian": "tab:blue", "wendland-c2": "tab:orange", "wendland-c4": "tab:green"}
+TAB10 = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
+         "tab:olive", "tab:cyan")
+
+
+def kernel_colour(kernel: str) -> str:
+    """A kernel's colour by its place in the registry (the Gaussian blue, Wendland C2 orange, C4 green); grey
+    for a stored kernel not registered here."""
+    names = kernel_names()
+    return TAB10[names.index(kernel) % len(TAB10)] if kernel in names else "grey"
 
 
 def speed_vs_accuracy(points, front, out: Path, pid: str):
@@ -409,7 +418,7 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
             here = [p for p in points if (p["t_final"], p["model"]) == (t_final, model)]
             for (kern, precision), pts in _groups([p for p in here if not p.get("past_limit")],
                                                   ("kernel", "precision")):
-                colour = KERNEL_COLOURS.get(kern, "grey")
+                colour = kernel_colour(kern)
                 ax.plot([p["seconds"] for p in pts], [p["error"] for p in pts], ls="none", marker="o", ms=4.5,
                         color=colour, mfc="none" if precision == "float32" else colour, alpha=0.75,
                         label=f"{kern}, {precision}")

@@ -15,7 +15,8 @@ import pandas as pd
 
 from pcabench import profiles
 from pcabench.record import STEP_STAGES
-from solvers import NUMERICS, STAGES, Scene
+from solvers import DEFAULT_KERNEL, NUMERICS, STAGES, Scene
+from solvers.kernels import truncated
 
 from . import paper as P
 
@@ -332,15 +333,15 @@ def accuracy_bars(series) -> list[dict]:
 
 # ---------------------------------------------------------------- speed against accuracy
 def numerics_label(r) -> str:
-    """The method of a run: kernel, h/dx, cutoff (Gaussian only) and CFL."""
-    kern = r.get("kernel") or "gaussian"
-    cut = f", {r['cutoff_factor']:g}h" if kern == "gaussian" else ""
+    """The method of a run: kernel, h/dx, cutoff (a truncated kernel's only: the Gaussian's) and CFL."""
+    kern = r.get("kernel") or DEFAULT_KERNEL
+    cut = f", {r['cutoff_factor']:g}h" if truncated(kern) else ""
     return f"{kern}, h {r['h_factor']:g}dx{cut}, CFL {r['cfl']:g}"
 
 
 def is_paper_method(r) -> bool:
     """The paper's numerics: the Gaussian at Scene's default h/dx, cutoff, CFL and integrator."""
-    return (r.get("kernel") or "gaussian") == "gaussian" and all(
+    return (r.get("kernel") or DEFAULT_KERNEL) == DEFAULT_KERNEL and all(
         (r[k] == v) if isinstance(v, str) else bool(np.isclose(float(r[k]), v)) for k, v in DEFAULT_NUMERICS.items())
 
 
@@ -375,7 +376,7 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
         if error is None or not np.isfinite(error):
             continue
         points.append({"config": label(r), "method": numerics_label(r), "paper_method": is_paper_method(r),
-                       "kernel": r.get("kernel") or "gaussian", "h_factor": r.h_factor, "cfl": r.cfl,
+                       "kernel": r.get("kernel") or DEFAULT_KERNEL, "h_factor": r.h_factor, "cfl": r.cfl,
                        "integrator": r.integrator, "cutoff_factor": r.cutoff_factor, "precision": r.precision,
                        "model": r.model, "domain": r.domain, "dx": r.dx, "N": int(r.n_particles),
                        "t_final": r.t_final, "seconds": r.t_solution, "error": float(error), "mse": r.mse,
@@ -416,7 +417,7 @@ def predicted_error(p: dict) -> float:
     from solvers.dispersion import predict
 
     scene = {"kernel": p["kernel"], "h_factor": p["h_factor"], "cfl": p["cfl"], "integrator": p["integrator"]}
-    if p["kernel"] == "gaussian":
+    if truncated(p["kernel"]):
         scene["cutoff_factor"] = p.get("cutoff_factor") or Scene.default("cutoff_factor")
     strip = p.get("strip_height")
     strip = None if strip is None or (isinstance(strip, float) and np.isnan(strip)) else strip
@@ -434,7 +435,7 @@ def predicted_by_model(df, dxs=(0.4, 0.2, 0.1)) -> list[dict]:
             if r.empty:
                 continue
             r = r.sort_values("timestamp").iloc[-1]
-            p = {"kernel": "gaussian", "h_factor": r.h_factor, "cfl": r.cfl, "integrator": r.integrator,
+            p = {"kernel": DEFAULT_KERNEL, "h_factor": r.h_factor, "cfl": r.cfl, "integrator": r.integrator,
                  "cutoff_factor": r.cutoff_factor, "dx": dx, "t_final": r.t_final, "strip_height": r.strip_height}
             rows.append({"model": model, "dx": dx, "measured": r.mse, "predicted": predicted_error(p),
                          "isothermal": r.mse_isothermal if model == "lagrangian" else None})
@@ -551,8 +552,8 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
     points, limits = [], []
     for (integ, kern, h, cut, precision, protocol, dx), g in runs.groupby(keys):
         g = g.sort_values("cfl")
-        method = f"{integ}, h = {h:g} dx" + (f", {kern}" if kern != "gaussian" else "")
-        if kern == "gaussian" and not np.isclose(cut, Scene.default("cutoff_factor")):
+        method = f"{integ}, h = {h:g} dx" + (f", {kern}" if kern != DEFAULT_KERNEL else "")
+        if truncated(kern) and not np.isclose(cut, Scene.default("cutoff_factor")):
             method += f", {cut:g}h"
         name = f"{method}, {precision}, {protocol}"
         mine = []

@@ -1,0 +1,18 @@
+"""SPH kernels, one file per kernel (see base.py), found by registry.py."""
+from __future__ import annotations
+
+from .base import Kernel
+from .registry import (
+    DEFAULT_KERNEL,
+    ENTRY_POINT_GROUP,
+    KernelPluginWarning,
+    kernel_named,
+    kernel_names,
+    kernels,
+    register,
+    truncated,
+    unregister,
+)
+
+__all__ = ["Kernel", "DEFAULT_KERNEL", "ENTRY_POINT_GROUP", "KernelPluginWarning", "kernel_named", "kernel_names",
+           "kernels", "register", "truncated", "unregister"]
