@@ -469,7 +469,7 @@ def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
         for i, lim in enumerate(limits):
             if lim["stable_cfl"] > 0:
                 ax.plot([lim["stable_cfl"]] * 2, [i - 0.38, i + 0.38], color="black", lw=1.5, solid_capstyle="butt",
-                        label=None if drawn else "predicted stable CFL")
+                        label=None if drawn else "stable CFL (predicted; long runs where lower)")
                 drawn = True
             else:
                 ax.annotate("predicted: grows at every CFL", (min(cfls), i), xytext=(-4, 6),

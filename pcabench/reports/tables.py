@@ -564,11 +564,13 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
             mine.append({"config": name, "cfl": float(r.cfl), "class": cls, "mse": r.mse,
                          "failed_step": _step_or_none(r.failed_step), "steps": _step_or_none(steps),
                          "stable_cfl": a["stable_cfl"], "past_limit": a["past_limit"],
+                         "limit_from": a["limit_from"], "predicted": a["predicted"],
                          "e_foldings": e_foldings(r, int(r.steps)) if cls == UNSTABLE_BY_PREDICTION else None})
         points += mine
         limits.append({"config": name, "integrator": integ, "kernel": kern, "h_factor": h, "precision": precision,
                        "protocol": protocol, "dx": dx, "cfls": [p["cfl"] for p in mine],
-                       "stable_cfl": mine[0]["stable_cfl"],
+                       "stable_cfl": mine[0]["stable_cfl"], "limit_from": mine[0]["limit_from"],
+                       "predicted": mine[0]["predicted"],
                        "accurate_at": [p["cfl"] for p in mine if p["class"] == "stable"],
                        "inaccurate_at": [(p["cfl"], p["mse"]) for p in mine if p["class"] == "inaccurate"],
                        "blew_up_at": [(p["cfl"], p["failed_step"]) for p in mine if p["class"] == "unstable"],
