@@ -23,6 +23,7 @@ import numpy as np
 from solvers import DEFAULT_KERNEL, DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind
 from solvers.dispersion import predict, stable_cfl
 
+from .parameters import METHOD, NUMERICS, PROBLEM
 from .reports.tables import comparable, default_numerics, error_column, latest, numerics_label
 from .stability import assess, e_foldings
 
@@ -34,34 +35,31 @@ SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
 
 
 def scene_of(r) -> dict:
-    """A stored run's scene parameters (the defaults where the row predates them)."""
-    return {"kernel": r.get("kernel") or DEFAULT_KERNEL, "h_factor": r["h_factor"], "cutoff_factor": r["cutoff_factor"],
+    """A stored run's method and domain (the frame has brought rows that predate a parameter to its default)."""
+    return {"kernel": r["kernel"], "h_factor": r["h_factor"], "cutoff_factor": r["cutoff_factor"],
             "cfl": r["cfl"], "integrator": r["integrator"], "dx": r["dx"], "strip_height": r["strip_height"]}
 
 
 def command(r, t_end: float) -> str:
     """The ``pcabench run`` command line that reproduces stored run ``r``, every word quoted for the shell
-    (shlex): a stored row from a shared store cannot plant shell syntax in a line the user pastes."""
-    s = scene_of(r)
-    words = ["pcabench", "run", "--solver", str(r["solver"]), "--dx", f"{s['dx']:g}", "--t-end", f"{t_end:g}",
+    (shlex): a stored row from a shared store cannot plant shell syntax in a line the user pastes. The
+    problem's and the method's options away from their defaults, as the parameter table names them."""
+    words = ["pcabench", "run", "--solver", str(r["solver"]), "--dx", f"{float(r['dx']):g}", "--t-end", f"{t_end:g}",
              "--model", str(r["model"])]
-    if r.get("scene", Scene.default("name")) != Scene.default("name"):
-        words += ["--scene", str(r["scene"])]
-    if "mach" in r and not np.isclose(float(r["mach"]), Scene.default("mach")):
-        words += ["--mach", f"{float(r['mach']):g}"]
-    for option, key in (("--kernel", "kernel"), ("--h-factor", "h_factor"), ("--cutoff", "cutoff_factor"),
-                        ("--cfl", "cfl"), ("--integrator", "integrator")):
-        value = s[key]
-        if value is not None and value != Scene.default(key):
-            words += [option, f"{value:g}" if isinstance(value, float) else str(value)]
-    if s["strip_height"] is not None and not (isinstance(s["strip_height"], float) and math.isnan(s["strip_height"])):
-        words += ["--strip-height", f"{s['strip_height']:g}"]
-    if r["precision"] != Scene.default("precision"):
-        words += ["--precision", str(r["precision"])]
+    for par in (*PROBLEM, NUMERICS[0], *METHOD):
+        column = "scene" if par.field == "name" else par.field
+        value = r.get(column) if hasattr(r, "get") else None
+        if value is None or (isinstance(value, float) and math.isnan(value)):
+            continue
+        value = float(value) if par.numeric else str(value)
+        if not (np.isclose(value, par.default()) if par.numeric else value == par.default()):
+            words += par.words(value)
+    height = r.get("strip_height")
+    if height is not None and not (isinstance(height, float) and math.isnan(height)):
+        words += ["--strip-height", f"{float(height):g}"]
     if int(r["threads"]) > 1:
         words += ["--threads", str(int(r["threads"]))]
     return shlex.join(words)
-
 
 
 def reaching(df, t_end: float, model: str):
@@ -74,7 +72,7 @@ def reaching(df, t_end: float, model: str):
 def paper_configuration(df):
     """Rows of the paper's numerics: default integrator, CFL, h/dx and cutoff, and the Gaussian kernel."""
     d = default_numerics(df)
-    return d[d["kernel"].fillna(DEFAULT_KERNEL) == DEFAULT_KERNEL] if "kernel" in d else d
+    return d[d["kernel"] == DEFAULT_KERNEL] if "kernel" in d else d
 
 
 def _unstable_row(r, column: str) -> dict:

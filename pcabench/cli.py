@@ -24,22 +24,18 @@ from pathlib import Path
 from solvers import (
     DEFAULT_SCENE,
     DEFAULT_SOLVER,
-    INTEGRATORS,
     MODELS,
-    PRECISIONS,
     Scene,
     SceneError,
     SolverUnavailable,
-    kernel_named,
-    kernel_names,
     registry,
     scene_kind,
     scene_names,
-    scenes,
 )
 
 from . import __version__, jsonout, memory, paths
 from .errors import NoResults
+from .parameters import METHOD, NUMERICS, PARAMETERS, PROBLEM
 from .parser import EXIT_BAD_INPUT, Parser
 from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
@@ -127,33 +123,22 @@ def threads_option(text):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def add_parameter_options(p: argparse.ArgumentParser, parameters, many: bool = False) -> None:
+    """Options for ``parameters`` (pcabench/parameters.py), each with its help and Scene's default."""
+    n = {"nargs": "+"} if many else {}
+    for par in parameters:
+        kind = {"choices": par.choices()} if par.choices else {"type": number(par.option)} if par.numeric else {}
+        p.add_argument(par.option, **kind, **n, help=par.describe())
+
+
 def add_method_options(p: argparse.ArgumentParser, many: bool = False) -> None:
     """The numerical method's options (integrator, kernel, cutoff, h/dx, CFL), with Scene's defaults."""
-    n = {"nargs": "+"} if many else {}
-    d = Scene.default
-    p.add_argument("--integrator", choices=INTEGRATORS, **n, help=f"default {d('integrator')}")
-    compact = "; ".join(f"{k} is cut at its compact support {kernel_named(k).support:g}h"
-                        for k in kernel_names() if kernel_named(k).support is not None)
-    p.add_argument("--kernel", choices=kernel_names(), **n,  # every registered kernel (solvers/kernels/)
-                   help=f"SPH kernel (default {d('kernel')}, truncated at --cutoff" + (f"; {compact})" if compact
-                                                                                         else ")"))
-    p.add_argument("--cutoff", type=number("--cutoff"), **n,
-                   help=f"the Gaussian's cutoff in units of h (default {d('cutoff_factor'):g})")
-    p.add_argument("--h-factor", type=number("--h-factor"), **n, help=f"h / dx (default {d('h_factor'):g})")
-    p.add_argument("--cfl", type=number("--cfl"), **n, help=f"dt * c0 / dx (default {d('cfl'):g})")
+    add_parameter_options(p, METHOD, many)
 
 
 def add_problem_options(p: argparse.ArgumentParser, many: bool = False) -> None:
     """The problem's options: the scene kind and its physical parameters, with Scene's defaults."""
-    n = {"nargs": "+"} if many else {}
-    d = Scene.default
-    p.add_argument("--scene", choices=scene_names(), **n,
-                   help=f"the problem (default {DEFAULT_SCENE}): " + "; ".join(
-                       f"{name}: {kind.summary}" for name, kind in scenes().items()))
-    p.add_argument("--mach", type=number("--mach"), **n, help=f"the pulse's amplitude as a Mach number "
-                   f"(default {d('mach'):g})")
-    p.add_argument("--pulse-width", type=number("--pulse-width"), **n,
-                   help=f"the pulse's width, m (default {d('pulse_width'):g})")
+    add_parameter_options(p, PROBLEM, many)
     if not many:
         p.add_argument("--domain-size", type=number("--domain-size"),
                        help="side of a square scene's domain, m (acoustic-pulse: default 40)")
@@ -162,15 +147,14 @@ def add_problem_options(p: argparse.ArgumentParser, many: bool = False) -> None:
 def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     """The scene's options, with Scene's defaults; ``many``: each takes a list (a study's matrix)."""
     n = {"nargs": "+"} if many else {}
-    d = Scene.default
     add_problem_options(p, many)
     p.add_argument("--dx", type=number("--dx"), required=not many, **n,
                    help="lattice spacing, m (paper: 1 .. 0.004; 0.1 is 100K particles)")
-    p.add_argument("--precision", choices=PRECISIONS, **n, help=f"default {d('precision')}")
+    add_parameter_options(p, NUMERICS[:1], many)
     end = p.add_mutually_exclusive_group()
     end.add_argument("--steps", type=positive_int("--steps"), **n, help="number of steps (default 100, the paper's)")
     end.add_argument("--t-end", type=number("--t-end"), **n, help="physical end time, s")
-    p.add_argument("--model", choices=MODELS, **n, help=f"default {d('model')}")
+    add_parameter_options(p, NUMERICS[1:], many)
     add_method_options(p, many)
     threaded = ", ".join(name for name, cls in registry().items() if cls.threaded)
     loops = {name: cls.pair_loops for name, cls in registry().items() if len(cls.pair_loops) > 1}
@@ -183,9 +167,7 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
                         "in every sweep); default auto: the solver's choice (list where it fits in memory)")
 
 
-SCENE_OPTIONS = {"precision": "precision", "model": "model", "integrator": "integrator", "cutoff": "cutoff_factor",
-                 "kernel": "kernel", "h_factor": "h_factor", "cfl": "cfl", "scene": "name", "mach": "mach",
-                 "pulse_width": "pulse_width"}
+SCENE_OPTIONS = {par.dest: par.field for par in PARAMETERS}  # argparse destination -> Scene field
 # the method and the problem
 ACCURACY_OPTIONS = {opt: key for opt, key in SCENE_OPTIONS.items() if opt not in ("precision", "model")}
 
@@ -621,8 +603,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 # Scene's parameter names as the options a user types (a SceneError names the parameter)
-OPTION_NAMES = {"cutoff_factor": "--cutoff", "t_end": "--t-end", "strip_height": "--strip-height",
-                "h_factor": "--h-factor", "pair_loop": "--pair-loop"}
+OPTION_NAMES = {"t_end": "--t-end", "strip_height": "--strip-height", "pair_loop": "--pair-loop",
+                **{par.field: par.option for par in PARAMETERS if par.option[2:] != par.field and par.field != "name"}}
 LEADING_OPTIONS = ("dx", "cfl", "steps", "threads", "kernel", "integrator", "precision", "model", "solver")
 
 

@@ -136,10 +136,11 @@ def scene_parameters(scene: Scene) -> dict:
 
 
 def stored_parameters(scene: dict) -> dict:
-    """A stored scene dict's own parameters (derived keys dropped), each one a row predates at its default:
-    the value runs had before the parameter existed (rows without ``kernel`` are Gaussian)."""
+    """A stored scene dict's own parameters (derived keys dropped), each one a row predates (absent or null) at
+    its default: the value runs had before the parameter existed (rows without ``kernel`` are Gaussian). The
+    one place old rows are brought up to the current fields (the frame, the resume key, scene_from_row)."""
     fields = Scene.__dataclass_fields__
-    return {k: scene.get(k, fields[k].default) for k in fields if fields[k].compare}
+    return {k: fields[k].default if scene.get(k) is None else scene[k] for k in fields if fields[k].compare}
 
 
 def scene_from_row(row: dict) -> Scene:

@@ -449,9 +449,10 @@ def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
         return None
     configs = [lim["config"] for lim in limits]
     path = out / "stability_map.png"
-    with figure(path, f"Stability map ({pid}): black bar: the predicted stable CFL; past it a run is unstable "
-                "(a hollow X where it ended bounded: too few steps for round-off to grow); inaccurate = bounded but relative "
-                f"RMS > {100 * inaccurate_above:g} %; numbers: the step where a run blew up",
+    with figure(path, f"Stability map ({pid}): black bar: the stable CFL (predicted, or long runs where lower); "
+                "past it a run is unstable (a hollow X where it ended bounded: too few steps for round-off to grow); "
+                f"inaccurate = bounded but relative RMS > {100 * inaccurate_above:g} %; numbers: the step where a run "
+                "blew up",
                 "CFL = dt c0 / dx", "", logx=True, size=(11, 2.1 + 0.32 * len(configs))) as (ax,):
         for cls, (colour, marker) in CLASS_STYLE.items():
             pts = [p for p in points if p["class"] == cls]

@@ -18,7 +18,7 @@ import pandas as pd
 from pcabench import store
 from pcabench.record import STEP_STAGES
 from pcabench.spec import stored_parameters
-from solvers import DEFAULT_KERNEL, DEFAULT_SCENE, registry
+from solvers import registry
 
 SCENE_COLUMNS = ("strip_height", "cutoff_factor", "kernel", "h_factor", "cfl", "t_final", "height", "mach",
                  "pulse_width")
@@ -40,8 +40,7 @@ def _flat(row: dict) -> dict:
     scene = {**stored_parameters(scene), **scene}  # a parameter the row predates at its default (kernel)
     for key in SCENE_COLUMNS:
         r[key] = scene.get(key)
-    r["kernel"] = scene.get("kernel") or DEFAULT_KERNEL  # rows from before the kernel option: the Gaussian
-    r["scene"] = scene.get("name") or DEFAULT_SCENE  # rows from before the scene registry: the paper's
+    r["scene"] = scene["name"]  # rows from before the scene registry: the paper's (stored_parameters)
     # how the run ends: the paper's fixed step count, or a fixed physical time
     r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
     r["domain"] = "strip" if scene.get("strip_height") else "full"

@@ -343,9 +343,10 @@ def _unstable_front_text(rows) -> list[str]:
             "at or past their method's predicted stable CFL that a front ignoring the prediction would hold. "
             "Each ended bounded only because its run was too short: its most unstable mode grew by the "
             "e-foldings shown, while round-off (1e-16) needs about 37 to reach the pulse's size; a finer dx "
-            "or a longer time makes it blow up. For `fixed` and `lagrangian` the limit is their linear part's, "
-            "or where lower the one long runs measured (pcabench/stability.py: the paper's method blows up from "
-            "CFL 4.75 and 4.7 within 300 s, below the linear 4.97).", "",
+            "or a longer time makes it blow up. The limit is the prediction's (for `fixed` and `lagrangian` "
+            "their linear part's), or where lower the one long runs on the scene measured (see 'Stability over "
+            "long runs': on the paper's strip its free ends blow the paper's method up from CFL 4.8, every "
+            "model, below the periodic lattice's 4.97).", "",
             md_table(["model", "t (s)", "method", "dx", "domain", "precision", "time (s)", "error",
                       "stable CFL", "steps", "e-foldings"],
                      [[p["model"], fmt(p["t_final"], "g"), p["method"], fmt(p["dx"], "g"), p["domain"],
@@ -488,7 +489,7 @@ def _long_runs_text(rows, ctx) -> list[str]:
         blew = "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in r["blew_up_at"]) or "none"
         method = f"{r['kernel']}, h = {r['h_factor']:g} dx, {r['integrator']}"
         table.append([r["scene"], f"{r['mach']:g}", r["model"], method, f"{r['dx']:g}",
-                      f"{r['t_end']:g} s ({r['steps']} steps)", ", ".join(f"{c:g}" for c in r["cfls"]),
+                      f"{r['protocol']} (up to {r['steps']} steps)", ", ".join(f"{c:g}" for c in r["cfls"]),
                       _limit_words(r["predicted"]), fmt(r["bounded_to"], "g") if r["bounded_to"] is not None else "none",
                       blew, fmt(r["e_foldings"], ".2g") if r["e_foldings"] is not None else "-",
                       fmt(r["held"], "g") if r["held"] is not None else "prediction"])

@@ -334,14 +334,14 @@ def accuracy_bars(series) -> list[dict]:
 # ---------------------------------------------------------------- speed against accuracy
 def numerics_label(r) -> str:
     """The method of a run: kernel, h/dx, cutoff (a truncated kernel's only: the Gaussian's) and CFL."""
-    kern = r.get("kernel") or DEFAULT_KERNEL
+    kern = r["kernel"]
     cut = f", {r['cutoff_factor']:g}h" if truncated(kern) else ""
     return f"{kern}, h {r['h_factor']:g}dx{cut}, CFL {r['cfl']:g}"
 
 
 def is_paper_method(r) -> bool:
     """The paper's numerics: the Gaussian at Scene's default h/dx, cutoff, CFL and integrator."""
-    return (r.get("kernel") or DEFAULT_KERNEL) == DEFAULT_KERNEL and all(
+    return r["kernel"] == DEFAULT_KERNEL and all(
         (r[k] == v) if isinstance(v, str) else bool(np.isclose(float(r[k]), v)) for k, v in DEFAULT_NUMERICS.items())
 
 
@@ -369,14 +369,16 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
     """
     from pcabench.stability import assess
 
-    pts = latest(df[(df.status == "ok") & df.protocol.str.startswith("t =") & df.model.isin(FRONT_MODELS)])
+    accuracy_runs = df.preset != "stability-long"  # runs to t = 300 s to measure a stable step, not an error
+    pts = latest(df[(df.status == "ok") & df.protocol.str.startswith("t =") & df.model.isin(FRONT_MODELS)
+                    & accuracy_runs])
     points = []
     for _, r in pts.iterrows():
         error = r[error_column(r.model)]
         if error is None or not np.isfinite(error):
             continue
         points.append({"config": label(r), "method": numerics_label(r), "paper_method": is_paper_method(r),
-                       "kernel": r.get("kernel") or DEFAULT_KERNEL, "h_factor": r.h_factor, "cfl": r.cfl,
+                       "kernel": r["kernel"], "h_factor": r.h_factor, "cfl": r.cfl,
                        "integrator": r.integrator, "cutoff_factor": r.cutoff_factor, "precision": r.precision,
                        "model": r.model, "domain": r.domain, "dx": r.dx, "N": int(r.n_particles),
                        "t_final": r.t_final, "seconds": r.t_solution, "error": float(error), "mse": r.mse,
@@ -583,6 +585,11 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
     return points, limits
 
 
+def _fold(x: float) -> float:
+    """e-foldings with the round-off of the step matrix's spectral radius (~1e-13 over a run) as 0."""
+    return 0.0 if x < 1e-9 else x
+
+
 def long_run_limits(df) -> list[dict]:
     """Each model's stable CFL measured by the long-run preset (``pcabench study --stability long``) beside the
     prediction of its linear part and the limit pcabench/stability.py holds for it (what advise uses).
@@ -594,7 +601,8 @@ def long_run_limits(df) -> list[dict]:
     from pcabench.stability import assess, e_foldings, measured_limit
 
     runs = latest(df[df.preset == "stability-long"]) if "preset" in df else df.iloc[:0]
-    keys = ["scene", "mach", "model", "kernel", "h_factor", "cutoff_factor", "integrator", "precision", "dx", "t_end"]
+    keys = ["scene", "mach", "model", "kernel", "h_factor", "cutoff_factor", "integrator", "precision", "dx",
+            "protocol"]
     out = []
     for key, g in runs.groupby(keys, sort=False):
         row = dict(zip(keys, key))
@@ -605,12 +613,11 @@ def long_run_limits(df) -> list[dict]:
                    and (first_blow is None or r.cfl < first_blow)]
         top = g[g.cfl == max(bounded)].iloc[0] if bounded else None
         held = measured_limit(row)
-        row.update(cfls=[float(c) for c in g.cfl], predicted=assess({**row, "model": "linear", "cfl": 1.0})[
-                       "stable_cfl"], bounded_to=max(bounded) if bounded else None, blew_up_from=first_blow,
+        row.update(cfls=[float(c) for c in g.cfl], predicted=assess({**row, "cfl": 1.0})["predicted"], bounded_to=max(bounded) if bounded else None, blew_up_from=first_blow,
                    first_step=blew[0][1] if blew else None, blew_up_at=blew,
                    steps=int(g.steps.max()), other=[(float(r.cfl), r.status) for _, r in g.iterrows()
                                                     if r.status not in ("ok", "unstable")],
-                   e_foldings=e_foldings(top, int(top.steps)) if top is not None else None, held=held)
+                   e_foldings=_fold(e_foldings(top, int(top.steps))) if top is not None else None, held=held)
         out.append(row)
     return out
 

@@ -48,8 +48,12 @@ class PlanePulse(SceneKind):
         return {"mse": err.mse, "me": err.me}
 
     def isothermal_errors(self, scene, fields) -> float | None:
+        """None once the pulse and four widths of its tail have left by the free right end: there is then no
+        pulse to score (against the linear pulse the relative error is NaN then: its reference is zero)."""
         from ..isothermal1d import isothermal_errors
 
+        if scene.pulse_center + scene.c0 * fields.t - 4.0 * scene.pulse_width > scene.x_max:
+            return None
         return isothermal_errors(scene, fields.x, fields.u, fields.t).mse
 
     def predict(self, scene):

@@ -1,0 +1,81 @@
+"""The problem's and the method's parameters, declared once.
+
+Each :class:`Parameter` ties a :class:`solvers.Scene` field (which is also
+the stored record's column: a record stores its scene's parameters) to its
+command-line option, its help and its allowed values. The default, the
+allowed range and the value a row stored before the parameter existed reads
+as are Scene's (``Scene.default``; Scene checks every value in one line;
+:func:`pcabench.spec.stored_parameters` brings an old row up to the current
+fields when the store loads it). The command line builds its options from
+this table, advise writes its commands with it, and the error messages name
+the option a user typed through it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel_names, scene_names, scenes
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One parameter: its Scene field (= record column), its option and what it is (with units)."""
+
+    field: str
+    option: str
+    help: str | Callable[[], str]  # without the default, which Scene states
+    choices: Callable[[], tuple] | None = None  # the allowed values (read at call: the registries grow)
+    numeric: bool = False  # a number checked by Scene (its range there)
+
+    @property
+    def dest(self) -> str:
+        """The argparse destination of :attr:`option`."""
+        return self.option[2:].replace("-", "_")
+
+    def default(self):
+        return Scene.default(self.field)
+
+    def describe(self) -> str:
+        """The option's help: what it is and its default."""
+        text = self.help() if callable(self.help) else self.help
+        value = self.default()
+        return f"{text} (default {value:g})" if isinstance(value, float) else f"{text} (default {value})"
+
+    def words(self, value) -> list[str]:
+        """``[option, value]`` as a command line writes them."""
+        return [self.option, f"{value:g}" if isinstance(value, float) else str(value)]
+
+
+def _kernel_help() -> str:
+    compact = "; ".join(f"{k} is cut at its compact support {kernel_named(k).support:g}h"
+                        for k in kernel_names() if kernel_named(k).support is not None)
+    return "SPH kernel, truncated at --cutoff" + (f" ({compact})" if compact else "")
+
+
+def _scene_help() -> str:
+    return "the problem: " + "; ".join(f"{name}: {kind.summary}" for name, kind in scenes().items())
+
+
+PROBLEM = (
+    Parameter("name", "--scene", _scene_help, scene_names),
+    Parameter("mach", "--mach", "the pulse's amplitude as a Mach number", numeric=True),
+    Parameter("pulse_width", "--pulse-width", "the pulse's width, m", numeric=True),
+)
+NUMERICS = (
+    Parameter("precision", "--precision", "floating-point precision", lambda: PRECISIONS),
+    Parameter("model", "--model", "the physics model", lambda: MODELS),
+)
+METHOD = (
+    Parameter("integrator", "--integrator", "time integrator", lambda: INTEGRATORS),
+    Parameter("kernel", "--kernel", _kernel_help, kernel_names),
+    Parameter("cutoff_factor", "--cutoff", "the Gaussian's cutoff in units of h", numeric=True),
+    Parameter("h_factor", "--h-factor", "h / dx", numeric=True),
+    Parameter("cfl", "--cfl", "dt * c0 / dx", numeric=True),
+)
+PARAMETERS = PROBLEM + NUMERICS + METHOD
+
+
+def parameter(field: str) -> Parameter:
+    """The parameter of Scene field ``field``."""
+    return next(p for p in PARAMETERS if p.field == field)
