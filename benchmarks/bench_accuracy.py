@@ -3,6 +3,7 @@
 asv counts a rise as a regression, which is the right direction for an error
 and for the share of a stage that should stay small.
 """
+
 import time
 
 import numpy as np
@@ -86,8 +87,11 @@ class TrackSceneError:
 
     def setup(self, scene):
         try:
-            self.scene = Scene(dx=0.4, t_end=10.0, model="linear", strip_height=thinnest_strip(0.4)) \
-                if scene == "plane-pulse" else Scene(dx=0.5, t_end=10.0, model="linear", name=scene)
+            self.scene = (
+                Scene(dx=0.4, t_end=10.0, model="linear", strip_height=thinnest_strip(0.4))
+                if scene == "plane-pulse"
+                else Scene(dx=0.5, t_end=10.0, model="linear", name=scene)
+            )
         except TypeError:  # a commit before the scene registry
             raise NotImplementedError(f"no scene {scene} at this commit") from None
 

@@ -5,6 +5,7 @@ inside the measurement. ``track_step_ms`` times the same step with CUDA
 events instead of the host clock. Nothing touches CUDA at import: the check
 runs in ``setup``.
 """
+
 from .common import Prepared, StageBenchmarks, gpu_available, gpu_dx, jit_seconds_in_fresh_process
 
 

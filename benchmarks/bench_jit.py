@@ -2,6 +2,7 @@
 
 Each measurement starts a fresh interpreter, as a new user's first run does.
 """
+
 from .common import jit_seconds_in_fresh_process, solver_names
 
 

@@ -1,4 +1,5 @@
 """Peak resident memory of a run: compile, place the particles, take one step."""
+
 from .common import Prepared, Unsupported, cpu_dx, is_all_pairs, solver_names
 
 

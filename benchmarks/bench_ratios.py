@@ -8,6 +8,7 @@ particles that never move (fixed, linear) against moving ones. Each returns
 t_baseline / t_config (> 1: faster). 100K particles; PCABENCH_BENCH_LARGE=1
 adds 400K.
 """
+
 import time
 
 from .common import Prepared, Unsupported, large
@@ -42,10 +43,10 @@ class TrackSpeedRatios:
 
     def setup(self, dx, against):
         try:
-            self.prepared = {key: Prepared("linkedlist-cpu", precision, dx, threads=threads, pair_loop=loop,
-                                           model=model)
-                             for key, (precision, model, threads, loop) in (("base", BASE),
-                                                                          (against, CONFIGS[against]))}
+            self.prepared = {
+                key: Prepared("linkedlist-cpu", precision, dx, threads=threads, pair_loop=loop, model=model)
+                for key, (precision, model, threads, loop) in (("base", BASE), (against, CONFIGS[against]))
+            }
         except Unsupported as exc:
             raise NotImplementedError(str(exc)) from None
 

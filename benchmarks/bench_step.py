@@ -4,6 +4,7 @@ Compilation and the first step happen in ``setup``, outside the timed region
 (``bench_jit.py`` times compilation on its own). All-pair stops at 16K
 particles; ``PCABENCH_BENCH_LARGE=1`` adds 100K and 400K for the linked list.
 """
+
 from .common import Prepared, StageBenchmarks, Unsupported, cpu_dx, solver_names
 
 

@@ -15,6 +15,7 @@ ends with ``synchronize()``, so a GPU's queued work is inside the timing.
 Nothing here touches CUDA at import: ``gpu_available()`` imports CuPy only
 when asked, and a GPU solver is built only when one exists.
 """
+
 from __future__ import annotations
 
 import abc
@@ -115,8 +116,7 @@ class Unsupported(Exception):
 class Prepared:
     """One solver at steady state on the paper's scene (or ``scene`` overrides)."""
 
-    def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=1, pair_loop=None,
-                 **scene):
+    def __init__(self, solver: str, precision: str = "float64", dx: float = 0.5, threads=1, pair_loop=None, **scene):
         self.scene = Scene(dx=dx, precision=precision, **{"steps": 100, **scene})
         if is_gpu(solver) and not gpu_available():
             raise Unsupported("no CUDA GPU here")
@@ -187,9 +187,11 @@ class StageBenchmarks(abc.ABC):
 
 def jit_seconds_in_fresh_process(solver: str, precision: str) -> float:
     """Compilation time of ``solver`` as a new user meets it: a fresh interpreter, s."""
-    code = (f"from {solvers.__name__} import Scene, make_solver\n"
-            f"s = make_solver({solver!r}); s.input(Scene(dx=1.0, precision={precision!r}))\n"
-            "print(s.warmup())")
+    code = (
+        f"from {solvers.__name__} import Scene, make_solver\n"
+        f"s = make_solver({solver!r}); s.input(Scene(dx=1.0, precision={precision!r}))\n"
+        "print(s.warmup())"
+    )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr.strip()[-400:])

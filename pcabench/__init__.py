@@ -4,4 +4,5 @@ Data flow: scene -> solver (the package ``solvers``) -> stage clock (pcabench.cl
 -> run record (pcabench.record) -> results store (pcabench.store)
 -> reports (pcabench.reports).
 """
+
 __version__ = "0.1.0"

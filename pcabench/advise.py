@@ -12,6 +12,7 @@ error (it ended bounded only because its run was too short for round-off to
 grow). Where no stored run reaches the target, the prediction names the sweep
 that would.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -36,16 +37,33 @@ SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
 
 def scene_of(r) -> dict:
     """A stored run's method and domain (the frame has brought rows that predate a parameter to its default)."""
-    return {"kernel": r["kernel"], "h_factor": r["h_factor"], "cutoff_factor": r["cutoff_factor"],
-            "cfl": r["cfl"], "integrator": r["integrator"], "dx": r["dx"], "strip_height": r["strip_height"]}
+    return {
+        "kernel": r["kernel"],
+        "h_factor": r["h_factor"],
+        "cutoff_factor": r["cutoff_factor"],
+        "cfl": r["cfl"],
+        "integrator": r["integrator"],
+        "dx": r["dx"],
+        "strip_height": r["strip_height"],
+    }
 
 
 def command(r, t_end: float) -> str:
     """The ``pcabench run`` command line that reproduces stored run ``r``, every word quoted for the shell
     (shlex): a stored row from a shared store cannot plant shell syntax in a line the user pastes. The
     problem's and the method's options away from their defaults, as the parameter table names them."""
-    words = ["pcabench", "run", "--solver", str(r["solver"]), "--dx", f"{float(r['dx']):g}", "--t-end", f"{t_end:g}",
-             "--model", str(r["model"])]
+    words = [
+        "pcabench",
+        "run",
+        "--solver",
+        str(r["solver"]),
+        "--dx",
+        f"{float(r['dx']):g}",
+        "--t-end",
+        f"{t_end:g}",
+        "--model",
+        str(r["model"]),
+    ]
     for par in (*PROBLEM, NUMERICS[0], *METHOD):
         column = "scene" if par.field == "name" else par.field
         value = r.get(column) if hasattr(r, "get") else None
@@ -78,10 +96,17 @@ def paper_configuration(df):
 def _unstable_row(r, column: str) -> dict:
     """A run that reached the error past its predicted stable CFL: what it was, never advised."""
     a = assess(r)
-    return {"method": numerics_label(r), "dx": float(r.dx), "cfl": float(r.cfl), "stable_cfl": a["stable_cfl"],
-            "limit_from": a["limit_from"],
-            "error": float(r[column]), "seconds": float(r.t_solution), "steps": int(r.steps),
-            "e_foldings": e_foldings(r, int(r.steps))}
+    return {
+        "method": numerics_label(r),
+        "dx": float(r.dx),
+        "cfl": float(r.cfl),
+        "stable_cfl": a["stable_cfl"],
+        "limit_from": a["limit_from"],
+        "error": float(r[column]),
+        "seconds": float(r.t_solution),
+        "steps": int(r.steps),
+        "e_foldings": e_foldings(r, int(r.steps)),
+    }
 
 
 def _unstable_rows(runs, column: str, most: int = 3) -> list[dict]:
@@ -95,8 +120,9 @@ def _unstable_rows(runs, column: str, most: int = 3) -> list[dict]:
     return rows
 
 
-def advise(df, error: float, t_end: float, model: str = "linear", domain: str | None = None,
-           scene: str = Scene.default("name")) -> dict:
+def advise(
+    df, error: float, t_end: float, model: str = "linear", domain: str | None = None, scene: str = Scene.default("name")
+) -> dict:
     """The fastest stored run of ``scene`` reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``,
     if given) below its predicted stable CFL, the fastest run of the paper's configuration reaching it that compares
     with it, and the ratio. Like is compared with like (``tables.comparable``): the same kind of domain (a
@@ -111,14 +137,26 @@ def advise(df, error: float, t_end: float, model: str = "linear", domain: str | 
     hits = runs[runs[column] <= error] if not runs.empty else runs
     past = np.array([assess(r)["past_limit"] for _, r in hits.iterrows()], bool)
     unstable, hits = hits[past], hits[~past]
-    out = {"error_target": error, "t_end": t_end, "model": model, "runs_considered": int(len(runs)),
-           "error_against": "the isothermal solution" if column == "mse_isothermal" else "the linear pulse"}
+    out = {
+        "error_target": error,
+        "t_end": t_end,
+        "model": model,
+        "runs_considered": int(len(runs)),
+        "error_against": "the isothermal solution" if column == "mse_isothermal" else "the linear pulse",
+    }
     if hits.empty:
         out["found"] = False
         out["unstable_by_prediction"] = _unstable_rows(unstable, column)
-        out["suggestion"] = suggest(error, t_end, model) if scene == Scene.default("name") else {
-            "note": f"no prediction search for the {scene} scene yet: run its front",
-            "paper_dx": None, "smallest_dx_searched": None, "front": f"pcabench study --front --scene {scene}"}
+        out["suggestion"] = (
+            suggest(error, t_end, model)
+            if scene == Scene.default("name")
+            else {
+                "note": f"no prediction search for the {scene} scene yet: run its front",
+                "paper_dx": None,
+                "smallest_dx_searched": None,
+                "front": f"pcabench study --front --scene {scene}",
+            }
+        )
         return out
     best = hits.iloc[0]
     faster = unstable[unstable.t_solution < best.t_solution]
@@ -126,15 +164,28 @@ def advise(df, error: float, t_end: float, model: str = "linear", domain: str | 
     stable = limit["stable_cfl"]
     paper = paper_configuration(hits[[comparable(r, best) for _, r in hits.iterrows()]])
     paper_best = paper.iloc[0] if not paper.empty else None
-    out.update(found=True, command=command(best, t_end), error=float(best[column]), seconds=float(best.t_solution),
-               machine=str(best.machine), solver=str(best.solver), domain=str(best.domain),
-               precision=str(best.precision), commit=str(best.commit)[:12], threads=int(best.threads),
-               n_particles=int(best.n_particles), steps=int(best.steps), **scene_of(best),
-               stable_cfl=stable, cfl_fraction=float(best.cfl) / stable, limit_from=limit["limit_from"],
-               paper_seconds=None if paper_best is None else float(paper_best.t_solution),
-               paper_error=None if paper_best is None else float(paper_best[column]),
-               paper_command=None if paper_best is None else command(paper_best, t_end),
-               unstable_by_prediction=_unstable_rows(faster, column))
+    out.update(
+        found=True,
+        command=command(best, t_end),
+        error=float(best[column]),
+        seconds=float(best.t_solution),
+        machine=str(best.machine),
+        solver=str(best.solver),
+        domain=str(best.domain),
+        precision=str(best.precision),
+        commit=str(best.commit)[:12],
+        threads=int(best.threads),
+        n_particles=int(best.n_particles),
+        steps=int(best.steps),
+        **scene_of(best),
+        stable_cfl=stable,
+        cfl_fraction=float(best.cfl) / stable,
+        limit_from=limit["limit_from"],
+        paper_seconds=None if paper_best is None else float(paper_best.t_solution),
+        paper_error=None if paper_best is None else float(paper_best[column]),
+        paper_command=None if paper_best is None else command(paper_best, t_end),
+        unstable_by_prediction=_unstable_rows(faster, column),
+    )
     out["is_paper_configuration"] = paper_best is not None and out["paper_command"] == out["command"]
     out["speedup_over_paper"] = out["paper_seconds"] / out["seconds"] if out["paper_seconds"] else None
     return out
@@ -162,16 +213,42 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
         scene = Scene(dx=dx, t_end=t_end, model="linear", memory_limit_bytes=2**62)
         if predict(scene).predicted_error <= error:
             paper = scene
-    out = {"paper_dx": None if paper is None else paper.dx, "smallest_dx_searched": min(SEARCH_DX),
-           "note": "predicted from the dispersion relation of the linear part"}
+    out = {
+        "paper_dx": None if paper is None else paper.dx,
+        "smallest_dx_searched": min(SEARCH_DX),
+        "note": "predicted from the dispersion relation of the linear part",
+    }
     if best is not None:
         _, s, p = best
-        out.update(kernel=s.kernel, h_factor=s.h_factor, cfl=s.cfl, dx=s.dx,
-                   predicted_error=p.predicted_error,
-                   study=shlex.join(["pcabench", "study", "--solver", DEFAULT_SOLVER, "--model", model, "--t-end",
-                                     f"{t_end:g}", "--strip", "--kernel", s.kernel,
-                                     "--h-factor", f"{s.h_factor:g}", "--cfl", f"{s.cfl:g}", "--dx", f"{s.dx:g}",
-                                     f"{s.dx / 2:g}"]))
+        out.update(
+            kernel=s.kernel,
+            h_factor=s.h_factor,
+            cfl=s.cfl,
+            dx=s.dx,
+            predicted_error=p.predicted_error,
+            study=shlex.join(
+                [
+                    "pcabench",
+                    "study",
+                    "--solver",
+                    DEFAULT_SOLVER,
+                    "--model",
+                    model,
+                    "--t-end",
+                    f"{t_end:g}",
+                    "--strip",
+                    "--kernel",
+                    s.kernel,
+                    "--h-factor",
+                    f"{s.h_factor:g}",
+                    "--cfl",
+                    f"{s.cfl:g}",
+                    "--dx",
+                    f"{s.dx:g}",
+                    f"{s.dx / 2:g}",
+                ]
+            ),
+        )
     return out
 
 
@@ -181,14 +258,16 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
     lines = []
     primary = scene_kind(scene).primary
     scene_words = "" if scene == DEFAULT_SCENE else f"{scene}, "
-    head = (f"{scene_words}{model} to a relative RMS error of {primary} <= {error:g} "
-            f"(against {out['error_against']}) at "
-            f"t = {t_end:g} s on {out['machine']}"
-            + (f", {domain} domain" if domain else ""))
+    head = (
+        f"{scene_words}{model} to a relative RMS error of {primary} <= {error:g} "
+        f"(against {out['error_against']}) at "
+        f"t = {t_end:g} s on {out['machine']}" + (f", {domain} domain" if domain else "")
+    )
     if not out["found"]:
         s = out["suggestion"]
-        lines.append(f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted "
-                     "stable CFL.")
+        lines.append(
+            f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL."
+        )
         lines += unstable_lines(out["unstable_by_prediction"], "runs that reach it")
         if "front" in s:
             lines.append(f"{s['note']}:\n  {s['front']}")
@@ -196,31 +275,44 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
         if "study" not in s:
             lines.append("no method of the searched grid is predicted to reach it")
         else:
-            lines.append(f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, "
-                         f"CFL {s['cfl']:g}, dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); "
-                         f"run:\n  {s['study']}")
-        lines.append(f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)" if s["paper_dx"] else
-                     f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m "
-                     "(the smallest searched)")
+            lines.append(
+                f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, "
+                f"CFL {s['cfl']:g}, dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); "
+                f"run:\n  {s['study']}"
+            )
+        lines.append(
+            f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)"
+            if s["paper_dx"]
+            else f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)"
+        )
         return "\n".join(lines), False
-    lines.append(f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
-                 f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
-                 + (f"stable {out['stable_cfl']:.3g} measured over long runs" if out["limit_from"] == "long runs" else
-                    f"predicted stable {out['stable_cfl']:.3g}{'' if model == 'linear' else ' (its linear part)'}")
-                 + f", dx {out['dx']:g}, "
-                 f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
-                 f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
-                 f"commit {out['commit'][:7]})\n  {out['command']}")
+    lines.append(
+        f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
+        f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
+        + (
+            f"stable {out['stable_cfl']:.3g} measured over long runs"
+            if out["limit_from"] == "long runs"
+            else f"predicted stable {out['stable_cfl']:.3g}{'' if model == 'linear' else ' (its linear part)'}"
+        )
+        + f", dx {out['dx']:g}, "
+        f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
+        f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
+        f"commit {out['commit'][:7]})\n  {out['command']}"
+    )
     if out["is_paper_configuration"]:
         lines.append("  this is the paper's configuration: none faster reaches the error")
     elif out["paper_seconds"]:
-        lines.append(f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
-                     f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}")
+        lines.append(
+            f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
+            f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}"
+        )
     else:
         other = {"strip": "full", "full": "strip"}[out["domain"]]
-        lines.append(f"  no stored run of the paper's configuration on the {out['domain']} domain with the same "
-                     f"threads and commit reaches it; `pcabench advise --domain {other}` looks at the {other} "
-                     "domain's runs")
+        lines.append(
+            f"  no stored run of the paper's configuration on the {out['domain']} domain with the same "
+            f"threads and commit reaches it; `pcabench advise --domain {other}` looks at the {other} "
+            "domain's runs"
+        )
     lines += unstable_lines(out["unstable_by_prediction"], "faster runs")
     return "\n".join(lines), True
 
@@ -229,13 +321,20 @@ def unstable_lines(rows, what: str) -> list[str]:
     """The lines naming advise's runs past their predicted stable CFL that reached the error: never advised."""
     lines = []
     if rows:
-        lines.append(f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a "
-                     "longer run or a finer dx grows them without bound)")
+        lines.append(
+            f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a "
+            "longer run or a finer dx grows them without bound)"
+        )
     for r in rows:
-        which = (f"predicted stable {r['stable_cfl']:.3g}" if r["limit_from"] == "prediction"
-                 else f"stable {r['stable_cfl']:.3g} measured over long runs")
+        which = (
+            f"predicted stable {r['stable_cfl']:.3g}"
+            if r["limit_from"] == "prediction"
+            else f"stable {r['stable_cfl']:.3g} measured over long runs"
+        )
         limit = f"CFL {r['cfl']:g} is past the {which}" if r["stable_cfl"] > 0 else "its integrator grows at every CFL"
-        lines.append(f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
-                     f"bounded only because its {r['steps']} steps gave the most unstable mode "
-                     f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)")
+        lines.append(
+            f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
+            f"bounded only because its {r['steps']} steps gave the most unstable mode "
+            f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)"
+        )
     return lines

@@ -5,6 +5,7 @@ asv reads ``~/.asv-machine.json``; every key of a machine's entry lands in the
 entry: the machine name is the profile id, ``cpu`` and ``ram`` come from the
 profile, and ``gpu`` and ``pcabench_profile`` are extra keys.
 """
+
 from __future__ import annotations
 
 import json
@@ -18,13 +19,20 @@ def entry(profile: dict) -> dict:
     cpu, gpu = profile.get("cpu") or {}, profile.get("gpu") or {}
     gpu_text = "none"
     if gpu:
-        gpu_text = (f"{gpu.get('name')}, {gpu.get('memory_bytes', 0) / 2**30:.0f} GiB, "
-                    f"compute capability {gpu.get('compute_capability')}, driver {gpu.get('driver')}")
-    return {"machine": profile["id"], "os": profile.get("os") or platform.platform(),
-            "arch": cpu.get("machine") or platform.machine(),
-            "cpu": f"{cpu.get('model', 'unknown CPU')} ({cpu.get('cores_usable', '?')} cores usable)",
-            "num_cpu": str(cpu.get("logical_cores", os.cpu_count())), "ram": str(profile.get("memory_bytes", "")),
-            "gpu": gpu_text, "pcabench_profile": profile["id"]}
+        gpu_text = (
+            f"{gpu.get('name')}, {gpu.get('memory_bytes', 0) / 2**30:.0f} GiB, "
+            f"compute capability {gpu.get('compute_capability')}, driver {gpu.get('driver')}"
+        )
+    return {
+        "machine": profile["id"],
+        "os": profile.get("os") or platform.platform(),
+        "arch": cpu.get("machine") or platform.machine(),
+        "cpu": f"{cpu.get('model', 'unknown CPU')} ({cpu.get('cores_usable', '?')} cores usable)",
+        "num_cpu": str(cpu.get("logical_cores", os.cpu_count())),
+        "ram": str(profile.get("memory_bytes", "")),
+        "gpu": gpu_text,
+        "pcabench_profile": profile["id"],
+    }
 
 
 def write(profile: dict, path: Path | None = None) -> str:

@@ -10,6 +10,7 @@ ignored ``.asv-*.conf.json`` at the root, so the config's relative paths still
 hold) whose results folder is a scratch one; the README, ``.ci/run`` and
 ``device_payload`` all run asv through it.
 """
+
 from __future__ import annotations
 
 import json
@@ -23,10 +24,12 @@ RESULTS_LINE = '"results_dir": "reports/asv/results"'
 SCRATCH = Path(".asv") / "smoke" / "results"  # under the ignored .asv/
 # One benchmark of each kind, at the smallest size (asv matches "name(param, ...)"): a timed step of both CPU
 # solvers, the stage shares, the JIT time in a fresh interpreter, and a GPU step (skips cleanly without a GPU).
-SELECTION = (r"TimeStep\.time_step\('(allpair|linkedlist)-cpu', 'float64', 1\.0\)",
-             r"TrackStageShare\.track_share\('float64', 'pi'\)",
-             r"TrackJIT\.track_jit_seconds\('linkedlist-cpu', 'float64'\)",
-             r"TimeGPUStep\.time_step\('float32', 0\.1\)")
+SELECTION = (
+    r"TimeStep\.time_step\('(allpair|linkedlist)-cpu', 'float64', 1\.0\)",
+    r"TrackStageShare\.track_share\('float64', 'pi'\)",
+    r"TrackJIT\.track_jit_seconds\('linkedlist-cpu', 'float64'\)",
+    r"TimeGPUStep\.time_step\('float32', 0\.1\)",
+)
 
 
 def scratch_config(results: Path, root: Path = ROOT, name: str = "smoke") -> Path:
@@ -44,13 +47,17 @@ def main(argv=None) -> int:
 
     p = Parser(prog="python -m pcabench.asv_smoke", description=__doc__.split("\n")[0])
     p.add_argument("--machine", help="asv's machine name (default: `pcabench profile --asv`, which writes it)")
-    p.add_argument("--results", type=Path, default=SCRATCH,
-                   help=f"the scratch results folder (default {SCRATCH}, git-ignored)")
+    p.add_argument(
+        "--results", type=Path, default=SCRATCH, help=f"the scratch results folder (default {SCRATCH}, git-ignored)"
+    )
     p.add_argument("--check", action="store_true", help="run `asv check` first")
     args = p.parse_args(argv)
     if args.results.resolve().is_relative_to((ROOT / "reports").resolve()):
-        print(f"asv_smoke: error: --results {args.results}: under reports/, where the committed results are; "
-              "pick a scratch folder", file=sys.stderr)
+        print(
+            f"asv_smoke: error: --results {args.results}: under reports/, where the committed results are; "
+            "pick a scratch folder",
+            file=sys.stderr,
+        )
         return 2
     machine = args.machine
     if not machine:
@@ -63,8 +70,16 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     if args.check and subprocess.run([*asv, "check", "--python=same"], cwd=ROOT).returncode:
         return 1
-    run = [*asv, "run", "--python=same", "--quick", "--show-stderr", "--machine", machine,
-           *(a for b in SELECTION for a in ("-b", b))]
+    run = [
+        *asv,
+        "run",
+        "--python=same",
+        "--quick",
+        "--show-stderr",
+        "--machine",
+        machine,
+        *(a for b in SELECTION for a in ("-b", b)),
+    ]
     rc = subprocess.run(run, cwd=ROOT).returncode
     print(f"asv smoke run: exit {rc} in {time.perf_counter() - t0:.0f} s; results in {args.results}", file=sys.stderr)
     return rc

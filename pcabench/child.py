@@ -12,6 +12,7 @@ so a progress line always reports the record this child made. Its record
 carries the sweep's machine id and commit (``PCABENCH_MACHINE_ID``
 and ``PCABENCH_COMMIT``, set by the parent).
 """
+
 from __future__ import annotations
 
 import json

@@ -10,6 +10,7 @@ Library code raises exceptions; this module alone maps them to the exit
 codes of :data:`EXIT_HELP` (bad input is one line naming the parameter and its
 allowed range, never a traceback).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -79,7 +80,6 @@ integrators:
   rk2     explicit midpoint"""
 
 
-
 # ---------------------------------------------------------------- option types
 DECIMAL = re.compile(r"[+-]?((\d+\.?\d*|\.\d+)(e[+-]?\d+)?|nan|inf|infinity)", re.ASCII | re.I)  # ASCII, as typed
 
@@ -92,6 +92,7 @@ def positive_int(name):
         if value < 1:
             raise argparse.ArgumentTypeError(f"{name} must be an integer >= 1 (got {value})")
         return value
+
     return parse
 
 
@@ -105,6 +106,7 @@ def number(name, low: float | None = None):
         if low is not None and value < low:
             raise argparse.ArgumentTypeError(f"{name} must be at least {low:g} (got {text!r})")
         return value
+
     return parse
 
 
@@ -113,6 +115,7 @@ def folder(name):
         if not text.strip():
             raise argparse.ArgumentTypeError(f"{name} needs a folder (got {text!r})")
         return text
+
     return parse
 
 
@@ -140,16 +143,24 @@ def add_problem_options(p: argparse.ArgumentParser, many: bool = False) -> None:
     """The problem's options: the scene kind and its physical parameters, with Scene's defaults."""
     add_parameter_options(p, PROBLEM, many)
     if not many:
-        p.add_argument("--domain-size", type=number("--domain-size"),
-                       help="side of a square scene's domain, m (acoustic-pulse: default 40)")
+        p.add_argument(
+            "--domain-size",
+            type=number("--domain-size"),
+            help="side of a square scene's domain, m (acoustic-pulse: default 40)",
+        )
 
 
 def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     """The scene's options, with Scene's defaults; ``many``: each takes a list (a study's matrix)."""
     n = {"nargs": "+"} if many else {}
     add_problem_options(p, many)
-    p.add_argument("--dx", type=number("--dx"), required=not many, **n,
-                   help="lattice spacing, m (paper: 1 .. 0.004; 0.1 is 100K particles)")
+    p.add_argument(
+        "--dx",
+        type=number("--dx"),
+        required=not many,
+        **n,
+        help="lattice spacing, m (paper: 1 .. 0.004; 0.1 is 100K particles)",
+    )
     add_parameter_options(p, NUMERICS[:1], many)
     end = p.add_mutually_exclusive_group()
     end.add_argument("--steps", type=positive_int("--steps"), **n, help="number of steps (default 100, the paper's)")
@@ -158,13 +169,22 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
     add_method_options(p, many)
     threaded = ", ".join(name for name, cls in registry().items() if cls.threaded)
     loops = {name: cls.pair_loops for name, cls in registry().items() if len(cls.pair_loops) > 1}
-    p.add_argument("--threads", type=threads_option, **n,
-                   help=f"CPU threads for {threaded}: N or 'all' (default 1: serial, like the paper's CPU code)")
-    p.add_argument("--pair-loop", choices=("auto", *dict.fromkeys(x for v in loops.values() for x in v)), **n,
-                   help="the pair loop of a solver with several (" + "; ".join(
-                       f"{name}: {', '.join(v)}" for name, v in loops.items()) + "): list visits each pair once "
-                        "per search and keeps its kernel factors, gather is the paper's (every particle's stencil "
-                        "in every sweep); default auto: the solver's choice (list where it fits in memory)")
+    p.add_argument(
+        "--threads",
+        type=threads_option,
+        **n,
+        help=f"CPU threads for {threaded}: N or 'all' (default 1: serial, like the paper's CPU code)",
+    )
+    p.add_argument(
+        "--pair-loop",
+        choices=("auto", *dict.fromkeys(x for v in loops.values() for x in v)),
+        **n,
+        help="the pair loop of a solver with several ("
+        + "; ".join(f"{name}: {', '.join(v)}" for name, v in loops.items())
+        + "): list visits each pair once "
+        "per search and keeps its kernel factors, gather is the paper's (every particle's stencil "
+        "in every sweep); default auto: the solver's choice (list where it fits in memory)",
+    )
 
 
 SCENE_OPTIONS = {par.dest: par.field for par in PARAMETERS}  # argparse destination -> Scene field
@@ -185,8 +205,15 @@ def domain_of(args) -> dict:
 def scene_from_args(args) -> Scene:
     """The scene of the options, bounded by the memory this process may use (one line if it does not fit)."""
     given = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt) is not None}
-    return Scene(dx=args.dx, steps=args.steps, t_end=args.t_end, strip_height=args.strip_height,
-                 memory_limit_bytes=memory.available_memory_bytes(), **given, **domain_of(args))
+    return Scene(
+        dx=args.dx,
+        steps=args.steps,
+        t_end=args.t_end,
+        strip_height=args.strip_height,
+        memory_limit_bytes=memory.available_memory_bytes(),
+        **given,
+        **domain_of(args),
+    )
 
 
 def check_output_path(path, option: str) -> None:
@@ -235,7 +262,7 @@ def cmd_run(args) -> int:
     from .study import check_specs
 
     # resolved once, and checked: the solver can run here (a GPU for a GPU solver), before anything is printed
-    spec, = check_specs([RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto")])
+    (spec,) = check_specs([RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto")])
     if args.fields is not None:
         if args.fields.strip() and not args.fields.endswith(".npz"):
             args.fields += ".npz"  # as numpy.savez names it
@@ -272,15 +299,33 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
 
     if args.dx:
         lists = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt)}
-        return "matrix", matrix(args.solver or [DEFAULT_SOLVER], args.dx, threads=args.threads or [SERIAL],
-                                steps=args.steps or [None], t_ends=args.t_end or [None], strip=args.strip,
-                                pair_loops=args.pair_loop or ["auto"], **lists)
+        return "matrix", matrix(
+            args.solver or [DEFAULT_SOLVER],
+            args.dx,
+            threads=args.threads or [SERIAL],
+            steps=args.steps or [None],
+            t_ends=args.t_end or [None],
+            strip=args.strip,
+            pair_loops=args.pair_loop or ["auto"],
+            **lists,
+        )
     scene = args.scene or [DEFAULT_SCENE]
-    if any(getattr(args, opt) for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")
-           if opt != "scene") or args.strip:
+    if (
+        any(
+            getattr(args, opt)
+            for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")
+            if opt != "scene"
+        )
+        or args.strip
+    ):
         raise OptionError("--dx is needed to build a matrix from the scene options (or use a preset alone)")
-    name = "paper" if args.paper else {"short": "stability", "long": "stability-long"}[args.stability] \
-        if args.stability else {None: "quick", "quick": "front", "full": "front-full"}[args.front]
+    name = (
+        "paper"
+        if args.paper
+        else {"short": "stability", "long": "stability-long"}[args.stability]
+        if args.stability
+        else {None: "quick", "quick": "front", "full": "front-full"}[args.front]
+    )
     if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not name.startswith("front")):
         raise OptionError("--scene with a preset: one scene, with --front (the other presets are the paper's scene)")
     return name, preset(name, scene[0])
@@ -304,8 +349,16 @@ def cmd_study(args) -> int:
         check_folder(paths.user_profiles(), home_option())  # where the sweep saves this machine's profile
     if not args.no_report:
         check_folder(args.reports, "--reports")  # before the sweep, not after it
-    return run_study(name, specs, Path(args.results), None if args.no_report else Path(args.reports), run_budget,
-                     args.sweep_budget, cluster=args.cluster, retry_failed=args.retry_failed)
+    return run_study(
+        name,
+        specs,
+        Path(args.results),
+        None if args.no_report else Path(args.reports),
+        run_budget,
+        args.sweep_budget,
+        cluster=args.cluster,
+        retry_failed=args.retry_failed,
+    )
 
 
 def cmd_report(args) -> int:
@@ -347,12 +400,15 @@ def cmd_runs(args) -> int:
                 raise OptionError(exc.args[0]) from None
             print(runs.render(out) if not out.empty else "no configuration was run by both")
         else:
-            out = runs.table(df, solver=args.solver, status=args.status, machine=args.machine, commit=args.commit,
-                             model=args.model)
+            out = runs.table(
+                df, solver=args.solver, status=args.status, machine=args.machine, commit=args.commit, model=args.model
+            )
             print(runs.render(out.tail(args.limit)) if not out.empty else f"no stored runs match in {results}")
             if len(out) > args.limit:
-                print(f"(the last {args.limit} of {len(out)} matching runs, by machine and time; --limit {len(out)} "
-                      "shows them all)")
+                print(
+                    f"(the last {args.limit} of {len(out)} matching runs, by machine and time; --limit {len(out)} "
+                    "shows them all)"
+                )
     return 0
 
 
@@ -367,27 +423,42 @@ def cmd_accuracy(args) -> int:
         print(jsonout.dumps({"scene": scene.as_dict(), **p.as_dict(), "past_stable_cfl": past}, sort_keys=True))
         return 0
     if past:
-        print(f"CFL {scene.cfl:g} is past the largest stable CFL {p.stable_cfl:.3g} of {scene.integrator}: a run "
-              "grows without bound (the predicted error is that growth)" if p.stable_cfl > 0 else
-              f"{scene.integrator} grows at every CFL: a long enough run grows without bound")
-    print(f"{scene.describe()}\n"
-          f"predicted relative RMS error of {scene.kind.primary} at t = {p.t_end:.4g} s: {p.predicted_error:.4g} "
-          f"(max error {p.predicted_me:.3g} {'m/s' if scene.kind.primary == 'u' else 'kg/m^3'})\n"
-          f"largest stable CFL (dt c0 / dx) for {scene.integrator}: {p.stable_cfl:.4g}"
-          f"{' (grows at any step)' if p.stable_cfl == 0 else ''}\n"
-          f"phase speed error at k = 1/w: lattice {100 * p.lattice_phase_error:+.3f} %, with the step "
-          f"{100 * p.step_phase_error:+.3f} %"
-          + ("" if p.lattice_phase_error_diagonal is None else
-             f" along the lattice's axis; along its diagonal {100 * p.lattice_phase_error_diagonal:+.3f} % and "
-             f"{100 * p.step_phase_error_diagonal:+.3f} %"))
+        print(
+            f"CFL {scene.cfl:g} is past the largest stable CFL {p.stable_cfl:.3g} of {scene.integrator}: a run "
+            "grows without bound (the predicted error is that growth)"
+            if p.stable_cfl > 0
+            else f"{scene.integrator} grows at every CFL: a long enough run grows without bound"
+        )
+    print(
+        f"{scene.describe()}\n"
+        f"predicted relative RMS error of {scene.kind.primary} at t = {p.t_end:.4g} s: {p.predicted_error:.4g} "
+        f"(max error {p.predicted_me:.3g} {'m/s' if scene.kind.primary == 'u' else 'kg/m^3'})\n"
+        f"largest stable CFL (dt c0 / dx) for {scene.integrator}: {p.stable_cfl:.4g}"
+        f"{' (grows at any step)' if p.stable_cfl == 0 else ''}\n"
+        f"phase speed error at k = 1/w: lattice {100 * p.lattice_phase_error:+.3f} %, with the step "
+        f"{100 * p.step_phase_error:+.3f} %"
+        + (
+            ""
+            if p.lattice_phase_error_diagonal is None
+            else f" along the lattice's axis; along its diagonal {100 * p.lattice_phase_error_diagonal:+.3f} % and "
+            f"{100 * p.step_phase_error_diagonal:+.3f} %"
+        )
+    )
     for name, value in (p.measures or {}).items():
         print(f"predicted {name.replace('_', ' ')}: {value:.4g}")
     return 0
 
 
 # advise's numbers printed to 3 significant digits (the scene's own parameters stay exact)
-ROUNDED_AS_PRINTED = ("error", "seconds", "stable_cfl", "paper_seconds", "paper_error", "speedup_over_paper",
-                      "unstable_by_prediction")
+ROUNDED_AS_PRINTED = (
+    "error",
+    "seconds",
+    "stable_cfl",
+    "paper_seconds",
+    "paper_error",
+    "speedup_over_paper",
+    "unstable_by_prediction",
+)
 
 
 def cmd_advise(args) -> int:
@@ -406,10 +477,12 @@ def cmd_advise(args) -> int:
         mach = Scene.default("mach") if args.mach is None else args.mach
         df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach)]
     if df is None or df.empty:
-        raise NoResults(f"no stored runs of the {args.scene} scene at --mach "
-                        f"{Scene.default('mach') if args.mach is None else args.mach:g} in {results}: run "
-                        f"`pcabench study --front{'' if args.scene == DEFAULT_SCENE else ' --scene ' + args.scene}` "
-                        "first, or use --reference")
+        raise NoResults(
+            f"no stored runs of the {args.scene} scene at --mach "
+            f"{Scene.default('mach') if args.mach is None else args.mach:g} in {results}: run "
+            f"`pcabench study --front{'' if args.scene == DEFAULT_SCENE else ' --scene ' + args.scene}` "
+            "first, or use --reference"
+        )
     machines = df.machine.value_counts()
     if args.machine:
         named = runs.machines(machines.index, args.machine)  # a machine's name, or a prefix of one
@@ -419,8 +492,11 @@ def cmd_advise(args) -> int:
         machine = named[0]
     else:
         machine = machine_id() if machine_id() in machines else machines.index[0]
-    out = {"machine": machine, "scene": args.scene,
-           **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain, args.scene)}
+    out = {
+        "machine": machine,
+        "scene": args.scene,
+        **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain, args.scene),
+    }
     if args.json:  # the numbers the text prints, rounded as it prints them
         shown = {key: jsonout.significant(out[key]) for key in ROUNDED_AS_PRINTED if out.get(key) is not None}
         if out.get("cfl_fraction") is not None:
@@ -451,8 +527,9 @@ def cmd_profile(args) -> int:
 def cmd_gpu_check(args) -> int:
     from .gpu_check import gpu_check
 
-    return gpu_check(Path(args.out), Path(args.results), Path(args.reports), budget_s=args.budget,
-                     rehearse=args.rehearse)
+    return gpu_check(
+        Path(args.out), Path(args.results), Path(args.reports), budget_s=args.budget, rehearse=args.rehearse
+    )
 
 
 def cmd_check_solver(args) -> int:
@@ -463,60 +540,97 @@ def cmd_check_solver(args) -> int:
 
 # ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
-    parser = Parser(prog="pcabench", description=DESCRIPTION, epilog=EXIT_HELP,
-                    formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = Parser(
+        prog="pcabench", description=DESCRIPTION, epilog=EXIT_HELP, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--version", action="version", version=f"pcabench {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     results_help = f"folder of results stores, *.jsonl (default: {paths.user_results()})"
     reports_help = f"folder for the reports (default: {paths.user_reports()})"
 
-    p = sub.add_parser("run", help="run one scene on one solver and print the stage table",
-                       epilog=solver_help() + "\n" + MODEL_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = sub.add_parser(
+        "run",
+        help="run one scene on one solver and print the stage table",
+        epilog=solver_help() + "\n" + MODEL_HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("--solver", required=True, choices=registry())
     add_scene_options(p, many=False)
-    p.add_argument("--strip-height", type=number("--strip-height"),
-                   help="replace the 20 m height by a y-periodic strip of this height, m")
+    p.add_argument(
+        "--strip-height",
+        type=number("--strip-height"),
+        help="replace the 20 m height by a y-periodic strip of this height, m",
+    )
     p.add_argument("--fields", help="write the final fields (x, y, u, v, drho, t) to this .npz")
     p.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
-    p.add_argument("--run-budget", type=number("--run-budget"),
-                   help="seconds before the run stops and is reported as a timeout (exit 1; default: no limit)")
+    p.add_argument(
+        "--run-budget",
+        type=number("--run-budget"),
+        help="seconds before the run stops and is reported as a timeout (exit 1; default: no limit)",
+    )
     p.set_defaults(func=cmd_run)
 
-    p = sub.add_parser("study", help="run a sweep (each run in its own process) and write the report",
-                       description="Run a preset, or the product of the matrix options, one process per run.",
-                       epilog=solver_help() + "\n" + MODEL_HELP, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = sub.add_parser(
+        "study",
+        help="run a sweep (each run in its own process) and write the report",
+        description="Run a preset, or the product of the matrix options, one process per run.",
+        epilog=solver_help() + "\n" + MODEL_HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     g = p.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="a few minutes on a laptop CPU (default)")
     g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets")
-    g.add_argument("--stability", nargs="?", const="short", choices=("short", "long"),
-                   help="short: CFL x integrator x h/dx, run length and float32, the stability map (92 runs); "
-                        "long: each model at CFL 4.4-5 to t = 300 s, the moving models' own limit (24 runs)")
-    g.add_argument("--front", nargs="?", const="quick", choices=("quick", "full"),
-                   help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
-                        "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the "
-                        "predicted fastest, serial (quick: 296 runs; full: 2408)")
+    g.add_argument(
+        "--stability",
+        nargs="?",
+        const="short",
+        choices=("short", "long"),
+        help="short: CFL x integrator x h/dx, run length and float32, the stability map (92 runs); "
+        "long: each model at CFL 4.4-5 to t = 300 s, the moving models' own limit (24 runs)",
+    )
+    g.add_argument(
+        "--front",
+        nargs="?",
+        const="quick",
+        choices=("quick", "full"),
+        help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
+        "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the "
+        "predicted fastest, serial (quick: 296 runs; full: 2408)",
+    )
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
     m.add_argument("--solver", nargs="+", choices=registry())
     add_scene_options(m, many=True)
     m.add_argument("--strip", action="store_true", help="the thinnest y-periodic strip instead of 20 m")
     p.add_argument("--results", type=folder("--results"), default=str(paths.user_results()), help=results_help)
     p.add_argument("--reports", type=folder("--reports"), default=str(paths.user_reports()), help=reports_help)
-    p.add_argument("--run-budget", type=number("--run-budget"), help="seconds per run before it is a timeout "
-                   "(default: quick 120, paper 900, stability 120, stability long 300, matrix 900)")
-    p.add_argument("--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0,
-                   help="seconds for the whole sweep")
+    p.add_argument(
+        "--run-budget",
+        type=number("--run-budget"),
+        help="seconds per run before it is a timeout "
+        "(default: quick 120, paper 900, stability 120, stability long 300, matrix 900)",
+    )
+    p.add_argument(
+        "--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0, help="seconds for the whole sweep"
+    )
     p.add_argument("--no-report", action="store_true", help="store the runs, do not write the reports")
-    p.add_argument("--cluster", metavar="ADDRESS",
-                   help="run each run as a Dask task: a scheduler address (tcp://host:8786) or local:N for a "
-                        "LocalCluster of N workers (pip install -e \".[cluster]\")")
-    p.add_argument("--retry-failed", action="store_true",
-                   help="run again the stored runs that timed out, were skipped or ended in an error")
+    p.add_argument(
+        "--cluster",
+        metavar="ADDRESS",
+        help="run each run as a Dask task: a scheduler address (tcp://host:8786) or local:N for a "
+        'LocalCluster of N workers (pip install -e ".[cluster]")',
+    )
+    p.add_argument(
+        "--retry-failed",
+        action="store_true",
+        help="run again the stored runs that timed out, were skipped or ended in an error",
+    )
     p.set_defaults(func=cmd_study)
 
     p = sub.add_parser("report", help="regenerate the reports from the stored results")
-    p.add_argument("--reference", action="store_true",
-                   help="the committed reference: reports/results -> reports/ of the checkout")
+    p.add_argument(
+        "--reference", action="store_true", help="the committed reference: reports/results -> reports/ of the checkout"
+    )
     p.add_argument("--results", type=folder("--results"), help=results_help)
     p.add_argument("--out", type=folder("--out"), help=reports_help)
     p.add_argument("--scene", choices=scene_names(), help="only this scene's runs (default: every scene)")
@@ -531,18 +645,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--commit", help="a commit prefix")
     p.add_argument("--model")
     p.add_argument("--scene", help="only the runs of this scene (plane-pulse, acoustic-pulse, ...)")
-    p.add_argument("--compare", nargs=2, metavar=("A", "B"),
-                   help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, "
-                        "ratio, errors")
-    p.add_argument("--limit", type=positive_int("--limit"), default=200,
-                   help="print at most the last this many matching runs, by machine and time (default 200; a line "
-                        "says when rows were left out)")
+    p.add_argument(
+        "--compare",
+        nargs=2,
+        metavar=("A", "B"),
+        help="the runs both A and B made (machines or prefixes of them, or commit prefixes): step times, ratio, errors",
+    )
+    p.add_argument(
+        "--limit",
+        type=positive_int("--limit"),
+        default=200,
+        help="print at most the last this many matching runs, by machine and time (default 200; a line "
+        "says when rows were left out)",
+    )
     p.set_defaults(func=cmd_runs)
 
-    p = sub.add_parser("accuracy", help="predict a run's error and largest stable CFL from the dispersion relation",
-                       description="The relative RMS error of u at --t-end and the largest stable CFL of the "
-                                   "`linear` model, from the lattice's SPH operator and the integrator's step, "
-                                   "with no simulation (for fixed and lagrangian: their linear part).")
+    p = sub.add_parser(
+        "accuracy",
+        help="predict a run's error and largest stable CFL from the dispersion relation",
+        description="The relative RMS error of u at --t-end and the largest stable CFL of the "
+        "`linear` model, from the lattice's SPH operator and the integrator's step, "
+        "with no simulation (for fixed and lagrangian: their linear part).",
+    )
     p.add_argument("--dx", type=number("--dx"), required=True, help="lattice spacing, m")
     p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical end time, s (default 10)")
     add_problem_options(p)
@@ -550,21 +674,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")
     p.set_defaults(func=cmd_accuracy)
 
-    p = sub.add_parser("advise", help="the fastest stored run that reaches an error at a physical time",
-                       description="Among one machine's stored runs at --t-end, the fastest by time to solution "
-                                   "(init + steps, JIT apart) whose relative RMS error of u is at most --error, "
-                                   "the paper configuration's time to the same error, and the command line.")
+    p = sub.add_parser(
+        "advise",
+        help="the fastest stored run that reaches an error at a physical time",
+        description="Among one machine's stored runs at --t-end, the fastest by time to solution "
+        "(init + steps, JIT apart) whose relative RMS error of u is at most --error, "
+        "the paper configuration's time to the same error, and the command line.",
+    )
     p.add_argument("--error", type=number("--error"), required=True, help="relative RMS error of u, e.g. 0.01")
     p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical time, s (default 10)")
     p.add_argument("--model", choices=MODELS, default="linear", help="default linear")
     p.add_argument("--scene", choices=scene_names(), default=DEFAULT_SCENE, help=f"default {DEFAULT_SCENE}")
-    p.add_argument("--mach", type=number("--mach"), help="only runs at this amplitude (default: the scene's "
-                   f"{Scene.default('mach'):g})")
+    p.add_argument(
+        "--mach",
+        type=number("--mach"),
+        help=f"only runs at this amplitude (default: the scene's {Scene.default('mach'):g})",
+    )
     p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
     p.add_argument("--results", help=results_help)
     p.add_argument("--machine", help="a machine (profile id) of the stores; default this one, else the first")
-    p.add_argument("--domain", choices=("strip", "full"), help="only runs on the y-periodic strip or the full "
-                   "domain (default: either; the paper's configuration is always taken on the fastest run's)")
+    p.add_argument(
+        "--domain",
+        choices=("strip", "full"),
+        help="only runs on the y-periodic strip or the full "
+        "domain (default: either; the paper's configuration is always taken on the fastest run's)",
+    )
     p.add_argument("--json", action="store_true", help="one JSON object: command, error, seconds, paper_seconds")
     p.set_defaults(func=cmd_advise)
 
@@ -572,39 +706,60 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--save", action="store_true", help="store it among the user's profiles")
     p.add_argument("--out", type=folder("--out"), help=f"folder to store it in (default: {paths.user_profiles()})")
     p.add_argument("--no-gpu", action="store_true")
-    p.add_argument("--asv", action="store_true",
-                   help="write this machine's entry into ~/.asv-machine.json and print its name (for --machine)")
+    p.add_argument(
+        "--asv",
+        action="store_true",
+        help="write this machine's entry into ~/.asv-machine.json and print its name (for --machine)",
+    )
     p.set_defaults(func=cmd_profile)
 
-    p = sub.add_parser("gpu-check", help="on a GPU machine: all of the GPU work in one call, within a budget",
-                       description="Profile and ceilings, GPU vs CPU, the GPU sweep, the graph path, the host's "
-                                   "CPU, GPU tests, pytest-benchmark, asv and Nsight Compute, in that order, "
-                                   "within --budget seconds; everything to bring back in OUT/gpu_check.tar.gz.")
+    p = sub.add_parser(
+        "gpu-check",
+        help="on a GPU machine: all of the GPU work in one call, within a budget",
+        description="Profile and ceilings, GPU vs CPU, the GPU sweep, the graph path, the host's "
+        "CPU, GPU tests, pytest-benchmark, asv and Nsight Compute, in that order, "
+        "within --budget seconds; everything to bring back in OUT/gpu_check.tar.gz.",
+    )
     p.add_argument("--out", default="gpu_check_out", help="folder for the check's own files (tables, logs, tarball)")
     p.add_argument("--results", default=str(paths.user_results()), help=results_help)
     p.add_argument("--reports", default=str(paths.user_reports()), help=reports_help)
-    p.add_argument("--budget", type=number("--budget", low=60.0), default=480.0,
-                   help="seconds for the whole check (default 480: the full plan takes about 6 min on an H200)")
-    p.add_argument("--rehearse", action="store_true",
-                   help="the same script in numba's CUDA simulator at a few hundred particles (no GPU needed)")
+    p.add_argument(
+        "--budget",
+        type=number("--budget", low=60.0),
+        default=480.0,
+        help="seconds for the whole check (default 480: the full plan takes about 6 min on an H200)",
+    )
+    p.add_argument(
+        "--rehearse",
+        action="store_true",
+        help="the same script in numba's CUDA simulator at a few hundred particles (no GPU needed)",
+    )
     p.set_defaults(func=cmd_gpu_check)
 
-    p = sub.add_parser("check-solver", help="the conformance suite: is a solver (yours too) right?",
-                       description="Checks a registered solver against the all-pair reference, its neighbour "
-                                   "count, memory bound, threads, stage timing, blow-up report and its claims "
-                                   "(pcabench/conformance.py); one line per check: ok, FAILED: why, skipped: why. "
-                                   "Exit 0 when none fails, 1 when one fails.")
+    p = sub.add_parser(
+        "check-solver",
+        help="the conformance suite: is a solver (yours too) right?",
+        description="Checks a registered solver against the all-pair reference, its neighbour "
+        "count, memory bound, threads, stage timing, blow-up report and its claims "
+        "(pcabench/conformance.py); one line per check: ok, FAILED: why, skipped: why. "
+        "Exit 0 when none fails, 1 when one fails.",
+    )
     p.add_argument("name", metavar="NAME", help="a solver's name: " + ", ".join(registry()))
-    p.add_argument("--quick", action="store_true",
-                   help="the defaults and each claimed value once, not every combination")
+    p.add_argument(
+        "--quick", action="store_true", help="the defaults and each claimed value once, not every combination"
+    )
     p.add_argument("--json", action="store_true", help="one JSON object: solver, ok, checks")
     p.set_defaults(func=cmd_check_solver)
     return parser
 
 
 # Scene's parameter names as the options a user types (a SceneError names the parameter)
-OPTION_NAMES = {"t_end": "--t-end", "strip_height": "--strip-height", "pair_loop": "--pair-loop",
-                **{par.field: par.option for par in PARAMETERS if par.option[2:] != par.field and par.field != "name"}}
+OPTION_NAMES = {
+    "t_end": "--t-end",
+    "strip_height": "--strip-height",
+    "pair_loop": "--pair-loop",
+    **{par.field: par.option for par in PARAMETERS if par.option[2:] != par.field and par.field != "name"},
+}
 LEADING_OPTIONS = ("dx", "cfl", "steps", "threads", "kernel", "integrator", "precision", "model", "solver")
 
 

@@ -6,6 +6,7 @@ clock records an event before and after every operation on the stream and
 resolves the elapsed times once, after the run, so timing adds no
 synchronisation inside the step loop.
 """
+
 from __future__ import annotations
 
 import time

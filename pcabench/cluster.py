@@ -16,6 +16,7 @@ killed client loses no finished run, and rerunning the command resumes. A run wh
 dies is retried on another worker by Dask (``distributed.scheduler.allowed-failures``
 times), then recorded as ``error`` (lost).
 """
+
 from __future__ import annotations
 
 import math
@@ -41,7 +42,7 @@ def dask_distributed():
     try:
         import dask.distributed
     except ImportError:
-        raise OptionError("--cluster needs Dask: pip install -e \".[cluster]\"") from None
+        raise OptionError('--cluster needs Dask: pip install -e ".[cluster]"') from None
     return dask.distributed
 
 
@@ -56,13 +57,21 @@ def connect(address: str, stack: ExitStack):
             n = 0
         if n < 1:
             raise OptionError(f"--cluster local:N needs N >= 1 workers (got {address!r})")
-        cluster = stack.enter_context(dd.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                                      host=LOOPBACK, dashboard_address=f"{LOOPBACK}:0",
-                                                      resources={TIMING: 1}))
+        cluster = stack.enter_context(
+            dd.LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                host=LOOPBACK,
+                dashboard_address=f"{LOOPBACK}:0",
+                resources={TIMING: 1},
+            )
+        )
         return stack.enter_context(dd.Client(cluster))
     if "://" not in address:
-        raise OptionError(f"--cluster must be a scheduler address such as tcp://host:8786, or local:N "
-                          f"(got {address!r})")
+        raise OptionError(
+            f"--cluster must be a scheduler address such as tcp://host:8786, or local:N (got {address!r})"
+        )
     try:
         return stack.enter_context(dd.Client(address, timeout="30s"))
     except OSError as exc:
@@ -86,8 +95,7 @@ def run_on_worker(spec_json: str, timeout: float, commit: str) -> dict:
     try:
         return run_child(spec, timeout, commit, machine, stream=None)
     except subprocess.TimeoutExpired:
-        return store.to_row(failed_record(spec, "timeout", f"past the run budget of {timeout:.0f} s", machine,
-                                          timeout))
+        return store.to_row(failed_record(spec, "timeout", f"past the run budget of {timeout:.0f} s", machine, timeout))
 
 
 class DaskExecutor(Executor):
@@ -105,15 +113,28 @@ class DaskExecutor(Executor):
         return _unplaced(spec.solver, spec.threads, spec.scene, spec.preset, commit, spec.pair_loop)
 
     def row_key(self, row):
-        return _unplaced(row["solver"], row.get("threads", 1), row.get("scene") or {}, row.get("preset", ""),
-                         row.get("commit"), row.get("pair_loop", ""))
+        return _unplaced(
+            row["solver"],
+            row.get("threads", 1),
+            row.get("scene") or {},
+            row.get("preset", ""),
+            row.get("commit"),
+            row.get("pair_loop", ""),
+        )
 
     def informs(self, row):
         return row.get("status") == "ok"
 
     def start(self, spec, timeout, budget_cut):
-        future = self.client.submit(run_on_worker, spec.to_json(), timeout, self.commit, pure=False,
-                                    resources=task_resources(spec), key=f"pcabench-run-{len(self.futures)}")
+        future = self.client.submit(
+            run_on_worker,
+            spec.to_json(),
+            timeout,
+            self.commit,
+            pure=False,
+            resources=task_resources(spec),
+            key=f"pcabench-run-{len(self.futures)}",
+        )
         self.futures[future] = spec
         self.finished.add(future)
 
@@ -123,12 +144,18 @@ class DaskExecutor(Executor):
         try:
             return spec, future.result()
         except Exception as exc:  # noqa: BLE001 - the task never returned: its workers died (KilledWorker)
-            return spec, store.to_row(failed_record(spec, "error", f"lost: {type(exc).__name__}: {exc}",
-                                                    machine_id()))
+            return spec, store.to_row(failed_record(spec, "error", f"lost: {type(exc).__name__}: {exc}", machine_id()))
 
 
-def cluster_sweep(specs: list[RunSpec], results: Path, run_budget: float, address: str, stream=sys.stderr,
-                  retry_failed: bool = False, sweep_budget: float = math.inf) -> list[dict]:
+def cluster_sweep(
+    specs: list[RunSpec],
+    results: Path,
+    run_budget: float,
+    address: str,
+    stream=sys.stderr,
+    retry_failed: bool = False,
+    sweep_budget: float = math.inf,
+) -> list[dict]:
     """Run ``specs`` as Dask tasks on the cluster at ``address``; each record stored as it arrives
     (:func:`pcabench.sweep.run_specs`)."""
     results = Path(results)
@@ -141,10 +168,20 @@ def cluster_sweep(specs: list[RunSpec], results: Path, run_budget: float, addres
             workers = worker_resources(client)
             for need in {tuple(sorted(task_resources(s))) for s in specs}:
                 if not any(all(r.get(k, 0) >= 1 for k in need) for r in workers.values()):
-                    raise OptionError(f"--cluster {address}: no worker offers the resources {', '.join(need)}; "
-                                      f"start workers with --resources \"{' '.join(f'{k}=1' for k in need)}\"")
-            return run_specs(specs, DaskExecutor(client, git_commit()), Stores(results, lock), rows, run_budget,
-                             sweep_budget, stream, retry_failed)
+                    raise OptionError(
+                        f"--cluster {address}: no worker offers the resources {', '.join(need)}; "
+                        f'start workers with --resources "{" ".join(f"{k}=1" for k in need)}"'
+                    )
+            return run_specs(
+                specs,
+                DaskExecutor(client, git_commit()),
+                Stores(results, lock),
+                rows,
+                run_budget,
+                sweep_budget,
+                stream,
+                retry_failed,
+            )
 
 
 def _unplaced(solver, threads, scene, preset, commit, pair_loop) -> str:

@@ -23,6 +23,7 @@ The scenes are tiny (dx = 1 m: 320 and 400 particles, a few steps), so the
 suite's time is numba's compilation of each configuration (``--quick``: the
 defaults and each claimed value once, not the full product).
 """
+
 from __future__ import annotations
 
 import gc
@@ -65,6 +66,8 @@ CLAIMS = {"precision": "precisions", "model": "models", "integrator": "integrato
 def all_values(axis: str) -> tuple:
     """Every value of Scene field ``axis``: the kernels are the registry's now (one registered later counts)."""
     return kernel_names() if axis == "kernel" else ALL_VALUES[axis]
+
+
 PYTHON_OBJECTS = 16 * 1024  # B: the interpreter's own objects in a run (solver, dicts, scalars; ~9 KiB measured)
 BLOWUP = dict(model="linear", integrator="euler", cfl=5.0, steps=200)  # forward Euler far past its CFL
 
@@ -142,8 +145,7 @@ class Subject:
         self.cls.available()
         return self.cls(threads=threads, pair_loop=pair_loop)
 
-    def evolve(self, scene: Scene, threads: int = 1, pair_loop: str = "auto", reference: bool = False,
-               between=None):
+    def evolve(self, scene: Scene, threads: int = 1, pair_loop: str = "auto", reference: bool = False, between=None):
         """(final fields, solver) of ``scene`` stepped with the primitives; each one run once.
         ``between(solver)`` is called after every step."""
         pair_loop = self.cls.pair_loops[0] if pair_loop == "auto" and not reference else pair_loop
@@ -180,8 +182,10 @@ def compare(got, ref, scene: Scene, tol: float) -> list[str]:
 
     groups = {
         "velocity": ([got.u, got.v], [ref.u, ref.v]),
-        "displacement": ([seam(got.x - x0, scene.width if scene.periodic_x else 0), seam(got.y - y0, scene.height)],
-                         [seam(ref.x - x0, scene.width if scene.periodic_x else 0), seam(ref.y - y0, scene.height)]),
+        "displacement": (
+            [seam(got.x - x0, scene.width if scene.periodic_x else 0), seam(got.y - y0, scene.height)],
+            [seam(ref.x - x0, scene.width if scene.periodic_x else 0), seam(ref.y - y0, scene.height)],
+        ),
         "drho": ([got.drho], [ref.drho]),
     }
     out = []
@@ -207,15 +211,23 @@ def snapshot(solver: Solver) -> dict:
     as host copies."""
     out = {f"arrays[{k}]": host(solver, v) for k, v in solver.arrays.items()}
     out.update({f"saved[{k}]": host(solver, v) for k, v in solver.saved.items()})
-    out.update({k: host(solver, v) for k, v in vars(solver).items()
-                if isinstance(v, np.ndarray) or hasattr(v, "__cuda_array_interface__")})
+    out.update(
+        {
+            k: host(solver, v)
+            for k, v in vars(solver).items()
+            if isinstance(v, np.ndarray) or hasattr(v, "__cuda_array_interface__")
+        }
+    )
     out["t"] = np.array(solver.t)
     return out
 
 
 def changed(before: dict, after: dict) -> list[str]:
-    return sorted(k for k in before.keys() | after.keys()
-                  if k not in before or k not in after or not np.array_equal(before[k], after[k], equal_nan=True))
+    return sorted(
+        k
+        for k in before.keys() | after.keys()
+        if k not in before or k not in after or not np.array_equal(before[k], after[k], equal_nan=True)
+    )
 
 
 def lattice_neighbours(scene: Scene) -> float:
@@ -273,8 +285,11 @@ def agreement(subject: Subject) -> str:
             continue
         problems += [f"{label(config)}: {p}" for p in compare(got, ref, scene, TOLERANCE[scene.precision])]
     if problems:
-        raise Failure(f"{len(problems)} of {len(configs)} configurations: " + "; ".join(problems[:6])
-                      + ("; ..." if len(problems) > 6 else ""))
+        raise Failure(
+            f"{len(problems)} of {len(configs)} configurations: "
+            + "; ".join(problems[:6])
+            + ("; ..." if len(problems) > 6 else "")
+        )
     return f"{len(configs)} configurations"
 
 
@@ -323,23 +338,25 @@ def memory(subject: Subject) -> str:
     if cls.device == "gpu":
         probe = subject.make()
         if probe.xp is np:
-            raise Skip("numba's CUDA simulator holds host arrays and Python threads, not device memory: "
-                       "checked on a GPU")
+            raise Skip(
+                "numba's CUDA simulator holds host arrays and Python threads, not device memory: checked on a GPU"
+            )
     integrators = [i for i in (subject.default("integrator"), "rk2") if i in cls.integrators]
     if not subject.quick:
         integrators = list(cls.integrators)
     precisions = list(cls.precisions)
     notes, problems = [], []
-    for pair_loop, integrator, precision in itertools.product(cls.pair_loops, dict.fromkeys(integrators),
-                                                              precisions):
+    for pair_loop, integrator, precision in itertools.product(cls.pair_loops, dict.fromkeys(integrators), precisions):
         scene = subject.scene(integrator=integrator, precision=precision, dx=0.5, steps=2)
         bound = cls.memory_bytes(scene, pair_loop)
         subject.evolve(scene, pair_loop=pair_loop)  # compiled and first launched outside the measurement
         used = measure(subject, scene, pair_loop)
         notes.append(f"{pair_loop}/{integrator}/{precision} {used / bound:.1%}")
         if used > bound + PYTHON_OBJECTS:
-            problems.append(f"{pair_loop}/{integrator}/{precision}: a run allocates {used:,} B, more than "
-                            f"memory_bytes {bound:,} B and {PYTHON_OBJECTS:,} B of Python objects")
+            problems.append(
+                f"{pair_loop}/{integrator}/{precision}: a run allocates {used:,} B, more than "
+                f"memory_bytes {bound:,} B and {PYTHON_OBJECTS:,} B of Python objects"
+            )
     if problems:
         raise Failure("; ".join(problems))
     return "peak of the bound: " + ", ".join(notes)
@@ -431,15 +448,19 @@ def stages(subject: Subject) -> str:
         bad = run(RunSpec(cls.name, blowup, 1, "", cls.pair_loops[0]))
     ref = run(RunSpec(REFERENCE, blowup, 1, "", solver_class(REFERENCE).pair_loops[0]))
     if bad.status != "unstable" or not bad.failed_step:
-        problems.append(f"a blow-up ended {bad.status!r} (failed step {bad.failed_step}), not unstable: "
-                        f"{first_line(bad.message)}")
+        problems.append(
+            f"a blow-up ended {bad.status!r} (failed step {bad.failed_step}), not unstable: {first_line(bad.message)}"
+        )
     elif bad.failed_step != ref.failed_step or bad.steps != bad.failed_step:
-        problems.append(f"the blow-up stopped at step {bad.failed_step} (steps {bad.steps}), the reference at "
-                        f"{ref.failed_step}")
+        problems.append(
+            f"the blow-up stopped at step {bad.failed_step} (steps {bad.steps}), the reference at {ref.failed_step}"
+        )
     if problems:
         raise Failure("; ".join(problems))
-    return f"snp/pi/su {record.stages['snp']:.2g}/{record.stages['pi']:.2g}/{record.stages['su']:.2g} s; " \
-           f"blow-up unstable at step {bad.failed_step}"
+    return (
+        f"snp/pi/su {record.stages['snp']:.2g}/{record.stages['pi']:.2g}/{record.stages['su']:.2g} s; "
+        f"blow-up unstable at step {bad.failed_step}"
+    )
 
 
 @check
@@ -552,8 +573,9 @@ def assert_conforms(solver, quick: bool = True, only=None) -> list[CheckResult]:
     failed = [r for r in results if r.failed]
     if failed:
         name = solver if isinstance(solver, str) else solver.__name__
-        raise AssertionError(f"{name} fails {len(failed)} conformance check(s):\n"
-                             + "\n".join(r.line() for r in failed))
+        raise AssertionError(
+            f"{name} fails {len(failed)} conformance check(s):\n" + "\n".join(r.line() for r in failed)
+        )
     return results
 
 
@@ -568,11 +590,24 @@ def main(solver: str, quick: bool = False, as_json: bool = False, out=None) -> i
             print(result.line(), file=out, flush=True)
     failed = any(r.failed for r in results)
     if as_json:
-        print(json.dumps({"solver": solver, "quick": quick, "ok": not failed, "seconds": time.perf_counter() - t0,
-                          "checks": [asdict(r) for r in results]}), file=out)
+        print(
+            json.dumps(
+                {
+                    "solver": solver,
+                    "quick": quick,
+                    "ok": not failed,
+                    "seconds": time.perf_counter() - t0,
+                    "checks": [asdict(r) for r in results],
+                }
+            ),
+            file=out,
+        )
     else:
         word = "FAILED" if failed else "conforms" if any(r.status == "ok" for r in results) else "not checked here"
-        print(f"{solver}: {word} ({sum(r.status == 'ok' for r in results)} ok, "
-              f"{sum(r.failed for r in results)} failed, {sum(r.status == 'skipped' for r in results)} skipped) "
-              f"in {time.perf_counter() - t0:.0f} s", file=out)
+        print(
+            f"{solver}: {word} ({sum(r.status == 'ok' for r in results)} ok, "
+            f"{sum(r.failed for r in results)} failed, {sum(r.status == 'skipped' for r in results)} skipped) "
+            f"in {time.perf_counter() - t0:.0f} s",
+            file=out,
+        )
     return 1 if failed else 0

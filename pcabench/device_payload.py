@@ -10,6 +10,7 @@ the tree itself is HEAD's code, an older commit's tree is extracted from the
 history and put first on the benchmarks' path (asv passes them ``ASV_PYTHONPATH``,
 not ``PYTHONPATH``), where ``benchmarks/common.py`` finds its solver package.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -29,17 +30,44 @@ LIMIT_BYTES = 64 * 2**20  # what one device run carries: working tree plus carri
 COMMITS = ("HEAD", "bf587a5")  # bf587a5: the commit the H100 was measured at
 TOP = ("asv==0.6.6",)
 # Already on the lent machine's image; asv's own dependencies are not among them, so all of those travel.
-DEVICE_HAS = frozenset({"numpy", "scipy", "pandas", "matplotlib", "pytest", "pytest-benchmark", "numba",
-                        "numba-cuda", "psutil", "py-cpuinfo"})
-PLATFORMS = ("manylinux_2_28_x86_64", "manylinux_2_27_x86_64", "manylinux_2_17_x86_64",
-             "manylinux2014_x86_64", "manylinux1_x86_64")
+DEVICE_HAS = frozenset(
+    {
+        "numpy",
+        "scipy",
+        "pandas",
+        "matplotlib",
+        "pytest",
+        "pytest-benchmark",
+        "numba",
+        "numba-cuda",
+        "psutil",
+        "py-cpuinfo",
+    }
+)
+PLATFORMS = (
+    "manylinux_2_28_x86_64",
+    "manylinux_2_27_x86_64",
+    "manylinux_2_17_x86_64",
+    "manylinux2014_x86_64",
+    "manylinux1_x86_64",
+)
 # The lent machine's Python, for the wheels' environment markers.
-TARGET_ENV = {"python_version": "3.12", "python_full_version": "3.12.0", "implementation_name": "cpython",
-              "platform_python_implementation": "CPython", "sys_platform": "linux", "os_name": "posix",
-              "platform_system": "Linux", "platform_machine": "x86_64", "extra": ""}
+TARGET_ENV = {
+    "python_version": "3.12",
+    "python_full_version": "3.12.0",
+    "implementation_name": "cpython",
+    "platform_python_implementation": "CPython",
+    "sys_platform": "linux",
+    "os_name": "posix",
+    "platform_system": "Linux",
+    "platform_machine": "x86_64",
+    "extra": "",
+}
 # The device command's start: asv from the wheels, the tree as the import path.
-DEVICE_PREFIX = ("python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade "
-                 "--target /tmp/site .whl/*.whl && export PYTHONPATH=/tmp/site:$PWD")
+DEVICE_PREFIX = (
+    "python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade "
+    "--target /tmp/site .whl/*.whl && export PYTHONPATH=/tmp/site:$PWD"
+)
 
 
 def _say(msg: str) -> None:
@@ -61,8 +89,11 @@ def requirements(metadata: str, env: dict = TARGET_ENV) -> list:
     """The ``Requires-Dist`` of a wheel's METADATA that apply on the lent machine, as packaging Requirements."""
     from packaging.requirements import Requirement
 
-    reqs = [Requirement(line.split(":", 1)[1].strip()) for line in metadata.splitlines()
-            if line.startswith("Requires-Dist:")]
+    reqs = [
+        Requirement(line.split(":", 1)[1].strip())
+        for line in metadata.splitlines()
+        if line.startswith("Requires-Dist:")
+    ]
     return [r for r in reqs if r.marker is None or r.marker.evaluate(env)]
 
 
@@ -89,9 +120,26 @@ def download_wheels(dest: Path, top=TOP, skip=DEVICE_HAS, python: str = "3.12") 
     env = {**TARGET_ENV, "python_version": python, "python_full_version": f"{python}.0"}
     seen, read, batch = set(skip), set(), list(top)
     while batch:
-        subprocess.run([sys.executable, "-m", "pip", "download", "-q", "--no-deps", "--only-binary=:all:",
-                        "--python-version", python, "--implementation", "cp", *platforms, "-d", str(dest),
-                        *batch], check=True)
+        subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "pip",
+                "download",
+                "-q",
+                "--no-deps",
+                "--only-binary=:all:",
+                "--python-version",
+                python,
+                "--implementation",
+                "cp",
+                *platforms,
+                "-d",
+                str(dest),
+                *batch,
+            ],
+            check=True,
+        )
         batch = []
         for wheel in sorted(set(dest.glob("*.whl")) - read):
             read.add(wheel)
@@ -119,8 +167,11 @@ def prepare(root: Path, commits=COMMITS, dest: Path | None = None) -> dict:
     bundle = dest / ".gl" / "repo.bundle"
     bundle.parent.mkdir(parents=True, exist_ok=True)
     _git(root, "bundle", "create", "-q", str(bundle.resolve()), "HEAD")
-    return {"wheels": wheels, "bundle": bundle.stat().st_size,
-            "payload": payload_bytes(root, carry=(dest / ".whl", dest / ".gl"))}
+    return {
+        "wheels": wheels,
+        "bundle": bundle.stat().st_size,
+        "payload": payload_bytes(root, carry=(dest / ".whl", dest / ".gl")),
+    }
 
 
 def payload_bytes(root: Path, carry=(".whl", ".gl")) -> int:
@@ -129,8 +180,9 @@ def payload_bytes(root: Path, carry=(".whl", ".gl")) -> int:
     root = Path(root)
     names = _git(root, "ls-files", "-co", "--exclude-standard", "-z").stdout.decode().split("\0")
     tree = sum((root / n).lstat().st_size for n in names if n and (root / n).is_file())
-    return tree + sum(_tree_size(root / c) if (root / c).is_dir() else (root / c).stat().st_size
-                      for c in carry if (root / c).exists())
+    return tree + sum(
+        _tree_size(root / c) if (root / c).is_dir() else (root / c).stat().st_size for c in carry if (root / c).exists()
+    )
 
 
 # -- there --------------------------------------------------------------------------------------------
@@ -178,8 +230,9 @@ def _run(cmd: list, cwd: Path, env: dict, timeout: float) -> int:
         return None
 
 
-def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = "GPU", root: Path | None = None,
-                asv_args=()) -> list:
+def run_asv_gpu(
+    out: Path, commits=COMMITS, budget_s: float = 600, bench: str = "GPU", root: Path | None = None, asv_args=()
+) -> list:
     """asv's ``bench`` benchmarks at each commit in this tree (``--python=same --set-commit-hash``), within
     ``budget_s`` seconds: each commit gets an equal share of what is left (asv saves a commit's results
     when its run ends, so a commit cut short has none). The result files go to ``out/<machine>/``.
@@ -191,8 +244,16 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
     out = Path(out)
 
     def row(commit, sha=None, seconds=0.0, returncode=None, result=None, message=""):
-        rows.append({"commit": commit, "sha": sha, "seconds": round(seconds, 1), "returncode": returncode,
-                     "result": result, "message": message})
+        rows.append(
+            {
+                "commit": commit,
+                "sha": sha,
+                "seconds": round(seconds, 1),
+                "returncode": returncode,
+                "result": result,
+                "message": message,
+            }
+        )
         _say(f"{commit}: {message or 'done'} ({seconds:.0f} s, rc {returncode})")
 
     try:
@@ -200,8 +261,14 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
             raise RuntimeError("no git on this machine: asv needs the history")
         head = ensure_repo(root)
         env = _git_env()
-        machine = subprocess.run([sys.executable, "-m", "pcabench.cli", "profile", "--asv"], cwd=root, env=env,
-                                 capture_output=True, text=True, check=True).stdout.split()[-1]
+        machine = subprocess.run(
+            [sys.executable, "-m", "pcabench.cli", "profile", "--asv"],
+            cwd=root,
+            env=env,
+            capture_output=True,
+            text=True,
+            check=True,
+        ).stdout.split()[-1]
         _say(f"machine {machine}, HEAD {head[:8]}, budget {budget_s:.0f} s, benchmarks {bench!r}")
     except Exception as exc:  # noqa: BLE001 - a device run reports, never stops
         detail = exc.stderr.strip()[-300:] if getattr(exc, "stderr", None) else ""
@@ -230,10 +297,28 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
             asv_path = code + path + ([] if str(root) in path else [str(root)])
             timeout = left / (len(commits) - i)
             _say(f"{commit} = {sha[:8]}: asv run, at most {timeout:.0f} s, code from {code[0] if code else root}")
-            rc = _run([sys.executable, "-m", "asv", "--config", str(config), "run", "--python=same",
-                       "--set-commit-hash", sha,
-                       "--machine", machine, "-b", bench, "--show-stderr", *asv_args], root,
-                      {**env, "ASV_PYTHONPATH": os.pathsep.join(asv_path)}, timeout)
+            rc = _run(
+                [
+                    sys.executable,
+                    "-m",
+                    "asv",
+                    "--config",
+                    str(config),
+                    "run",
+                    "--python=same",
+                    "--set-commit-hash",
+                    sha,
+                    "--machine",
+                    machine,
+                    "-b",
+                    bench,
+                    "--show-stderr",
+                    *asv_args,
+                ],
+                root,
+                {**env, "ASV_PYTHONPATH": os.pathsep.join(asv_path)},
+                timeout,
+            )
             found = sorted(f for f in results.glob(f"{sha[:8]}-*.json") if f.stat().st_mtime >= wall)
             copied = None
             if found:
@@ -252,7 +337,6 @@ def run_asv_gpu(out: Path, commits=COMMITS, budget_s: float = 600, bench: str = 
     return rows
 
 
-
 # -- the one command --------------------------------------------------------------------------------------
 
 
@@ -260,12 +344,14 @@ def device_command(commit: str, budget_s: float = 450.0) -> str:
     """The whole device call: asv from the wheels, then ``pcabench gpu-check`` within ``budget_s`` seconds;
     what to bring back (the check's tarball, its tables and the log) lands in ``$OUT``."""
     install, path = DEVICE_PREFIX.split(" && ")
-    return (f"set -o pipefail; {install} || echo 'gpu-check: the wheels did not install: no asv'; {path}; "
-            f"export PCABENCH_HOME=/tmp/pcabench PCABENCH_COMMIT={commit} PYTHONUNBUFFERED=1; "
-            "nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,memory.total --format=csv; "
-            f"python3 -m pcabench.cli gpu-check --out /tmp/check --budget {budget_s:.0f} "
-            "2>&1 | tee $OUT/gpu_check.log; "
-            "rc=$?; cp /tmp/check/gpu_check.tar.gz /tmp/check/gpu_check.md $OUT/; exit $rc")
+    return (
+        f"set -o pipefail; {install} || echo 'gpu-check: the wheels did not install: no asv'; {path}; "
+        f"export PCABENCH_HOME=/tmp/pcabench PCABENCH_COMMIT={commit} PYTHONUNBUFFERED=1; "
+        "nvidia-smi --query-gpu=name,driver_version,clocks.max.sm,memory.total --format=csv; "
+        f"python3 -m pcabench.cli gpu-check --out /tmp/check --budget {budget_s:.0f} "
+        "2>&1 | tee $OUT/gpu_check.log; "
+        "rc=$?; cp /tmp/check/gpu_check.tar.gz /tmp/check/gpu_check.md $OUT/; exit $rc"
+    )
 
 
 def main(argv=None) -> int:
@@ -277,8 +363,9 @@ def main(argv=None) -> int:
         return 2
     sizes = prepare(root)
     commit = _git(root, "rev-parse", "HEAD", text=True).stdout.strip()
-    print(f"payload {sizes['payload'] / 2**20:.1f} MiB of {LIMIT_BYTES / 2**20:.0f} (carry .whl and .gl)",
-          file=sys.stderr)
+    print(
+        f"payload {sizes['payload'] / 2**20:.1f} MiB of {LIMIT_BYTES / 2**20:.0f} (carry .whl and .gl)", file=sys.stderr
+    )
     print(device_command(commit, float(argv[0]) if argv else 450.0))
     return 0 if sizes["payload"] <= LIMIT_BYTES else 1
 

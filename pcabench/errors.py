@@ -5,6 +5,7 @@ Bad input is :class:`~pcabench.spec.OptionError` (a harness option) or
 cannot be read or written is :class:`StoreError` (raised by the store and by what checks names that become
 store paths).
 """
+
 from __future__ import annotations
 
 

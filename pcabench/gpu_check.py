@@ -37,6 +37,7 @@ process) to take about 6 minutes of an H200, leaving a default budget of
 hundred particles in the simulator (the graph and the ceilings need a GPU
 and say so), which is what CI runs so that the script cannot rot.
 """
+
 from __future__ import annotations
 
 import json
@@ -95,9 +96,21 @@ class Plan:
 
 
 FULL = Plan()
-REHEARSAL = Plan(gpu_dx=(1.0, 0.5), min_steps=2, max_steps=2, compare_dx=1.0, compare_steps=3, graph_dx=(1.0,),
-                 graph_steps=2, graph_rounds=1, cpu_dx=(1.0,), cpu_steps=2,
-                 scene={"x_min": -8.0, "x_max": 8.0}, asv_bench="TimeGPUStep", ncu_dx=1.0)
+REHEARSAL = Plan(
+    gpu_dx=(1.0, 0.5),
+    min_steps=2,
+    max_steps=2,
+    compare_dx=1.0,
+    compare_steps=3,
+    graph_dx=(1.0,),
+    graph_steps=2,
+    graph_rounds=1,
+    cpu_dx=(1.0,),
+    cpu_steps=2,
+    scene={"x_min": -8.0, "x_max": 8.0},
+    asv_bench="TimeGPUStep",
+    ncu_dx=1.0,
+)
 
 
 class Budget:
@@ -159,6 +172,7 @@ def measure_ceilings(cupy) -> dict:
                 a6 = a6 * m + c
                 a7 = a7 * m + c
             x[i] = a0 + a1 + a2 + a3 + a4 + a5 + a6 + a7
+
         return k
 
     for dtype, key in ((np.float32, "fp32_fma_tflops"), (np.float64, "fp64_fma_tflops")):
@@ -182,8 +196,16 @@ def measure_ceilings(cupy) -> dict:
 def _smi_clock():
     """The SM clock nvidia-smi reports right after the FMA kernels, MHz (None without nvidia-smi)."""
     try:
-        text = subprocess.run(["nvidia-smi", "--query-gpu=clocks.sm,clocks.max.sm", "--format=csv,noheader,nounits"],
-                              capture_output=True, text=True, timeout=20).stdout.strip().splitlines()[0]
+        text = (
+            subprocess.run(
+                ["nvidia-smi", "--query-gpu=clocks.sm,clocks.max.sm", "--format=csv,noheader,nounits"],
+                capture_output=True,
+                text=True,
+                timeout=20,
+            )
+            .stdout.strip()
+            .splitlines()[0]
+        )
         now, most = (int(v) for v in text.split(","))
         return {"now": now, "max": most}
     except (OSError, ValueError, IndexError, subprocess.SubprocessError):
@@ -196,8 +218,7 @@ def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
     rows = []
     for precision in PRECISIONS:
         for model in MODELS:
-            scene = Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision,
-                          **plan.scene)
+            scene = Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision, **plan.scene)
             fields = {}
             for solver in (DEFAULT_SOLVER, GPU_SOLVER):
                 path = fresh(out / f"compare_{solver}.npz")
@@ -206,27 +227,58 @@ def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
                     raise RuntimeError(f"{solver} {model} {precision}: {rec.status} {rec.message}")
                 fields[solver] = dict(np.load(path))
                 path.unlink()
-            diff = {name: float(np.max(np.abs(fields[GPU_SOLVER][name] - fields[DEFAULT_SOLVER][name]))
-                                / np.max(np.abs(fields[DEFAULT_SOLVER][name]))) for name in ("u", "drho")}
-            rows.append({"precision": precision, "model": model, "dx": plan.compare_dx, "steps": plan.compare_steps,
-                         "max_rel_diff_u": diff["u"], "max_rel_diff_drho": diff["drho"]})
-            print(f"compare {precision} {model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}", file=sys.stderr,
-                  flush=True)
+            diff = {
+                name: float(
+                    np.max(np.abs(fields[GPU_SOLVER][name] - fields[DEFAULT_SOLVER][name]))
+                    / np.max(np.abs(fields[DEFAULT_SOLVER][name]))
+                )
+                for name in ("u", "drho")
+            }
+            rows.append(
+                {
+                    "precision": precision,
+                    "model": model,
+                    "dx": plan.compare_dx,
+                    "steps": plan.compare_steps,
+                    "max_rel_diff_u": diff["u"],
+                    "max_rel_diff_drho": diff["drho"],
+                }
+            )
+            print(
+                f"compare {precision} {model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}", file=sys.stderr, flush=True
+            )
     return rows
 
 
 # ---------------------------------------------------------------- 3 and 5. the sweeps
 def gpu_specs(plan: Plan) -> list[RunSpec]:
     """The GPU timing sweep: linkedlist-gpu on the paper's full domain, every size, precision and model."""
-    return [RunSpec(GPU_SOLVER, Scene(dx=dx, steps=plan.gpu_steps(dx), model=model, precision=precision,
-                                            memory_limit_bytes=2**40, **plan.scene), preset="gpu")
-            for dx in plan.gpu_dx for precision in PRECISIONS for model in plan.models]  # the GPU checks its memory
+    return [
+        RunSpec(
+            GPU_SOLVER,
+            Scene(
+                dx=dx,
+                steps=plan.gpu_steps(dx),
+                model=model,
+                precision=precision,
+                memory_limit_bytes=2**40,
+                **plan.scene,
+            ),
+            preset="gpu",
+        )
+        for dx in plan.gpu_dx
+        for precision in PRECISIONS
+        for model in plan.models
+    ]  # the GPU checks its memory
 
 
 def cpu_peer_specs(plan: Plan) -> list[RunSpec]:
     """linkedlist-cpu, lagrangian float64, one thread and every core, on this GPU's host: Table 6's CPU column."""
-    return [RunSpec(DEFAULT_SOLVER, Scene(dx=dx, steps=plan.cpu_steps, **plan.scene), threads, preset="gpu")
-            for dx in plan.cpu_dx for threads in (SERIAL, ALL_CORES)]
+    return [
+        RunSpec(DEFAULT_SOLVER, Scene(dx=dx, steps=plan.cpu_steps, **plan.scene), threads, preset="gpu")
+        for dx in plan.cpu_dx
+        for threads in (SERIAL, ALL_CORES)
+    ]
 
 
 def run_and_release(spec, timeout, commit, machine, stream=sys.stderr) -> dict:
@@ -291,9 +343,17 @@ def graph_vs_plain(dx: float, precision: str, steps: int, rounds: int, scene_ove
             one_step()
         u[name] = solver.output().u  # particle-id order
     diff = float(np.max(np.abs(u["graph"] - u["plain"])) / np.max(np.abs(u["plain"])))
-    return {"dx": dx, "N": scene.n_particles, "precision": precision, "steps": steps, "rounds": rounds,
-            "plain_ms": best["plain"], "graph_ms": best["graph"], "speedup": best["plain"] / best["graph"],
-            "max_rel_diff_u": diff}
+    return {
+        "dx": dx,
+        "N": scene.n_particles,
+        "precision": precision,
+        "steps": steps,
+        "rounds": rounds,
+        "plain_ms": best["plain"],
+        "graph_ms": best["graph"],
+        "speedup": best["plain"] / best["graph"],
+        "max_rel_diff_u": diff,
+    }
 
 
 # ---------------------------------------------------------------- 6-8. subprocess stages
@@ -302,8 +362,7 @@ def run_logged(cmd: list[str], log: Path, timeout: float, env=None) -> dict:
     t0 = time.perf_counter()
     with open(fresh(log), "w") as f:
         try:
-            rc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, timeout=max(timeout, 1.0),
-                                env=env).returncode
+            rc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT, timeout=max(timeout, 1.0), env=env).returncode
         except subprocess.TimeoutExpired:
             rc = 124
             f.write(f"\n[gpu-check: stopped at the stage's share of the budget, {timeout:.0f} s]\n")
@@ -315,11 +374,37 @@ def run_logged(cmd: list[str], log: Path, timeout: float, env=None) -> dict:
 
 def ncu_command(plan: Plan, out: Path) -> list[str]:
     """Nsight Compute on one short lagrangian run: the speed-of-light and memory sections of each kernel once."""
-    return ["ncu", "--clock-control", "none", "--section", "SpeedOfLight", "--section", "MemoryWorkloadAnalysis",
-            "--kernel-name", "regex:kick|continuity|advance|cell_count|cell_begin|scatter|momentum",
-            "--launch-skip", "40", "--launch-count", "8", "-o", str(out / "ncu_step"), "-f",
-            sys.executable, "-m", "pcabench.cli", "run", "--solver", GPU_SOLVER, "--dx", str(plan.ncu_dx),
-            "--precision", "float32", "--steps", "8", "--quiet"]
+    return [
+        "ncu",
+        "--clock-control",
+        "none",
+        "--section",
+        "SpeedOfLight",
+        "--section",
+        "MemoryWorkloadAnalysis",
+        "--kernel-name",
+        "regex:kick|continuity|advance|cell_count|cell_begin|scatter|momentum",
+        "--launch-skip",
+        "40",
+        "--launch-count",
+        "8",
+        "-o",
+        str(out / "ncu_step"),
+        "-f",
+        sys.executable,
+        "-m",
+        "pcabench.cli",
+        "run",
+        "--solver",
+        GPU_SOLVER,
+        "--dx",
+        str(plan.ncu_dx),
+        "--precision",
+        "float32",
+        "--steps",
+        "8",
+        "--quiet",
+    ]
 
 
 # ---------------------------------------------------------------- the tables
@@ -330,53 +415,95 @@ def timing_row(row: dict) -> dict:
     loop = step * steps
     pairs = 2 * n * (row.get("mean_neighbours") or 0)  # both sweeps of a Verlet step
     share = {s: 100 * st[s] / loop if loop else float("nan") for s in STEP_STAGES}
-    return {"dx": row["dx"], "N": n, "precision": row["precision"], "model": row["model"], "status": row["status"],
-            "steps": steps, "step_ms": 1e3 * step, **{f"{s}_pct": share[s] for s in STEP_STAGES},
-            "ns_per_particle_step": 1e9 * step / n, "ps_per_pair": 1e12 * step / pairs if pairs else float("nan"),
-            "neighbours": row.get("mean_neighbours") or float("nan"),
-            "mse": row.get("mse") if row.get("mse") is not None else float("nan"),
-            "init_ms": 1e3 * st["init"], "output_ms": 1e3 * st["output"]}
+    return {
+        "dx": row["dx"],
+        "N": n,
+        "precision": row["precision"],
+        "model": row["model"],
+        "status": row["status"],
+        "steps": steps,
+        "step_ms": 1e3 * step,
+        **{f"{s}_pct": share[s] for s in STEP_STAGES},
+        "ns_per_particle_step": 1e9 * step / n,
+        "ps_per_pair": 1e12 * step / pairs if pairs else float("nan"),
+        "neighbours": row.get("mean_neighbours") or float("nan"),
+        "mse": row.get("mse") if row.get("mse") is not None else float("nan"),
+        "init_ms": 1e3 * st["init"],
+        "output_ms": 1e3 * st["output"],
+    }
 
 
 def markdown(profile: dict, results: dict) -> str:
     """The check's tables: stages run, ceilings, agreement, sweep, graph path, CPU peers."""
     g = profile.get("gpu") or {}
-    lines = [f"# GPU check: {g.get('name', 'no GPU (rehearsal)')} ({profile['id']})", "",
-             f"Commit {results.get('commit', '?')}; budget {results['budget_s']:.0f} s, used "
-             f"{results['elapsed_s']:.0f} s.", "", "| stage | status | seconds |", "|---|---|---|"]
+    lines = [
+        f"# GPU check: {g.get('name', 'no GPU (rehearsal)')} ({profile['id']})",
+        "",
+        f"Commit {results.get('commit', '?')}; budget {results['budget_s']:.0f} s, used {results['elapsed_s']:.0f} s.",
+        "",
+        "| stage | status | seconds |",
+        "|---|---|---|",
+    ]
     lines += [f"| {s['stage']} | {s['status']} | {s['seconds']:.1f} |" for s in results["stages"]]
     lines += ["", f"Measured ceilings: {json.dumps(profile.get('measured', {}))}", ""]
     if results.get("compare"):
-        lines += ["## GPU vs linkedlist-cpu (max relative difference after the steps shown)", "",
-                  "| precision | model | dx | steps | u | drho |", "|---|---|---|---|---|---|"]
-        lines += [f"| {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | {r['max_rel_diff_u']:.2e} | "
-                  f"{r['max_rel_diff_drho']:.2e} |" for r in results["compare"]]
+        lines += [
+            "## GPU vs linkedlist-cpu (max relative difference after the steps shown)",
+            "",
+            "| precision | model | dx | steps | u | drho |",
+            "|---|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | {r['max_rel_diff_u']:.2e} | "
+            f"{r['max_rel_diff_drho']:.2e} |"
+            for r in results["compare"]
+        ]
     if results.get("gpu_rows"):
-        lines += ["", "## linkedlist-gpu, paper domain, Verlet, cutoff 3h (stage clock: events around each "
-                  "operation)", "",
-                  "| dx | N | precision | model | status | steps | step (ms) | SNP % | PI % | SU % | ns/particle-step "
-                  "| ps/pair | neighbours | MSE | init (ms) | output (ms) |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        lines += [
+            "",
+            "## linkedlist-gpu, paper domain, Verlet, cutoff 3h (stage clock: events around each operation)",
+            "",
+            "| dx | N | precision | model | status | steps | step (ms) | SNP % | PI % | SU % | ns/particle-step "
+            "| ps/pair | neighbours | MSE | init (ms) | output (ms) |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        ]
         for r in map(timing_row, results["gpu_rows"]):
             lines.append(
                 f"| {r['dx']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['status']} | {r['steps']} | "
                 f"{r['step_ms']:.3f} | {r['snp_pct']:.1f} | {r['pi_pct']:.1f} | {r['su_pct']:.1f} | "
                 f"{r['ns_per_particle_step']:.3f} | {r['ps_per_pair']:.2f} | {r['neighbours']:.1f} | "
-                f"{r['mse']:.3g} | {r['init_ms']:.1f} | {r['output_ms']:.1f} |")
+                f"{r['mse']:.3g} | {r['init_ms']:.1f} | {r['output_ms']:.1f} |"
+            )
         lines += ["", "ps/pair counts both sweeps of a Verlet step (2 x N x mean neighbours pairs)."]
     if results.get("graph"):
-        lines += ["", "## The step as a CUDA graph against plain launches (same process, alternating, best round)",
-                  "", "| dx | N | precision | steps x rounds | plain (ms/step) | graph (ms/step) | plain / graph | "
-                  "u: graph vs plain |", "|---|---|---|---|---|---|---|---|"]
-        lines += [f"| {r['dx']} | {r['N']:,} | {r['precision']} | {r['steps']} x {r['rounds']} | {r['plain_ms']:.4f} "
-                  f"| {r['graph_ms']:.4f} | {r['speedup']:.2f} | {r['max_rel_diff_u']:.1e} |"
-                  for r in results["graph"] if "plain_ms" in r]
+        lines += [
+            "",
+            "## The step as a CUDA graph against plain launches (same process, alternating, best round)",
+            "",
+            "| dx | N | precision | steps x rounds | plain (ms/step) | graph (ms/step) | plain / graph | "
+            "u: graph vs plain |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {r['dx']} | {r['N']:,} | {r['precision']} | {r['steps']} x {r['rounds']} | {r['plain_ms']:.4f} "
+            f"| {r['graph_ms']:.4f} | {r['speedup']:.2f} | {r['max_rel_diff_u']:.1e} |"
+            for r in results["graph"]
+            if "plain_ms" in r
+        ]
         lines += [f"- dx {r['dx']} {r['precision']}: {r['error']}" for r in results["graph"] if "error" in r]
     if results.get("cpu_rows"):
-        lines += ["", "## linkedlist-cpu on this host (lagrangian, float64)", "",
-                  "| dx | N | threads | status | steps | step (ms) |", "|---|---|---|---|---|---|"]
-        lines += [f"| {r['dx']} | {r['n_particles']:,} | {r['threads']} | {r['status']} | {r['steps']} | "
-                  f"{1e3 * step_seconds(r['stages'], r['steps']):.1f} |" for r in results["cpu_rows"]]
+        lines += [
+            "",
+            "## linkedlist-cpu on this host (lagrangian, float64)",
+            "",
+            "| dx | N | threads | status | steps | step (ms) |",
+            "|---|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {r['dx']} | {r['n_particles']:,} | {r['threads']} | {r['status']} | {r['steps']} | "
+            f"{1e3 * step_seconds(r['stages'], r['steps']):.1f} |"
+            for r in results["cpu_rows"]
+        ]
     for key in ("pytest_gpu", "bench", "asv", "ncu"):
         if results.get(key):
             lines += ["", f"## {key}", "", "```", json.dumps(results[key], indent=1, default=str), "```"]
@@ -384,8 +511,9 @@ def markdown(profile: dict, results: dict) -> str:
 
 
 # ---------------------------------------------------------------- the check
-def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, rehearse: bool = False,
-              plan: Plan | None = None) -> int:
+def gpu_check(
+    out: Path, results: Path, reports: Path, budget_s: float = 480.0, rehearse: bool = False, plan: Plan | None = None
+) -> int:
     """Every stage within ``budget_s`` seconds; 0 when every stage that ran passed, else 1.
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
@@ -437,14 +565,22 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
         return all(r["max_rel_diff_u"] < tol[r["precision"]] for r in state["compare"])
 
     def gpu_sweep():
-        state["gpu_rows"] = sweep(gpu_specs(plan), store_path, run_budget=budget.left(),
-                                  sweep_budget=budget.left() - 60, runner=run_and_release)
+        state["gpu_rows"] = sweep(
+            gpu_specs(plan),
+            store_path,
+            run_budget=budget.left(),
+            sweep_budget=budget.left() - 60,
+            runner=run_and_release,
+        )
         return all(r["status"] == "ok" for r in state["gpu_rows"])
 
     def graph():
         if cupy is None:
-            state["graph"] = [{"dx": dx, "precision": p, "error": "needs a real GPU (no streams in the simulator)"}
-                              for dx in plan.graph_dx for p in PRECISIONS]
+            state["graph"] = [
+                {"dx": dx, "precision": p, "error": "needs a real GPU (no streams in the simulator)"}
+                for dx in plan.graph_dx
+                for p in PRECISIONS
+            ]
             return True
         state["graph"] = []
         for dx in plan.graph_dx:
@@ -461,21 +597,41 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
         return all("error" not in r for r in state["graph"])
 
     def cpu_peers():
-        state["cpu_rows"] = sweep(cpu_peer_specs(plan), store_path, run_budget=budget.left(),
-                                  sweep_budget=budget.left() - 30, runner=run_and_release)
+        state["cpu_rows"] = sweep(
+            cpu_peer_specs(plan),
+            store_path,
+            run_budget=budget.left(),
+            sweep_budget=budget.left() - 30,
+            runner=run_and_release,
+        )
         return all(r["status"] == "ok" for r in state["cpu_rows"])
 
     env = dict(os.environ, PCABENCH_COMMIT=state["commit"])
 
     def pytest_gpu():
-        state["pytest_gpu"] = run_logged([sys.executable, "-m", "pytest", "-m", "gpu", "-q", "-p", "no:cacheprovider",
-                                          "tests"], out / "pytest_gpu.log", min(150, budget.left()), env)
+        state["pytest_gpu"] = run_logged(
+            [sys.executable, "-m", "pytest", "-m", "gpu", "-q", "-p", "no:cacheprovider", "tests"],
+            out / "pytest_gpu.log",
+            min(150, budget.left()),
+            env,
+        )
         return state["pytest_gpu"]["exit"] in (0, 5)  # 5: every GPU test deselected or skipped (rehearsal)
 
     def bench():
         json_path = out / f"pytest-benchmark_{profile['id']}.json"
-        cmd = [sys.executable, "-m", "pytest", "-o", "addopts=", "-p", "no:cacheprovider", "tests/benchmarks",
-               "--benchmark-only", f"--benchmark-json={json_path}", "-q"]
+        cmd = [
+            sys.executable,
+            "-m",
+            "pytest",
+            "-o",
+            "addopts=",
+            "-p",
+            "no:cacheprovider",
+            "tests/benchmarks",
+            "--benchmark-only",
+            f"--benchmark-json={json_path}",
+            "-q",
+        ]
         if rehearse:
             cmd += ["-k", "linkedlist and step"]
         state["bench"] = run_logged(cmd, out / "pytest_benchmark.log", min(120, budget.left()), env)
@@ -484,8 +640,13 @@ def gpu_check(out: Path, results: Path, reports: Path, budget_s: float = 480.0, 
     def asv():
         from .device_payload import run_asv_gpu
 
-        state["asv"] = run_asv_gpu(out / "asv", commits=("HEAD", H100_COMMIT), budget_s=min(150, budget.left()),
-                                   bench=plan.asv_bench, asv_args=("--quick",))
+        state["asv"] = run_asv_gpu(
+            out / "asv",
+            commits=("HEAD", H100_COMMIT),
+            budget_s=min(150, budget.left()),
+            bench=plan.asv_bench,
+            asv_args=("--quick",),
+        )
         return all(r.get("returncode") == 0 for r in state["asv"])
 
     def ncu():

@@ -1,4 +1,5 @@
 """Strict JSON for every ``--json``: what json.loads with a strict parser reads (NaN and infinities as null)."""
+
 from __future__ import annotations
 
 import json

@@ -7,6 +7,7 @@ the memory this process may use now (MemAvailable and every level of its
 cgroup), so a run that will not fit is refused with the scene's own one-line
 SceneError (naming dx and the smallest dx that fits) before anything runs.
 """
+
 from __future__ import annotations
 
 import os
@@ -17,8 +18,10 @@ from solvers.scene import Scene
 CGROUP_MOUNT = "/sys/fs/cgroup"
 PROC_CGROUP = "/proc/self/cgroup"  # this process's cgroup in each hierarchy
 # cgroup v2 (the unified hierarchy at the mount) and v1 (its memory hierarchy): folder, limit, usage, events
-CGROUP_MEMORY = (("", "memory.max", "memory.current", "memory.events"),
-                 ("memory", "memory.limit_in_bytes", "memory.usage_in_bytes", "memory.oom_control"))
+CGROUP_MEMORY = (
+    ("", "memory.max", "memory.current", "memory.events"),
+    ("memory", "memory.limit_in_bytes", "memory.usage_in_bytes", "memory.oom_control"),
+)
 
 
 def _read_int(path: str) -> int | None:
@@ -49,8 +52,9 @@ def cgroup_memory_folders() -> list[tuple[str, str, str, str]]:
         for k in range(len(parts), -1, -1):
             folder = os.path.join(CGROUP_MOUNT, sub, *parts[:k])
             if os.path.isdir(folder):
-                out.append((folder, os.path.join(folder, limit), os.path.join(folder, usage),
-                            os.path.join(folder, events)))
+                out.append(
+                    (folder, os.path.join(folder, limit), os.path.join(folder, usage), os.path.join(folder, events))
+                )
     return out
 
 
@@ -111,9 +115,10 @@ def is_out_of_memory(exc: BaseException) -> bool:
     CudaAPIError with CUDA_ERROR_OUT_OF_MEMORY. Recognised by type and code, never by message text."""
     kinds = [(MemoryError, None, None)]
     for module, name, attr, code in (
-            ("cupy.cuda.memory", "OutOfMemoryError", None, None),
-            ("cupy_backends.cuda.api.runtime", "CUDARuntimeError", "status", CUDA_ERROR_MEMORY_ALLOCATION),
-            ("numba.cuda.cudadrv.driver", "CudaAPIError", "code", CUDA_ERROR_OUT_OF_MEMORY)):
+        ("cupy.cuda.memory", "OutOfMemoryError", None, None),
+        ("cupy_backends.cuda.api.runtime", "CUDARuntimeError", "status", CUDA_ERROR_MEMORY_ALLOCATION),
+        ("numba.cuda.cudadrv.driver", "CudaAPIError", "code", CUDA_ERROR_OUT_OF_MEMORY),
+    ):
         cls = _loaded(module, name)
         if isinstance(cls, type):
             kinds.append((cls, attr, code))

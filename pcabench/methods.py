@@ -9,6 +9,7 @@ the cheapest methods predicted to reach an error, one per kernel. The front
 preset runs them beside the paper's configuration, so the method advise
 names comes from the front and the prediction, not from a hand-made list.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -36,8 +37,9 @@ def _stable(kernel: str, h_factor: float) -> float:
     return stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h_factor, model="linear", memory_limit_bytes=2**62))
 
 
-def fastest(error: float, t_end: float, model: str = "linear", name: str = DEFAULT_SCENE,
-            per_kernel: int = 1) -> tuple[dict, ...]:
+def fastest(
+    error: float, t_end: float, model: str = "linear", name: str = DEFAULT_SCENE, per_kernel: int = 1
+) -> tuple[dict, ...]:
     """The cheapest methods (kernel, h_factor, cfl, dx; the paper's domain of scene ``name``) predicted to reach
     a relative RMS ``error`` at ``t_end``, ``per_kernel`` for each registered kernel, cheapest first, each with
     its predicted error, its stable CFL and its cost."""
@@ -53,14 +55,31 @@ def _fastest(error: float, t_end: float, model: str, name: str, per_kernel: int,
             continue
         for dx in sorted(DXS, reverse=True):  # coarse first: the first dx that reaches it is the cheapest
             try:
-                scene = Scene(dx=dx, name=name, kernel=kernel, h_factor=h, cfl=round(share * limit, 2), t_end=t_end,
-                              model="linear", memory_limit_bytes=2**62)
+                scene = Scene(
+                    dx=dx,
+                    name=name,
+                    kernel=kernel,
+                    h_factor=h,
+                    cfl=round(share * limit, 2),
+                    t_end=t_end,
+                    model="linear",
+                    memory_limit_bytes=2**62,
+                )
             except ValueError:  # a combination Scene refuses is not a candidate
                 continue
             p = predict(scene)
             if p.predicted_error <= error:
-                found.append({"kernel": kernel, "h_factor": h, "cfl": scene.cfl, "dx": dx, "stable_cfl": limit,
-                              "predicted_error": p.predicted_error, "cost": cost(scene)})
+                found.append(
+                    {
+                        "kernel": kernel,
+                        "h_factor": h,
+                        "cfl": scene.cfl,
+                        "dx": dx,
+                        "stable_cfl": limit,
+                        "predicted_error": p.predicted_error,
+                        "cost": cost(scene),
+                    }
+                )
                 break
     found.sort(key=lambda m: m["cost"])
     out, per = [], {}

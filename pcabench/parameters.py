@@ -10,6 +10,7 @@ fields when the store loads it). The command line builds its options from
 this table, advise writes its commands with it, and the error messages name
 the option a user typed through it.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -48,8 +49,11 @@ class Parameter:
 
 
 def _kernel_help() -> str:
-    compact = "; ".join(f"{k} is cut at its compact support {kernel_named(k).support:g}h"
-                        for k in kernel_names() if kernel_named(k).support is not None)
+    compact = "; ".join(
+        f"{k} is cut at its compact support {kernel_named(k).support:g}h"
+        for k in kernel_names()
+        if kernel_named(k).support is not None
+    )
     return "SPH kernel, truncated at --cutoff" + (f" ({compact})" if compact else "")
 
 

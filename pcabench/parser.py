@@ -2,6 +2,7 @@
 
 Shared by ``pcabench`` (cli.py) and the smaller entry points (asv_smoke.py) without either importing the
 other."""
+
 from __future__ import annotations
 
 import argparse

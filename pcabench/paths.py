@@ -13,6 +13,7 @@ Two kinds of place:
 
 Nothing is ever written into the installed package.
 """
+
 from __future__ import annotations
 
 import os

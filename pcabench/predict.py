@@ -9,6 +9,7 @@ the solver's ``order`` (2 for all-pair, 1 for a cell list). A run whose predicte
 plus JIT and start-up, exceeds the run budget is recorded as ``skipped`` with
 the prediction, instead of being run into the wall.
 """
+
 from __future__ import annotations
 
 import math
@@ -24,10 +25,14 @@ START_UP = 5.0  # s: a child process, imports and JIT on a tiny scene (measured 
 
 def _same_config(row: dict, spec) -> bool:
     rs, scene = row.get("scene") or {}, spec.scene
-    return (row.get("status") == "ok" and row.get("solver") == spec.solver
-            and int(row.get("threads") or 1) == int(spec.threads)
-            and rs.get("precision") == scene.precision and rs.get("model") == scene.model
-            and (row.get("steps") or 0) > 0)
+    return (
+        row.get("status") == "ok"
+        and row.get("solver") == spec.solver
+        and int(row.get("threads") or 1) == int(spec.threads)
+        and rs.get("precision") == scene.precision
+        and rs.get("model") == scene.model
+        and (row.get("steps") or 0) > 0
+    )
 
 
 def _reach(solver: str, scene: dict) -> float:
@@ -67,9 +72,11 @@ def predicted_seconds(spec, rows: list[dict]):
     if model is None:
         return None, ""
     a, b, sizes = model
-    step = a * scene.n_particles ** b
+    step = a * scene.n_particles**b
     seconds = START_UP + scene.n_steps * step
     sizes_txt = ", ".join(f"{n:,}" for n in sizes[-3:])
-    why = (f"predicted {seconds:.3g} s ({scene.n_steps} steps x {1e3 * step:.3g} ms; step time "
-           f"~ N^{b:.2f} fitted to N = {sizes_txt} on this host)")
+    why = (
+        f"predicted {seconds:.3g} s ({scene.n_steps} steps x {1e3 * step:.3g} ms; step time "
+        f"~ N^{b:.2f} fitted to N = {sizes_txt} on this host)"
+    )
     return (seconds if math.isfinite(seconds) else None), why

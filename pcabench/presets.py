@@ -5,6 +5,7 @@ figures need, smallest first, so that a sweep can predict the cost of a large
 run from the smaller ones before it. Scene defaults (h/dx, CFL, cutoff, integrator, the strip
 rule) come from :class:`solvers.Scene`, never from here.
 """
+
 from __future__ import annotations
 
 import itertools
@@ -14,8 +15,15 @@ from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, solver_c
 from .spec import ALL_CORES, SERIAL, RunSpec
 
 # Seconds per run before it is recorded as a timeout, by preset (--run-budget overrides).
-RUN_BUDGET = {"quick": 120.0, "paper": 900.0, "stability": 120.0, "stability-long": 300.0, "matrix": 900.0,
-              "front": 300.0, "front-full": 900.0}
+RUN_BUDGET = {
+    "quick": 120.0,
+    "paper": 900.0,
+    "stability": 120.0,
+    "stability-long": 300.0,
+    "matrix": 900.0,
+    "front": 300.0,
+    "front-full": 900.0,
+}
 
 # The stability preset's scene: the design's dx = 0.25 on a strip, the linear model
 # (exactly the linear wave equation, so growth is the integrator's, not the physics').
@@ -33,8 +41,10 @@ QUICK_CFL = (0.2, 2.0, 5.0, 7.0)  # the quick map: stable, stable, just past the
 # does not break before t = 300 s: 350 s; the pulse leaves by the free end long before, so that the run then tests
 # the edges); and the 2D acoustic pulse in a 20 m periodic square, where the sound never leaves and never breaks.
 # The linear model runs beside the moving ones on each: the control whose limit the prediction knows exactly.
-LONG_SCENES = {"plane-pulse": dict(strip=True, mach=0.01),
-               "acoustic-pulse": dict(x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0)}
+LONG_SCENES = {
+    "plane-pulse": dict(strip=True, mach=0.01),
+    "acoustic-pulse": dict(x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0),
+}
 LONG_T_END = 300.0  # s: about 250 steps at CFL 4.7, dx 0.25
 LONG_CFL = (4.4, 4.5, 4.6, 4.7, 4.75, 4.8, 4.9, 5.0)
 LONG_MODELS = ("linear", "fixed", "lagrangian")
@@ -43,8 +53,9 @@ LONG_MODELS = ("linear", "fixed", "lagrangian")
 def _spec(solver=DEFAULT_SOLVER, threads=SERIAL, strip=False, pair_loop="auto", **scene) -> RunSpec:
     """One run; ``strip`` puts it on the thinnest y-periodic strip Scene accepts."""
     if strip:
-        scene["strip_height"] = Scene.thinnest_strip(scene["dx"], scene.get("cutoff_factor"),
-                                                     scene.get("h_factor"), scene.get("kernel"))
+        scene["strip_height"] = Scene.thinnest_strip(
+            scene["dx"], scene.get("cutoff_factor"), scene.get("h_factor"), scene.get("kernel")
+        )
     return RunSpec(solver, Scene(**scene), threads, pair_loop=pair_loop)
 
 
@@ -70,8 +81,11 @@ def quick() -> list[RunSpec]:
     # The stability map: Verlet on the stability scene at a few CFLs, up to past its limit
     runs += [_spec(dx=STABILITY_DX, t_end=10.0, model="linear", strip=True, cfl=cfl) for cfl in QUICK_CFL]
     # Another scene: the 2D acoustic pulse, linear and lagrangian, at the default amplitude and a small one
-    runs += [_spec(name="acoustic-pulse", dx=0.5, t_end=10.0, model=model, mach=mach)
-             for mach in (Scene.default("mach"), 0.005) for model in ("linear", "lagrangian")]
+    runs += [
+        _spec(name="acoustic-pulse", dx=0.5, t_end=10.0, model=model, mach=mach)
+        for mach in (Scene.default("mach"), 0.005)
+        for model in ("linear", "lagrangian")
+    ]
     return runs
 
 
@@ -123,19 +137,32 @@ def stability() -> list[RunSpec]:
 def stability_long() -> list[RunSpec]:
     """Each model of the paper's method at the CFLs around its predicted limit, to t = 300 s (dx = 0.25), on
     each scene of LONG_SCENES."""
-    return [_spec(name=scene, dx=STABILITY_DX, t_end=LONG_T_END, model=model, cfl=cfl, **setting)
-            for scene, setting in LONG_SCENES.items() for model in LONG_MODELS for cfl in LONG_CFL]
+    return [
+        _spec(name=scene, dx=STABILITY_DX, t_end=LONG_T_END, model=model, cfl=cfl, **setting)
+        for scene, setting in LONG_SCENES.items()
+        for model in LONG_MODELS
+        for cfl in LONG_CFL
+    ]
 
 
 # The speed-accuracy front at t = 10 s on the strip, serial: kernel x h/dx x CFL x dx x precision x model, the
 # kernels every registered one (:func:`front_axes`). CFL 6 is past every configuration's predicted stable step:
 # the front shows where methods fail.
 FRONT = {
-    "quick": dict(h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0, 6.0),
-                  dx=(0.4, 0.2, 0.1), precision=("float64", "float32"), model=("linear", "lagrangian")),
-    "full": dict(h_factor=(1.0, 1.3, 1.6, 2.13, 2.6),
-                 cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0), dx=(0.4, 0.2, 0.1, 0.05, 0.025),
-                 precision=("float64", "float32"), model=("linear", "lagrangian")),
+    "quick": dict(
+        h_factor=(1.3, 2.13),
+        cfl=(0.2, 1.0, 3.0, 6.0),
+        dx=(0.4, 0.2, 0.1),
+        precision=("float64", "float32"),
+        model=("linear", "lagrangian"),
+    ),
+    "full": dict(
+        h_factor=(1.0, 1.3, 1.6, 2.13, 2.6),
+        cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0),
+        dx=(0.4, 0.2, 0.1, 0.05, 0.025),
+        precision=("float64", "float32"),
+        model=("linear", "lagrangian"),
+    ),
 }
 FRONT_T_END = 10.0
 
@@ -153,19 +180,30 @@ def fast_methods(model: str) -> tuple[dict, ...]:
     from .methods import fastest
 
     paper = predict(Scene(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model="linear", memory_limit_bytes=2**62))
-    return tuple({k: m[k] for k in ("kernel", "h_factor", "cfl", "dx")}
-                 for m in fastest(paper.predicted_error, FRONT_T_END, model))
+    return tuple(
+        {k: m[k] for k in ("kernel", "h_factor", "cfl", "dx")}
+        for m in fastest(paper.predicted_error, FRONT_T_END, model)
+    )
 
 
 # The 2D acoustic pulse's front (40 m periodic square, t = 10 s, serial): no strip (the pulse spreads in y), so
 # fewer and coarser runs; the paper's method at dx 0.1 beside them. CFL 3 is past the stable step of h = 1.3 dx.
 # The kernels: every registered one, as on the strip.
 FRONT_2D = {
-    "quick": dict(h_factor=(1.3, 2.13), cfl=(0.2, 1.0, 3.0),
-                  dx=(0.5, 0.25, 0.125), precision=("float64",), model=("linear", "lagrangian")),
-    "full": dict(h_factor=(1.0, 1.3, 1.6, 2.13),
-                 cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0), dx=(0.5, 0.25, 0.125, 0.1), precision=("float64", "float32"),
-                 model=("linear", "lagrangian")),
+    "quick": dict(
+        h_factor=(1.3, 2.13),
+        cfl=(0.2, 1.0, 3.0),
+        dx=(0.5, 0.25, 0.125),
+        precision=("float64",),
+        model=("linear", "lagrangian"),
+    ),
+    "full": dict(
+        h_factor=(1.0, 1.3, 1.6, 2.13),
+        cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0),
+        dx=(0.5, 0.25, 0.125, 0.1),
+        precision=("float64", "float32"),
+        model=("linear", "lagrangian"),
+    ),
 }
 PAPER_METHOD_2D_DX = (0.2, 0.1)
 # Which model a scene needs: the paper's method at these amplitudes, linear against lagrangian, scored against
@@ -177,8 +215,12 @@ MODEL_DX = {DEFAULT_SCENE: (0.2, 0.1), "acoustic-pulse": (0.25,)}
 def model_needs(scene: str) -> list[RunSpec]:
     """Linear against lagrangian at several amplitudes, the paper's method, t = 10 s (a strip where it serves)."""
     strip = scene == DEFAULT_SCENE
-    return [_spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model, mach=mach, strip=strip)
-            for dx in MODEL_DX.get(scene, (0.25,)) for mach in MODEL_MACH for model in ("linear", "lagrangian")]
+    return [
+        _spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model, mach=mach, strip=strip)
+        for dx in MODEL_DX.get(scene, (0.25,))
+        for mach in MODEL_MACH
+        for model in ("linear", "lagrangian")
+    ]
 
 
 def front_axes(size: str = "quick", scene: str = DEFAULT_SCENE) -> dict:
@@ -194,15 +236,24 @@ def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     if scene != DEFAULT_SCENE:
         axes = front_axes(size, scene)
         names = [k for k in axes if k != "dx"]
-        runs = [_spec(name=scene, dx=dx, t_end=FRONT_T_END, **dict(zip(names, values)))
-                for dx in sorted(axes["dx"], reverse=True) for values in itertools.product(*(axes[k] for k in names))]
-        runs += [_spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model)
-                 for model in ("linear", "lagrangian") for dx in PAPER_METHOD_2D_DX]
+        runs = [
+            _spec(name=scene, dx=dx, t_end=FRONT_T_END, **dict(zip(names, values)))
+            for dx in sorted(axes["dx"], reverse=True)
+            for values in itertools.product(*(axes[k] for k in names))
+        ]
+        runs += [
+            _spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model)
+            for model in ("linear", "lagrangian")
+            for dx in PAPER_METHOD_2D_DX
+        ]
         return runs + model_needs(scene)
     axes = front_axes(size, scene)
     names = [k for k in axes if k != "dx"]
-    runs = [_spec(dx=dx, t_end=FRONT_T_END, strip=True, **dict(zip(names, values)))
-            for dx in sorted(axes["dx"], reverse=True) for values in itertools.product(*(axes[k] for k in names))]
+    runs = [
+        _spec(dx=dx, t_end=FRONT_T_END, strip=True, **dict(zip(names, values)))
+        for dx in sorted(axes["dx"], reverse=True)
+        for values in itertools.product(*(axes[k] for k in names))
+    ]
     for model in ("linear", "lagrangian"):
         runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in fast_methods(model)]
         runs.append(_spec(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model=model))
@@ -213,8 +264,14 @@ def front_full(scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     return front("full", scene)
 
 
-PRESETS = {"quick": quick, "paper": paper, "stability": stability, "stability-long": stability_long, "front": front,
-           "front-full": front_full}
+PRESETS = {
+    "quick": quick,
+    "paper": paper,
+    "stability": stability,
+    "stability-long": stability_long,
+    "front": front,
+    "front-full": front_full,
+}
 
 
 def preset(name: str, scene: str = DEFAULT_SCENE) -> list[RunSpec]:
@@ -226,8 +283,16 @@ def preset(name: str, scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     return [RunSpec(s.solver, s.scene, s.threads, name, s.pair_loop) for s in specs]
 
 
-def matrix(solvers=(DEFAULT_SOLVER,), dxs=(), threads=(SERIAL,), steps=(None,), t_ends=(None,),
-           strip=False, pair_loops=("auto",), **scene_lists) -> list[RunSpec]:
+def matrix(
+    solvers=(DEFAULT_SOLVER,),
+    dxs=(),
+    threads=(SERIAL,),
+    steps=(None,),
+    t_ends=(None,),
+    strip=False,
+    pair_loops=("auto",),
+    **scene_lists,
+) -> list[RunSpec]:
     """The product of the option lists, smallest N first, as run specs of preset ``matrix``.
 
     ``scene_lists`` maps Scene parameters (precision, model, integrator, cfl,
@@ -244,7 +309,8 @@ def matrix(solvers=(DEFAULT_SOLVER,), dxs=(), threads=(SERIAL,), steps=(None,), 
     any_threaded = any(cls.threaded for cls in classes)
     runs = []
     for solver, dx, nthreads, loop, end, *values in itertools.product(
-            solvers, sorted(dxs, reverse=True), threads, pair_loops, ends, *(scene_lists[k] for k in names)):
+        solvers, sorted(dxs, reverse=True), threads, pair_loops, ends, *(scene_lists[k] for k in names)
+    ):
         scene = dict(zip(names, values), dx=dx, **end)
         cls = solver_class(solver)
         if loop not in cls.pair_loops and loop in offered_loops:

@@ -20,6 +20,7 @@ CPU runs included. Two environment variables bear on it:
 - ``PCABENCH_FAKE_GPU``: a test hook; a card name that :func:`gpu_info`
   reports as this machine's GPU.
 """
+
 from __future__ import annotations
 
 import functools
@@ -35,6 +36,7 @@ from . import paths
 PROFILE_BYTES = 1 << 24  # a stored profile larger than this is not read
 MACHINE_ID_ENV = "PCABENCH_MACHINE_ID"  # the id a sweep gives its children
 FAKE_GPU_ENV = "PCABENCH_FAKE_GPU"  # test hook: a card name gpu_info() reports
+
 
 class ProfileWarning(UserWarning):
     """A stored hardware profile was skipped (not JSON, or not an object)."""
@@ -92,6 +94,7 @@ def _cuda_gpu_info() -> dict | None:
         return None
     try:
         import cupy
+
         if cupy.cuda.runtime.getDeviceCount() < 1:
             return None
         props = cupy.cuda.runtime.getDeviceProperties(0)
@@ -112,15 +115,21 @@ def _cuda_gpu_info() -> dict | None:
         }
         if info["memory_clock_mhz"] and info["memory_bus_bits"]:
             info["peak_bandwidth_tbs_from_clocks"] = round(
-                2 * info["memory_clock_mhz"] * 1e6 * info["memory_bus_bits"] / 8 / 1e12, 3)
+                2 * info["memory_clock_mhz"] * 1e6 * info["memory_bus_bits"] / 8 / 1e12, 3
+            )
         for key, peaks in DATASHEET.items():
             if key.lower() in name.lower():
                 info["datasheet"] = dict(peaks, note="datasheet value, not measured")
                 break
         try:
             import subprocess
-            smi = subprocess.run(["nvidia-smi", "--query-gpu=driver_version", "--format=csv,noheader"],
-                                 capture_output=True, text=True, timeout=20).stdout.strip()
+
+            smi = subprocess.run(
+                ["nvidia-smi", "--query-gpu=driver_version", "--format=csv,noheader"],
+                capture_output=True,
+                text=True,
+                timeout=20,
+            ).stdout.strip()
             if smi:
                 info["driver"] = smi.splitlines()[0]
         except (OSError, Exception):  # noqa: BLE001 - nvidia-smi is optional
@@ -191,8 +200,11 @@ def stored() -> dict:
             if isinstance(profile, dict):
                 out[p.stem] = profile
             else:
-                warnings.warn(f"{p}: not a hardware profile (a JSON object), skipped ({str(profile)[:80]})",
-                              ProfileWarning, stacklevel=2)
+                warnings.warn(
+                    f"{p}: not a hardware profile (a JSON object), skipped ({str(profile)[:80]})",
+                    ProfileWarning,
+                    stacklevel=2,
+                )
     return out
 
 

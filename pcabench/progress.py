@@ -1,4 +1,5 @@
 """Progress of a run on stderr: its steps, and an ETA from the steps so far."""
+
 from __future__ import annotations
 
 import sys
@@ -21,8 +22,7 @@ class Progress:
             return
         self.last = now
         eta = (now - self.t0) / max(done, 1) * (total - done)
-        self.stream.write(f"\r{self.label}: step {done}/{total} ({100 * done / total:5.1f} %), "
-                          f"eta {eta:6.1f} s ")
+        self.stream.write(f"\r{self.label}: step {done}/{total} ({100 * done / total:5.1f} %), eta {eta:6.1f} s ")
         if done == total:
             self.stream.write("\n")
         self.stream.flush()

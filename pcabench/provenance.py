@@ -1,4 +1,5 @@
 """Provenance of a result: git commit, package versions, a short machine id."""
+
 from __future__ import annotations
 
 import functools
@@ -8,8 +9,7 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
-PACKAGES = ("pcabench", "numpy", "numba", "numba-cuda", "cupy-cuda12x", "cupy-cuda13x", "pandas",
-            "matplotlib")
+PACKAGES = ("pcabench", "numpy", "numba", "numba-cuda", "cupy-cuda12x", "cupy-cuda13x", "pandas", "matplotlib")
 
 
 # The paths whose changes change a run's numbers (git pathspecs from the repository root).
@@ -41,13 +41,19 @@ def git_commit() -> str:
         return checked_env("PCABENCH_COMMIT", "commit")
     here = Path(__file__).resolve().parent
     try:
-        proc = subprocess.run(["git", "rev-parse", "--verify", "HEAD"], cwd=here, capture_output=True,
-                              text=True, timeout=10)
+        proc = subprocess.run(
+            ["git", "rev-parse", "--verify", "HEAD"], cwd=here, capture_output=True, text=True, timeout=10
+        )
         sha = proc.stdout.strip()
         if proc.returncode != 0 or len(sha) != 40:
             return "unknown"
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no", "--", *CODE],
-                               cwd=here, capture_output=True, text=True, timeout=10).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no", "--", *CODE],
+            cwd=here,
+            capture_output=True,
+            text=True,
+            timeout=10,
+        ).stdout.strip()
         return sha + ("+dirty" if dirty else "")
     except (OSError, subprocess.SubprocessError):
         return "unknown"

@@ -1,4 +1,5 @@
 """The run record: one run's parameters, stage times, errors, status and provenance."""
+
 from __future__ import annotations
 
 import datetime as _dt
@@ -51,8 +52,23 @@ class RunRecord:
     timestamp: str = field(default_factory=lambda: _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
     run_id: str = field(default_factory=lambda: uuid.uuid4().hex[:16])  # this record, wherever it is copied
 
-    CONTRACT = ("solver", "precision", "model", "integrator", "dx", "n_particles", "steps", "t_end",
-                "stages", "jit_seconds", "mse", "me", "mean_neighbours", "status", "failed_step")
+    CONTRACT = (
+        "solver",
+        "precision",
+        "model",
+        "integrator",
+        "dx",
+        "n_particles",
+        "steps",
+        "t_end",
+        "stages",
+        "jit_seconds",
+        "mse",
+        "me",
+        "mean_neighbours",
+        "status",
+        "failed_step",
+    )
 
     @classmethod
     def from_spec(cls, spec, machine: str = "", status: str = "error", message: str = "") -> "RunRecord":
@@ -63,13 +79,34 @@ class RunRecord:
         from .provenance import git_commit, host_id, package_versions
 
         nan, scene = float("nan"), spec.scene
-        return cls(solver=spec.solver, device=solver_class(spec.solver).device, precision=scene.precision,
-                   model=scene.model, integrator=scene.integrator,
-                   dx=scene.dx, n_particles=scene.n_particles, steps=0, t_end=0.0,
-                   stages={s: 0.0 for s in STAGES}, jit_seconds=0.0, mse=nan, me=nan, mean_neighbours=nan,
-                   status=status, failed_step=None, threads=int(spec.threads), pair_loop=spec.pair_loop,
-                   steps_requested=scene.n_steps, scene=scene.as_dict(), message=message, profile_id=machine,
-                   commit=git_commit(), versions=package_versions(), preset=spec.preset, host=host_id())
+        return cls(
+            solver=spec.solver,
+            device=solver_class(spec.solver).device,
+            precision=scene.precision,
+            model=scene.model,
+            integrator=scene.integrator,
+            dx=scene.dx,
+            n_particles=scene.n_particles,
+            steps=0,
+            t_end=0.0,
+            stages={s: 0.0 for s in STAGES},
+            jit_seconds=0.0,
+            mse=nan,
+            me=nan,
+            mean_neighbours=nan,
+            status=status,
+            failed_step=None,
+            threads=int(spec.threads),
+            pair_loop=spec.pair_loop,
+            steps_requested=scene.n_steps,
+            scene=scene.as_dict(),
+            message=message,
+            profile_id=machine,
+            commit=git_commit(),
+            versions=package_versions(),
+            preset=spec.preset,
+            host=host_id(),
+        )
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -96,17 +133,20 @@ class RunRecord:
         (in the scene's primary field: u in m/s, drho in kg/m^3) and its status."""
         primary = scene.kind.primary
         unit = {"u": "m/s", "drho": "kg/m^3"}.get(primary, "")
-        lines = [self.stage_table(),
-                 f"particles        {self.n_particles:,}",
-                 f"steps            {self.steps} (t = {self.t_end:.6g} s)",
-                 f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
-                 f"mean neighbours  {self.mean_neighbours:.2f}",
-                 f"MSE (rel. RMS)   {self.mse:.6g}" + ("" if primary == "u" else f" of {primary}"),
-                 f"ME (max)         {self.me:.6g} {unit}"]
+        lines = [
+            self.stage_table(),
+            f"particles        {self.n_particles:,}",
+            f"steps            {self.steps} (t = {self.t_end:.6g} s)",
+            f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
+            f"mean neighbours  {self.mean_neighbours:.2f}",
+            f"MSE (rel. RMS)   {self.mse:.6g}" + ("" if primary == "u" else f" of {primary}"),
+            f"ME (max)         {self.me:.6g} {unit}",
+        ]
         lines += [f"{name.replace('_', ' '):<17}{value:.6g}" for name, value in self.errors.items()]
         if self.mse_isothermal is not None:
-            lines.append(f"MSE against the isothermal solution (the equations lagrangian solves) "
-                         f"{self.mse_isothermal:.6g}")
+            lines.append(
+                f"MSE against the isothermal solution (the equations lagrangian solves) {self.mse_isothermal:.6g}"
+            )
         lines.append(f"status           {self.status}" + (f" at step {self.failed_step}" if self.failed_step else ""))
         if self.message:
             lines.append(f"message          {self.message.splitlines()[0]}")

@@ -4,6 +4,7 @@ A run that blows up (non-finite fields, or max|u| past the scene's bound) stops
 at once and is recorded with status ``unstable`` and its step; a device
 out-of-memory is recorded as ``out-of-memory``. Neither is a crash.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -47,8 +48,9 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> Ru
             amp = solver.amplitude()
             if not math.isfinite(amp) or amp > bound:
                 record.status, record.failed_step = "unstable", step
-                record.message = (f"max|u| = {amp:.3g} m/s at step {step} "
-                                  f"(bound {bound:.3g} = blowup_factor * mach * c0)")
+                record.message = (
+                    f"max|u| = {amp:.3g} m/s at step {step} (bound {bound:.3g} = blowup_factor * mach * c0)"
+                )
                 break
             if progress is not None:
                 progress(step, scene.n_steps)

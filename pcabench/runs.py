@@ -1,15 +1,34 @@
 """Stored runs as tables (pandas): list and filter them, and compare two machines or two commits.
 
-    pcabench runs --solver linkedlist-cpu --status ok
-    pcabench runs --compare amd-epyc h100-80gb-hbm3__intel-xeon      # two machines
-    pcabench runs --compare 0ff5d9e 92b452f                          # two commits
+pcabench runs --solver linkedlist-cpu --status ok
+pcabench runs --compare amd-epyc h100-80gb-hbm3__intel-xeon      # two machines
+pcabench runs --compare 0ff5d9e 92b452f                          # two commits
 """
+
 from __future__ import annotations
 
 import pandas as pd
 
-COLUMNS = ["machine", "commit", "solver", "threads", "pair_loop", "precision", "model", "integrator", "domain",
-           "protocol", "dx", "n_particles", "steps", "status", "step_ms", "mse", "timestamp", "note"]
+COLUMNS = [
+    "machine",
+    "commit",
+    "solver",
+    "threads",
+    "pair_loop",
+    "precision",
+    "model",
+    "integrator",
+    "domain",
+    "protocol",
+    "dx",
+    "n_particles",
+    "steps",
+    "status",
+    "step_ms",
+    "mse",
+    "timestamp",
+    "note",
+]
 NOTE_WIDTH = 160  # characters of a failed run's message in the table's note column
 CONFIG = ["solver", "threads", "pair_loop", "scene_key"]  # the same run on two machines or commits
 
@@ -34,15 +53,24 @@ def table(df: pd.DataFrame, **filters) -> pd.DataFrame:
     if df.empty:
         return pd.DataFrame(columns=COLUMNS)
     stepped = df.steps > 0
-    out = df.assign(step_ms=(1e3 * df.t_step).where(stepped), steps=df.steps.astype("Int64").where(stepped),
-                    mse=df.mse.where(stepped),
-                    commit=df.commit.astype(str).str[:7],
-                    note=(df.message if "message" in df else pd.Series("", index=df.index)).fillna("")
-                    .astype(str).map(note).where(df.status != "ok", ""))
+    out = df.assign(
+        step_ms=(1e3 * df.t_step).where(stepped),
+        steps=df.steps.astype("Int64").where(stepped),
+        mse=df.mse.where(stepped),
+        commit=df.commit.astype(str).str[:7],
+        note=(df.message if "message" in df else pd.Series("", index=df.index))
+        .fillna("")
+        .astype(str)
+        .map(note)
+        .where(df.status != "ok", ""),
+    )
     for column, value in filters.items():
         if value:
-            hit = (out.machine.isin(machines(out.machine, str(value))) if column == "machine"
-                   else out[column].astype(str).str.startswith(str(value)))
+            hit = (
+                out.machine.isin(machines(out.machine, str(value)))
+                if column == "machine"
+                else out[column].astype(str).str.startswith(str(value))
+            )
             out = out[hit]
     return out.sort_values(["machine", "timestamp"])[COLUMNS]
 
@@ -73,8 +101,10 @@ def compare(df: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
     kind_b, rb = side(ok, b)
     for key, kind in ((a, kind_a), (b, kind_b)):
         if not kind:
-            raise KeyError(f"--compare: {key!r} is neither a machine nor a commit of a finished run in the store "
-                           f"(machines: {', '.join(machines(df.machine, ''))})")
+            raise KeyError(
+                f"--compare: {key!r} is neither a machine nor a commit of a finished run in the store "
+                f"(machines: {', '.join(machines(df.machine, ''))})"
+            )
     if kind_a != kind_b:  # a machine's runs span commits, a commit's span machines: no like with like
         raise KeyError(f"--compare: {a!r} is a {kind_a} and {b!r} a {kind_b}: compare two machines or two commits")
     # a machine's columns are named by the machine, a prefix's included
@@ -83,10 +113,22 @@ def compare(df: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
     ra = ra.sort_values("timestamp").drop_duplicates(newest, keep="last")
     rb = rb.sort_values("timestamp").drop_duplicates(newest, keep="last")
     both = ra.merge(rb, on=newest, suffixes=("_a", "_b"))
-    out = pd.DataFrame({"solver": both.solver, "threads": both.threads, "pair_loop": both.pair_loop,
-                        "precision": both.precision_a, "model": both.model_a, "domain": both.domain_a,
-                        "protocol": both.protocol_a, "N": both.n_particles_a,
-                        f"step_ms {a}": 1e3 * both.t_step_a, f"step_ms {b}": 1e3 * both.t_step_b,
-                        "b / a": both.t_step_b / both.t_step_a,
-                        f"mse {a}": both.mse_a, f"mse {b}": both.mse_b, "mse b - a": both.mse_b - both.mse_a})
+    out = pd.DataFrame(
+        {
+            "solver": both.solver,
+            "threads": both.threads,
+            "pair_loop": both.pair_loop,
+            "precision": both.precision_a,
+            "model": both.model_a,
+            "domain": both.domain_a,
+            "protocol": both.protocol_a,
+            "N": both.n_particles_a,
+            f"step_ms {a}": 1e3 * both.t_step_a,
+            f"step_ms {b}": 1e3 * both.t_step_b,
+            "b / a": both.t_step_b / both.t_step_a,
+            f"mse {a}": both.mse_a,
+            f"mse {b}": both.mse_b,
+            "mse b - a": both.mse_b - both.mse_a,
+        }
+    )
     return out.sort_values(["solver", "threads", "precision", "model", "N"]).reset_index(drop=True)

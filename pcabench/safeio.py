@@ -8,6 +8,7 @@ partial file and says which path it was writing (:class:`~pcabench.store.StoreEr
 A folder pcabench writes into, or deletes in, that is itself a link is
 refused (:func:`own_folder`).
 """
+
 from __future__ import annotations
 
 import errno
@@ -28,7 +29,7 @@ def _error(path, exc: OSError):
 
 def _write_all(fd: int, data: bytes) -> None:
     while data:
-        data = data[os.write(fd, data):]
+        data = data[os.write(fd, data) :]
 
 
 def own_folder(path, what: str = "folder") -> Path:

@@ -14,6 +14,7 @@ the report's folder; ``solver``, ``commit``) are letters, digits and
 ``. _ - +`` of bounded length, and never one of :data:`RESERVED` (a file
 pcabench writes beside them).
 """
+
 from __future__ import annotations
 
 import math
@@ -38,8 +39,10 @@ TIMESTAMP = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?([+-]\d\d:\d\d|Z)
 CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
 MESSAGE_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # a message may hold newlines and tabs
 # files and folders pcabench writes beside a machine's store or report folder: never a machine's name
-RESERVED = frozenset(n.lower() for n in ("README.md", "cards.md", "gpu", "results", "store", "reports",
-                                         "hardware_profiles", "index.md", ".", ".."))
+RESERVED = frozenset(
+    n.lower()
+    for n in ("README.md", "cards.md", "gpu", "results", "store", "reports", "hardware_profiles", "index.md", ".", "..")
+)
 RESERVED_SUFFIXES = (".md", ".png", ".json", ".jsonl", ".lock", ".torn", ".reserve", ".npz", ".gz", ".tmp")
 
 
@@ -113,10 +116,29 @@ SCENE_FIELDS: dict[str, Field] = {
     "strip_height": Field(("number", "null"), low=0, high=1e12),
     "n_particles": Field(("int",), low=0, high=2**31 - 1),
     "n_steps": Field(("int",), True, low=0, high=MAX_STEPS),
-    "cutoff": _SCENE_NUMBER, "h": _SCENE_NUMBER, "dt": _SCENE_NUMBER, "t_final": _SCENE_NUMBER,
-    **{k: Field(("number",), low=-1e12, high=1e12) for k in (
-        "x_min", "x_max", "y_min", "y_max", "rho0", "c0", "mach", "pulse_width", "pulse_center", "h_factor",
-        "cutoff_factor", "cfl", "blowup_factor", "height")},
+    "cutoff": _SCENE_NUMBER,
+    "h": _SCENE_NUMBER,
+    "dt": _SCENE_NUMBER,
+    "t_final": _SCENE_NUMBER,
+    **{
+        k: Field(("number",), low=-1e12, high=1e12)
+        for k in (
+            "x_min",
+            "x_max",
+            "y_min",
+            "y_max",
+            "rho0",
+            "c0",
+            "mach",
+            "pulse_width",
+            "pulse_center",
+            "h_factor",
+            "cutoff_factor",
+            "cfl",
+            "blowup_factor",
+            "height",
+        )
+    },
     "kernel": _name(max_len=32, pattern=KERNEL_NAME),  # as the kernel registry checks
     "model": Field(("str",), choices=MODELS),
     "integrator": Field(("str",), choices=INTEGRATORS),
@@ -165,11 +187,15 @@ def check_value(key: str, spec: Field, value) -> str:
             return f"{key!r} is out of range (got an integer of {value.bit_length()} bits)"
         if not math.isfinite(value):
             return f"{key!r} must be finite (got {value!r})"
-        if (spec.low is not None and (value <= spec.low if spec.above else value < spec.low)) \
-                or (spec.high is not None and value > spec.high):
+        if (spec.low is not None and (value <= spec.low if spec.above else value < spec.low)) or (
+            spec.high is not None and value > spec.high
+        ):
             low = f"{'(' if spec.above else '['}{spec.low:g}"
-            return f"{key!r} must be in {low}, {spec.high:g}] (got {value!r:.40})" if spec.high is not None \
+            return (
+                f"{key!r} must be in {low}, {spec.high:g}] (got {value!r:.40})"
+                if spec.high is not None
                 else f"{key!r} must be >= {spec.low:g} (got {value!r:.40})"
+            )
     if kind == "str":
         why = text_problem(value, MESSAGE_CONTROL if key == "message" else CONTROL)
         if why:
@@ -279,4 +305,4 @@ def clean_text(text: str, limit: int = MAX_MESSAGE) -> str:
     surrogates replaced, cut to its last ``limit`` characters."""
     text = text.encode("utf-8", "replace").decode("utf-8")
     text = MESSAGE_CONTROL.sub("?", text)
-    return text if len(text) <= limit else "..." + text[-(limit - 3):]
+    return text if len(text) <= limit else "..." + text[-(limit - 3) :]

@@ -9,6 +9,7 @@ The thread policy lives here and nowhere else: ``threads`` is an integer >= 1
 (1 is serial, the paper's CPU code) or ``"all"`` (every core this process may
 use, for a solver whose class says it is ``threaded``), resolved to an integer by :func:`resolve_threads`.
 """
+
 from __future__ import annotations
 
 import json
@@ -62,8 +63,9 @@ def resolve_threads(threads, solver: str) -> int:
     import numba
 
     if threads > numba.config.NUMBA_NUM_THREADS:
-        raise OptionError(f"--threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} "
-                          f"on this machine (got {threads})")
+        raise OptionError(
+            f"--threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} on this machine (got {threads})"
+        )
     return threads
 
 
@@ -100,8 +102,13 @@ class RunSpec:
         (itself if it is resolved already: a spec is resolved once, where the sweep or command starts)."""
         if self.is_resolved:
             return self
-        return RunSpec(self.solver, self.scene, resolve_threads(self.threads, self.solver), self.preset,
-                       resolve_pair_loop(self.solver, self.scene, self.pair_loop))
+        return RunSpec(
+            self.solver,
+            self.scene,
+            resolve_threads(self.threads, self.solver),
+            self.preset,
+            resolve_pair_loop(self.solver, self.scene, self.pair_loop),
+        )
 
     def key(self, machine: str, commit: str, host: str) -> str:
         """:func:`identity` of this (resolved) spec run on ``machine``/``host`` at ``commit``."""
@@ -119,14 +126,23 @@ class RunSpec:
         return f"{self.solver}{threads}{loop}{scene} dx={s.dx:g} N={s.n_particles:,}" + (f" {extra}" if extra else "")
 
     def to_json(self) -> str:
-        return json.dumps({"solver": self.solver, "threads": self.threads, "scene": scene_parameters(self.scene),
-                           "preset": self.preset, "pair_loop": self.pair_loop}, sort_keys=True)
+        return json.dumps(
+            {
+                "solver": self.solver,
+                "threads": self.threads,
+                "scene": scene_parameters(self.scene),
+                "preset": self.preset,
+                "pair_loop": self.pair_loop,
+            },
+            sort_keys=True,
+        )
 
     @classmethod
     def from_json(cls, text: str) -> "RunSpec":
         d = json.loads(text)
-        return cls(d["solver"], Scene(**d["scene"]), d.get("threads", SERIAL), d.get("preset", ""),
-                   d.get("pair_loop", "auto"))
+        return cls(
+            d["solver"], Scene(**d["scene"]), d.get("threads", SERIAL), d.get("preset", ""), d.get("pair_loop", "auto")
+        )
 
 
 def scene_parameters(scene: Scene) -> dict:
@@ -148,8 +164,16 @@ def scene_from_row(row: dict) -> Scene:
     return Scene(**stored_parameters(row.get("scene") or {}))
 
 
-def identity(solver: str, threads: int, scene: Scene | dict, preset: str, profile: str, commit: str,
-             host: str, pair_loop: str = "") -> str:
+def identity(
+    solver: str,
+    threads: int,
+    scene: Scene | dict,
+    preset: str,
+    profile: str,
+    commit: str,
+    host: str,
+    pair_loop: str = "",
+) -> str:
     """The key of a run for resuming and de-duplication: the same key is the same run.
 
     ``scene`` may be a Scene or a stored row's scene dict (its derived keys are ignored, the parameters
@@ -157,11 +181,20 @@ def identity(solver: str, threads: int, scene: Scene | dict, preset: str, profil
     ``pair_loop`` is the loop the run used (rows from before pair loops had none).
     """
     scene = stored_parameters(scene) if isinstance(scene, dict) else scene_parameters(scene)
-    return json.dumps([solver, int(threads), scene, preset or "", profile, commit, host, pair_loop or ""],
-                      sort_keys=True, default=str)
+    return json.dumps(
+        [solver, int(threads), scene, preset or "", profile, commit, host, pair_loop or ""], sort_keys=True, default=str
+    )
 
 
 def row_identity(row: dict) -> str:
     """:func:`identity` of a stored row."""
-    return identity(row["solver"], int(row.get("threads") or 1), row.get("scene") or {}, row.get("preset", ""),
-                    row.get("profile_id", ""), row.get("commit", ""), row.get("host", ""), row.get("pair_loop", ""))
+    return identity(
+        row["solver"],
+        int(row.get("threads") or 1),
+        row.get("scene") or {},
+        row.get("preset", ""),
+        row.get("profile_id", ""),
+        row.get("commit", ""),
+        row.get("host", ""),
+        row.get("pair_loop", ""),
+    )

@@ -12,6 +12,7 @@ ended bounded, its run was too short for round-off to grow, and
 the pulse's size). advise, the speed-accuracy front, the time-to-accuracy
 table and the stability map all read :func:`assess`.
 """
+
 from __future__ import annotations
 
 import math
@@ -31,10 +32,12 @@ UNSTABLE_BY_PREDICTION = "unstable by prediction"
 # one too, so that it is the free ends' limit; on the 2D pulse in a periodic 20 m square linear and lagrangian
 # bounded at 4.9 and blew up at 5 (the prediction), fixed blew up from 4.75 (bounded at 4.7).
 _PAPER_METHOD = ("gaussian", 2.13, 3.0, "verlet")
-MEASURED_LIMITS = {("plane-pulse", "linear", *_PAPER_METHOD): (4.8, 4.75),
-                   ("plane-pulse", "fixed", *_PAPER_METHOD): (4.8, 4.75),
-                   ("plane-pulse", "lagrangian", *_PAPER_METHOD): (4.8, 4.75),
-                   ("acoustic-pulse", "fixed", *_PAPER_METHOD): (4.75, 4.7)}
+MEASURED_LIMITS = {
+    ("plane-pulse", "linear", *_PAPER_METHOD): (4.8, 4.75),
+    ("plane-pulse", "fixed", *_PAPER_METHOD): (4.8, 4.75),
+    ("plane-pulse", "lagrangian", *_PAPER_METHOD): (4.8, 4.75),
+    ("acoustic-pulse", "fixed", *_PAPER_METHOD): (4.75, 4.7),
+}
 
 
 def _value(r, key, default=None):
@@ -68,9 +71,12 @@ def method_of(r) -> tuple[str, float, float, str]:
     """(kernel, h/dx, cutoff/h, integrator) of a stored run or a front point (Scene's defaults where missing)."""
     from solvers import Scene
 
-    return (str(_value(r, "kernel", Scene.default("kernel"))), float(_value(r, "h_factor", Scene.default("h_factor"))),
-            float(_value(r, "cutoff_factor", Scene.default("cutoff_factor"))),
-            str(_value(r, "integrator", Scene.default("integrator"))))
+    return (
+        str(_value(r, "kernel", Scene.default("kernel"))),
+        float(_value(r, "h_factor", Scene.default("h_factor"))),
+        float(_value(r, "cutoff_factor", Scene.default("cutoff_factor"))),
+        str(_value(r, "integrator", Scene.default("integrator"))),
+    )
 
 
 def measured_limit(r) -> float | None:
@@ -115,6 +121,10 @@ def assess(r) -> dict:
     ``limit_from`` ("prediction", or "long runs" where the limit long runs of its scene measured is the lower)
     and ``predicted`` (the periodic lattice's predicted limit)."""
     limit, cfl, predicted = stable_limit(r), float(r["cfl"]), _limits(*method_of(r))[0]
-    return {"stable_cfl": limit, "fraction": cfl / limit if limit > 0 else math.inf,
-            "past_limit": past_limit(cfl, limit), "predicted": predicted,
-            "limit_from": "prediction" if limit == predicted else "long runs"}
+    return {
+        "stable_cfl": limit,
+        "fraction": cfl / limit if limit > 0 else math.inf,
+        "past_limit": past_limit(cfl, limit),
+        "predicted": predicted,
+        "limit_from": "prediction" if limit == predicted else "long runs",
+    }

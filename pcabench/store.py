@@ -30,6 +30,7 @@ writer at a time.
 - Stores taken on different machines merge by concatenation: a record keeps
   its ``run_id`` wherever it is copied, and duplicates are dropped on load.
 """
+
 from __future__ import annotations
 
 import errno
@@ -69,8 +70,19 @@ class InvalidRecord(StoreError):
 
 def run_id(row: dict) -> str:
     """The id of a row that has none (rows of old stores): a hash of its provenance and time."""
-    key = json.dumps([row.get("profile_id"), row.get("commit"), row.get("solver"), row.get("threads"),
-                      row.get("scene"), row.get("timestamp"), row.get("host")], sort_keys=True, default=str)
+    key = json.dumps(
+        [
+            row.get("profile_id"),
+            row.get("commit"),
+            row.get("solver"),
+            row.get("threads"),
+            row.get("scene"),
+            row.get("timestamp"),
+            row.get("host"),
+        ],
+        sort_keys=True,
+        default=str,
+    )
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 
@@ -141,14 +153,15 @@ def check_writable(path) -> Path:
         raise StoreError(f"results store {path} is not writable: {exc.strerror or exc}") from None
     free = shutil.disk_usage(path.parent).free
     if free < MIN_FREE_BYTES:
-        raise StoreError(f"results store {path}: only {free} bytes free on its file system "
-                         f"(need at least {MIN_FREE_BYTES})")
+        raise StoreError(
+            f"results store {path}: only {free} bytes free on its file system (need at least {MIN_FREE_BYTES})"
+        )
     return path
 
 
 def _write_all(fd: int, data: bytes) -> None:
     while data:
-        data = data[os.write(fd, data):]
+        data = data[os.write(fd, data) :]
 
 
 def _complete(line: bytes) -> bool:
@@ -185,8 +198,11 @@ def _repair_tail(fd: int, path: Path) -> None:
     finally:
         os.close(torn)
     os.ftruncate(fd, start)
-    warnings.warn(f"{path}: a torn last line ({len(tail)} bytes, a write cut short) was moved to {path}.torn",
-                  StoreWarning, stacklevel=3)
+    warnings.warn(
+        f"{path}: a torn last line ({len(tail)} bytes, a write cut short) was moved to {path}.torn",
+        StoreWarning,
+        stacklevel=3,
+    )
 
 
 def reserve_path(path) -> Path:
@@ -250,8 +266,10 @@ def append(record, path) -> dict:
             raise StoreError(f"results store {path}: the disk is full; the record was not stored") from None
         raise StoreError(f"results store {path} is not writable: {exc.strerror or exc}") from None
     if freed:
-        raise StoreError(f"results store {path}: the disk is full; this run's record was stored in the space "
-                         "kept for it, and the sweep stops: free some space and rerun to resume")
+        raise StoreError(
+            f"results store {path}: the disk is full; this run's record was stored in the space "
+            "kept for it, and the sweep stops: free some space and rerun to resume"
+        )
     return row
 
 
@@ -281,19 +299,26 @@ class SweepLock:
         except BlockingIOError:  # only an exclusive holder writes its pid
             holder = os.pread(fd, 200, 0).decode("utf-8", "replace").strip() if holder_wrote_pid else ""
             self.__exit__()
-            raise StoreError(f"{what} is in use by another sweep{f' ({holder})' if holder else ''}; "
-                             "wait for it, or give this one its own --results folder") from None
+            raise StoreError(
+                f"{what} is in use by another sweep{f' ({holder})' if holder else ''}; "
+                "wait for it, or give this one its own --results folder"
+            ) from None
         return fd
 
     def __enter__(self):
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
             if self.store is None:
-                fd = self._lock(self.folder / self.FOLDER_LOCK, fcntl.LOCK_EX, f"results folder {self.folder}",
-                                holder_wrote_pid=False)
+                fd = self._lock(
+                    self.folder / self.FOLDER_LOCK,
+                    fcntl.LOCK_EX,
+                    f"results folder {self.folder}",
+                    holder_wrote_pid=False,
+                )
             else:
-                self._lock(self.folder / self.FOLDER_LOCK, fcntl.LOCK_SH,
-                           f"results folder {self.folder} (a cluster sweep)")
+                self._lock(
+                    self.folder / self.FOLDER_LOCK, fcntl.LOCK_SH, f"results folder {self.folder} (a cluster sweep)"
+                )
                 fd = self._lock(Path(f"{self.store}.lock"), fcntl.LOCK_EX, f"results store {self.store}")
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"pid {os.getpid()}".encode(), 0)
@@ -331,8 +356,10 @@ def validate(row) -> str:
         return why
     fields = Scene.__dataclass_fields__
     try:
-        Scene(**{k: v for k, v in row["scene"].items() if k in fields and fields[k].compare},
-              memory_limit_bytes=sys.maxsize)
+        Scene(
+            **{k: v for k, v in row["scene"].items() if k in fields and fields[k].compare},
+            memory_limit_bytes=sys.maxsize,
+        )
     except (SceneError, TypeError, ValueError, OverflowError) as exc:
         return f"'scene' is not a valid scene ({exc})"
     return ""
@@ -416,4 +443,3 @@ def read_rows(paths) -> list[dict]:
                     seen.add(rid)
                     rows.append(row)
     return rows
-

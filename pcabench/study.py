@@ -3,6 +3,7 @@ on a Dask cluster), then the reports written and the summary printed.
 
 The command line builds the runs from its options (a preset or a matrix) and hands them here.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -35,8 +36,16 @@ def check_specs(specs: list[RunSpec]) -> list[RunSpec]:
     return resolved
 
 
-def run_study(name: str, specs: list[RunSpec], results: Path, reports: Path | None, run_budget: float,
-              sweep_budget: float, cluster: str | None = None, retry_failed: bool = False) -> int:
+def run_study(
+    name: str,
+    specs: list[RunSpec],
+    results: Path,
+    reports: Path | None,
+    run_budget: float,
+    sweep_budget: float,
+    cluster: str | None = None,
+    retry_failed: bool = False,
+) -> int:
     """Sweep ``specs`` (preset ``name``) into ``results`` with ``run_budget`` seconds per run and
     ``sweep_budget`` in all, then write the reports into ``reports`` (None: no reports) and print the
     summary table; 0 (a failed run is a stored row, not an error)."""
@@ -48,17 +57,24 @@ def run_study(name: str, specs: list[RunSpec], results: Path, reports: Path | No
         from .cluster import cluster_sweep, dask_distributed
 
         dask_distributed()  # one line naming the extra, before anything else
-        print(f"pcabench study ({name}): {len(specs)} runs on the Dask cluster {cluster}, "
-              f"{run_budget:.0f} s per run at most, stores in {results}", file=sys.stderr, flush=True)
-        cluster_sweep(specs, results, run_budget, cluster, retry_failed=retry_failed,
-                      sweep_budget=sweep_budget)
+        print(
+            f"pcabench study ({name}): {len(specs)} runs on the Dask cluster {cluster}, "
+            f"{run_budget:.0f} s per run at most, stores in {results}",
+            file=sys.stderr,
+            flush=True,
+        )
+        cluster_sweep(specs, results, run_budget, cluster, retry_failed=retry_failed, sweep_budget=sweep_budget)
     else:
         profile = profiles.capture()
         store_path = results / store_name(profile["id"])
         check_writable(store_path)
         profiles.save(profile)
-        print(f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
-              f"store {store_path}", file=sys.stderr, flush=True)
+        print(
+            f"pcabench study ({name}): {len(specs)} runs on {profile['id']}, {run_budget:.0f} s per run at most, "
+            f"store {store_path}",
+            file=sys.stderr,
+            flush=True,
+        )
         sweep(specs, store_path, run_budget, sweep_budget, retry_failed=retry_failed)
     if reports is None:
         return 0

@@ -12,6 +12,7 @@ sweep resumes where it stopped (a run given twice is run once); ``retry_failed``
 reruns timeouts, skips and errors. A run predicted to take longer than the run budget is stored as
 ``skipped`` with the prediction.
 """
+
 from __future__ import annotations
 
 import abc
@@ -70,8 +71,12 @@ def exit_status(returncode: int, oom_before: int | None, oom_after: int | None) 
     """(status, what happened) of a child that ended without a record."""
     if returncode < 0:
         name = signal.Signals(-returncode).name if -returncode in signal.valid_signals() else f"signal {-returncode}"
-        if -returncode == signal.SIGKILL and oom_before is not None and oom_after is not None \
-                and oom_after > oom_before:
+        if (
+            -returncode == signal.SIGKILL
+            and oom_before is not None
+            and oom_after is not None
+            and oom_after > oom_before
+        ):
             return "out-of-memory", f"killed by {name}: the kernel's OOM killer (cgroup oom_kill count rose)"
         return "error", f"killed by {name}"
     return "error", f"exit code {returncode}"
@@ -113,9 +118,15 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
     env = {**os.environ, "PCABENCH_COMMIT": commit, MACHINE_ID_ENV: machine}  # every run carries the sweep's
     oom_before = oom_kills()
     try:
-        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                env=env, pass_fds=(write_end,),
-                                preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
+        proc = subprocess.Popen(
+            cmd,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            env=env,
+            pass_fds=(write_end,),
+            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
+        )
     except BaseException:
         os.close(read_end)
         raise
@@ -135,9 +146,11 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
                 pass
         record.append(data if len(data) <= RECORD_LIMIT else b"")
 
-    readers = [threading.Thread(target=_drain, args=(proc.stdout, out), daemon=True),
-               threading.Thread(target=_drain, args=(proc.stderr, err, relay), daemon=True),
-               threading.Thread(target=read_record, daemon=True)]
+    readers = [
+        threading.Thread(target=_drain, args=(proc.stdout, out), daemon=True),
+        threading.Thread(target=_drain, args=(proc.stderr, err, relay), daemon=True),
+        threading.Thread(target=read_record, daemon=True),
+    ]
     for reader in readers:
         reader.start()
     try:
@@ -152,8 +165,11 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
         if stream is not None and err and not err[-1].endswith("\n"):
             stream.write("\n")  # end the child's last progress line
     said = PROGRESS.sub("", "".join(err)).strip()  # stderr less the child's own progress lines
-    printed = "".join(f"\nthe solver's {name} (cut): {_cut([text])}" for name, text in
-                      (("stdout", "".join(out).strip()), ("stderr", said)) if text)
+    printed = "".join(
+        f"\nthe solver's {name} (cut): {_cut([text])}"
+        for name, text in (("stdout", "".join(out).strip()), ("stderr", said))
+        if text
+    )
     data = record[0] if record else b""
     if proc.returncode == 0 and data:
         try:
@@ -184,8 +200,9 @@ def run_here(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sy
     return run_spec(spec)
 
 
-def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None,
-             whose: str = "this host's") -> str:
+def eta_text(
+    remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None, whose: str = "this host's"
+) -> str:
     """The sweep's ETA and how sure it is: runs predicted from ``whose`` timings, the rest at the mean so far."""
     if not remaining:
         return "done"
@@ -195,8 +212,9 @@ def eta_text(remaining: list[RunSpec], mine: list[dict], seconds_per_run: float 
     if unknown and seconds_per_run is None:
         return f"eta unknown ({len(remaining)} runs left, {len(known)} predicted)"
     total = sum(known) + unknown * (seconds_per_run or 0.0)
-    how = (f"{len(known)} of {len(remaining)} runs predicted from {whose} timings"
-           + (f", {unknown} at the mean so far" if unknown else ""))
+    how = f"{len(known)} of {len(remaining)} runs predicted from {whose} timings" + (
+        f", {unknown} at the mean so far" if unknown else ""
+    )
     return f"eta {total / 60:.1f} min ({how})"
 
 
@@ -257,8 +275,11 @@ class LocalExecutor(Executor):
         except subprocess.TimeoutExpired:
             if budget_cut:  # the sweep's budget ran out, not the run's: nothing to record
                 return spec, None
-            return spec, store.to_row(failed_record(spec, "timeout", f"past the run budget of {timeout:.0f} s",
-                                                    self.machine, time.perf_counter() - t0))
+            return spec, store.to_row(
+                failed_record(
+                    spec, "timeout", f"past the run budget of {timeout:.0f} s", self.machine, time.perf_counter() - t0
+                )
+            )
 
 
 class StoreFile:
@@ -271,8 +292,16 @@ class StoreFile:
         return store.append(row, self.path)
 
 
-def run_specs(specs: list[RunSpec], executor: Executor, stores, rows: list[dict], run_budget: float,
-              sweep_budget: float = math.inf, stream=sys.stderr, retry_failed: bool = False) -> list[dict]:
+def run_specs(
+    specs: list[RunSpec],
+    executor: Executor,
+    stores,
+    rows: list[dict],
+    run_budget: float,
+    sweep_budget: float = math.inf,
+    stream=sys.stderr,
+    retry_failed: bool = False,
+) -> list[dict]:
     """The sweep loop of every executor: ``specs`` not already in ``rows`` run by ``executor``, each row
     appended to ``stores`` as it arrives; the rows stored.
 
@@ -303,12 +332,18 @@ def run_specs(specs: list[RunSpec], executor: Executor, stores, rows: list[dict]
             queue.pop(0)
             seconds, why = predicted_seconds(spec, known)
             if seconds is not None and seconds > run_budget:
-                stored.append(stores.append(store.to_row(failed_record(
-                    spec, "skipped", f"{why} > run budget {run_budget:.0f} s", machine))))
+                stored.append(
+                    stores.append(
+                        store.to_row(failed_record(spec, "skipped", f"{why} > run budget {run_budget:.0f} s", machine))
+                    )
+                )
                 print(f"{labels[spec]}: skipped, {why}", file=stream, flush=True)
                 continue
-            print(f"{labels[spec]}: running" + (f" (predicted {seconds:.0f} s)" if seconds is not None else ""),
-                  file=stream, flush=True)
+            print(
+                f"{labels[spec]}: running" + (f" (predicted {seconds:.0f} s)" if seconds is not None else ""),
+                file=stream,
+                flush=True,
+            )
             executor.start(spec, min(run_budget, left), left < run_budget)
             running += 1
         if not running:
@@ -316,14 +351,16 @@ def run_specs(specs: list[RunSpec], executor: Executor, stores, rows: list[dict]
         spec, row = executor.wait()
         running -= 1
         if row is None:
-            print(f"{labels[spec]}: sweep budget spent during the run, not stored (rerun to resume)",
-                  file=stream, flush=True)
+            print(
+                f"{labels[spec]}: sweep budget spent during the run, not stored (rerun to resume)",
+                file=stream,
+                flush=True,
+            )
             queue.clear()
             continue
         why = store.validate(store.to_row(row))
         if why:  # a record that would not read back is never written: the run is stored as an error
-            row = store.to_row(failed_record(spec, "error", f"the run's record would not read back ({why})",
-                                             machine))
+            row = store.to_row(failed_record(spec, "error", f"the run's record would not read back ({why})", machine))
         row = stores.append(row)
         stored.append(row)
         known.append(row)
@@ -332,15 +369,25 @@ def run_specs(specs: list[RunSpec], executor: Executor, stores, rows: list[dict]
         per_run = (time.perf_counter() - t_start) / len(made) / executor.slots if made else None
         where = f" on {row.get('profile_id')}/{row.get('host')}" if executor.slots > 1 else ""
         mse = row.get("mse")
-        print(f"{labels[spec]}{where}: {row['status']}, step {1e3 * step_seconds(row['stages'], row['steps']):.2f} "
-              f"ms, MSE {'-' if mse is None else f'{mse:.4g}'} | sweep: {len(stored)}/{n_todo} done, "
-              f"{running} running, {failed} not ok, {eta_text(queue, known, per_run, executor.whose)}",
-              file=stream, flush=True)
+        print(
+            f"{labels[spec]}{where}: {row['status']}, step {1e3 * step_seconds(row['stages'], row['steps']):.2f} "
+            f"ms, MSE {'-' if mse is None else f'{mse:.4g}'} | sweep: {len(stored)}/{n_todo} done, "
+            f"{running} running, {failed} not ok, {eta_text(queue, known, per_run, executor.whose)}",
+            file=stream,
+            flush=True,
+        )
     return stored
 
 
-def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budget: float,
-          stream=sys.stderr, retry_failed: bool = False, runner=None) -> list[dict]:
+def sweep(
+    specs: list[RunSpec],
+    store_path: Path,
+    run_budget: float,
+    sweep_budget: float,
+    stream=sys.stderr,
+    retry_failed: bool = False,
+    runner=None,
+) -> list[dict]:
     """Run ``specs`` on this machine (skipping those already stored), one child process each (``runner``),
     into the store at ``store_path``; the rows stored (:func:`run_specs`)."""
     store.check_writable(store_path)
@@ -348,5 +395,4 @@ def sweep(specs: list[RunSpec], store_path: Path, run_budget: float, sweep_budge
         store_path = Path(store_path)
         rows = store.read_rows(store_path) if store_path.exists() else []
         executor = LocalExecutor(machine_id(), host_id(), git_commit(), runner, stream)
-        return run_specs(specs, executor, StoreFile(store_path), rows, run_budget, sweep_budget, stream,
-                         retry_failed)
+        return run_specs(specs, executor, StoreFile(store_path), rows, run_budget, sweep_budget, stream, retry_failed)

@@ -4,6 +4,7 @@ SNP is empty: the pair loop itself tests every pair against the cutoff, as
 the paper's all-pair code does. Same pair physics as the cell list
 (solvers/pairs.py), with the minimum image in y instead of a cell stencil.
 """
+
 from __future__ import annotations
 
 import time
@@ -38,8 +39,12 @@ def sweeps(precision: str, kernel: str) -> dict:
         return total
 
     jit = numba.njit(nogil=True)
-    return {"continuity": jit(continuity), "momentum": jit(momentum), "neighbours": jit(neighbours),
-            **cpu_updates(precision, False)}
+    return {
+        "continuity": jit(continuity),
+        "momentum": jit(momentum),
+        "neighbours": jit(neighbours),
+        **cpu_updates(precision, False),
+    }
 
 
 class AllPairCPU(Solver):

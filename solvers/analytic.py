@@ -3,6 +3,7 @@
 u(t, x) = c0 Ma exp(-((x - x_c - c0 t) / w)^2), v = 0, drho = rho0 u / c0:
 a right-travelling solution of the linear wave equation.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -1,4 +1,5 @@
 """The shared per-particle physics (solvers/pairs.py) compiled for numba's CPU target."""
+
 from __future__ import annotations
 
 import threading

@@ -14,6 +14,7 @@ linkedlist-cpu splits its sort into steps a variant overrides one at a time
 (``cell_ids``, ``cell_order``, ``permute``); ``pcabench check-solver``
 (pcabench/conformance.py) checks a variant against the all-pair reference.
 """
+
 from __future__ import annotations
 
 import abc
@@ -54,8 +55,10 @@ class CellListSolver(Solver):
     def cell_ids(self) -> None:
         """particleIndex of every particle, into ``self.cell`` (a particle past a periodic seam has its lattice
         coordinates moved by a period first: the same position)."""
-        self.launch("cell_ids", *self.grid_arguments(self.arrays["lx"], self.arrays["ly"], self.arrays["sx"],
-                                                     self.arrays["sy"], self.cell))
+        self.launch(
+            "cell_ids",
+            *self.grid_arguments(self.arrays["lx"], self.arrays["ly"], self.arrays["sx"], self.arrays["sy"], self.cell),
+        )
 
     def grid_arguments(self, lx, ly, sx, sy, cell) -> tuple:
         """The arguments of the cell-index kernels for positions ``lx, ly, sx, sy`` and output ``cell``."""

@@ -15,6 +15,7 @@ rows need :data:`PAD` spare entries. Where the core has no AVX-512, or
 numba's LLVM predates the vector compress (LLVM 19),
 :func:`compress_within` is the scalar loop, with the same result.
 """
+
 from __future__ import annotations
 
 import numba
@@ -81,6 +82,7 @@ def compress_vector(typingctx, js, rxs, rys, r2s, cj, crx, cry, cr2, nq, limit):
                 st = builder.store(packed, builder.bitcast(dst, ir.PointerType(vec_type)))
                 st.align = 4
                 return vec
+
             return store
 
         index_store = compress_store(ir.VectorType(context.get_value_type(js.dtype), lanes))

@@ -11,6 +11,7 @@ and :func:`flush_off` puts the old word back, so nothing outside the loop
 here (the pulse amplitude is ~0.5 m/s). On other architectures both are
 no-ops.
 """
+
 from __future__ import annotations
 
 import platform
@@ -38,6 +39,7 @@ def _read_mxcsr(typingctx):
         if X86:
             _mxcsr_call(builder, "llvm.x86.sse.stmxcsr", ptr)
         return builder.load(ptr)
+
     return types.uint32(), codegen
 
 
@@ -49,6 +51,7 @@ def _write_mxcsr(typingctx, word):
             builder.store(args[0], ptr)
             _mxcsr_call(builder, "llvm.x86.sse.ldmxcsr", ptr)
         return context.get_dummy_value()
+
     return types.void(types.uint32), codegen
 
 

@@ -23,6 +23,7 @@ while the integrator's amplification over one step has spectral radius <= 1,
 which depends only on z = c0 |D| dt; :func:`stable_cfl` turns the largest
 stable z into the largest stable CFL = dt c0 / dx.
 """
+
 from __future__ import annotations
 
 import math
@@ -61,7 +62,7 @@ def symbol(scene, kx, ky=0.0) -> tuple[np.ndarray, np.ndarray]:
     for lo in range(0, kx.size, step):
         part = slice(lo, lo + step)
         phase = np.multiply.outer(kx[part], a * scene.dx) + np.multiply.outer(ky[part], b * scene.dx)
-        weight = -scene.dx**2 * np.sin(phase) * g
+        weight = -(scene.dx**2) * np.sin(phase) * g
         out_x[part], out_y[part] = weight @ (a * scene.dx), weight @ (b * scene.dx)
     return out_x.reshape(shape), out_y.reshape(shape)
 
@@ -137,8 +138,7 @@ def evolve(solver: ModeSolver, integrator: str, steps: int) -> ModeSolver:
     """``steps`` steps of ``integrator``'s program, the first one primed as a run's is: the first step's
     matrix, then the power of the others' (so the cost does not grow with the number of steps)."""
     first = step_matrices(integrator, solver.d, solver.rho0, solver.c0, solver.dt, first=True)
-    rest = np.linalg.matrix_power(step_matrices(integrator, solver.d, solver.rho0, solver.c0, solver.dt),
-                                  steps - 1)
+    rest = np.linalg.matrix_power(step_matrices(integrator, solver.d, solver.rho0, solver.c0, solver.dt), steps - 1)
     state = np.einsum("nij,njk,kn->in", rest, first, solver.state())
     solver.set_state(state)
     solver.t += steps * solver.dt
@@ -182,8 +182,15 @@ def stable_cfl(scene) -> float:
 def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> float:
     from .scene import Scene
 
-    unit = Scene(dx=1.0, kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor, integrator=integrator,
-                 model="linear", memory_limit_bytes=2**62)
+    unit = Scene(
+        dx=1.0,
+        kernel=kernel,
+        h_factor=h_factor,
+        cutoff_factor=cutoff_factor,
+        integrator=integrator,
+        model="linear",
+        memory_limit_bytes=2**62,
+    )
     return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
 
 
@@ -219,10 +226,14 @@ def predict_plane(scene) -> Prediction:
     err = analytic_errors(scene, x, u, t)
     k = 1.0 / scene.pulse_width
     d = float(symbol(scene, np.array([k]))[0][0])
-    return Prediction(predicted_error=err.mse, predicted_me=err.me, stable_cfl=stable_cfl(scene), t_end=t,
-                      lattice_phase_error=d / k - 1.0,
-                      step_phase_error=step_phase_angle(scene.integrator, scene.c0 * d * scene.dt)
-                      / (scene.c0 * k * scene.dt) - 1.0)
+    return Prediction(
+        predicted_error=err.mse,
+        predicted_me=err.me,
+        stable_cfl=stable_cfl(scene),
+        t_end=t,
+        lattice_phase_error=d / k - 1.0,
+        step_phase_error=step_phase_angle(scene.integrator, scene.c0 * d * scene.dt) / (scene.c0 * k * scene.dt) - 1.0,
+    )
 
 
 def step_phase_angle(integrator: str, z: float) -> float:
@@ -251,8 +262,9 @@ def predicted_fields_2d(scene) -> tuple:
     ys = scene.y_lo + (np.arange(scene.ny) + 0.5) * scene.dx
     x, y = np.meshgrid(xs, ys)
     u0, v0, drho0 = scene.kind.initial_fields(scene, x, y, np)
-    kx, ky = np.meshgrid(2.0 * math.pi * np.fft.fftfreq(scene.nx, d=scene.dx),
-                         2.0 * math.pi * np.fft.fftfreq(scene.ny, d=scene.dx))
+    kx, ky = np.meshgrid(
+        2.0 * math.pi * np.fft.fftfreq(scene.nx, d=scene.dx), 2.0 * math.pi * np.fft.fftfreq(scene.ny, d=scene.dx)
+    )
     dx_, dy_ = symbol(scene, kx, ky)
     d = np.hypot(dx_, dy_)
     safe = np.where(d > 0, d, 1.0)
@@ -276,7 +288,14 @@ def predict_2d(scene, kind) -> Prediction:
     fields = Fields(x=x.ravel(), y=y.ravel(), u=u.ravel(), v=v.ravel(), drho=drho.ravel(), t=t)
     measures = kind.errors(scene.replace(model="linear"), fields)
     axis, diagonal = phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4)
-    return Prediction(predicted_error=measures.pop("mse"), predicted_me=measures.pop("me"),
-                      stable_cfl=stable_cfl(scene), t_end=t, lattice_phase_error=axis[0], step_phase_error=axis[1],
-                      lattice_phase_error_diagonal=diagonal[0], step_phase_error_diagonal=diagonal[1],
-                      measures=measures)
+    return Prediction(
+        predicted_error=measures.pop("mse"),
+        predicted_me=measures.pop("me"),
+        stable_cfl=stable_cfl(scene),
+        t_end=t,
+        lattice_phase_error=axis[0],
+        step_phase_error=axis[1],
+        lattice_phase_error_diagonal=diagonal[0],
+        step_phase_error_diagonal=diagonal[1],
+        measures=measures,
+    )

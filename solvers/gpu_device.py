@@ -1,4 +1,5 @@
 """The GPU backend: numba-cuda and CuPy on a real device, or numba's CUDA simulator without one."""
+
 from __future__ import annotations
 
 import os
@@ -28,15 +29,16 @@ def device_backend():
     try:
         from numba import cuda
     except ImportError as exc:  # pragma: no cover - numba without CUDA support
-        raise SolverUnavailable("linkedlist-gpu needs numba-cuda: pip install -e \".[gpu-cuda13]\" "
-                                "(or .[gpu] for CUDA 12)") from exc
+        raise SolverUnavailable(
+            'linkedlist-gpu needs numba-cuda: pip install -e ".[gpu-cuda13]" (or .[gpu] for CUDA 12)'
+        ) from exc
     if simulated():
         return cuda, None
     try:
         import cupy
     except ImportError as exc:
         raise SolverUnavailable(
-            "linkedlist-gpu needs CuPy and a CUDA GPU: pip install -e \".[gpu-cuda13]\" (or .[gpu] for CUDA 12) on a "
+            'linkedlist-gpu needs CuPy and a CUDA GPU: pip install -e ".[gpu-cuda13]" (or .[gpu] for CUDA 12) on a '
             "machine with an NVIDIA GPU (or set NUMBA_ENABLE_CUDASIM=1 to run its kernels in the simulator)"
         ) from exc
     try:
@@ -45,7 +47,8 @@ def device_backend():
     except Exception as exc:  # noqa: BLE001 - any driver/runtime failure means no usable GPU
         raise SolverUnavailable(
             f"linkedlist-gpu: no CUDA GPU on this machine ({exc}); use linkedlist-cpu, or set "
-            "NUMBA_ENABLE_CUDASIM=1 to run its kernels in the simulator") from exc
+            "NUMBA_ENABLE_CUDASIM=1 to run its kernels in the simulator"
+        ) from exc
     _one_stream()
     return cuda, cupy
 

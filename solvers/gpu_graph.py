@@ -9,6 +9,7 @@ state exactly as the plain launches would, with one graph launch per step
 instead of eight kernel launches from Python. Needs a real GPU (numba's
 simulator has no streams to capture).
 """
+
 from __future__ import annotations
 
 from .integrators import step_program
@@ -27,8 +28,10 @@ class CapturedSteps:
         if solver.stream is None:
             raise RuntimeError("CUDA graph capture needs a real GPU stream (not the simulator)")
         if integrator not in GRAPH_INTEGRATORS:
-            raise ValueError(f"integrator: the graph path replays {', '.join(GRAPH_INTEGRATORS)} "
-                             f"(got {integrator!r}; rk2 allocates its saved copies inside the step)")
+            raise ValueError(
+                f"integrator: the graph path replays {', '.join(GRAPH_INTEGRATORS)} "
+                f"(got {integrator!r}; rk2 allocates its saved copies inside the step)"
+            )
         self.solver = solver
         t0, start = solver.t, solver.state()
         self.graphs = {}  # block it starts from -> (graph, block current after it, seconds it advances)

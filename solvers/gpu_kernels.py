@@ -6,6 +6,7 @@ module's global on purpose: numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1)
 runs the kernels as Python and swaps the module global named ``cuda`` for its
 own, which a closure variable would hide from it.
 """
+
 from __future__ import annotations
 
 from functools import lru_cache
@@ -148,9 +149,17 @@ def kernels(precision: str, kernel: str = DEFAULT_KERNEL):
             P.advance_at(i, drho, dd, sx, sy, u, v, c, moving)
             P.coefficients_at(i, drho, mass, vol, pr, True, True, k)
 
-    return {"cell_count": cell_count, "cell_begin": cell_begin, "scatter": scatter, "continuity": continuity,
-            "momentum": momentum, "neighbours": neighbours, "coefficients": coefficients, "kick": kick,
-            "advance": advance}
+    return {
+        "cell_count": cell_count,
+        "cell_begin": cell_begin,
+        "scatter": scatter,
+        "continuity": continuity,
+        "momentum": momentum,
+        "neighbours": neighbours,
+        "coefficients": coefficients,
+        "kick": kick,
+        "advance": advance,
+    }
 
 
 def scan_block() -> int:

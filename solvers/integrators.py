@@ -15,6 +15,7 @@ The first step may begin with a priming search and sweep (the rates at t=0).
 - ``euler``: forward Euler, one sweep of both rates; grows at any dt.
 - ``rk2``: explicit midpoint, two sweeps of both rates per step.
 """
+
 from __future__ import annotations
 
 VELOCITY = ("u", "v")
@@ -49,11 +50,13 @@ def step_program(integrator: str, solver, first: bool) -> list:
         return [snp, both, ("su", lambda: s.advance(1.0)), ("su", lambda: s.kick(1.0))]
     if integrator == "rk2":
         return [
-            snp, both,
+            snp,
+            both,
             ("su", s.save),
             ("su", lambda: s.advance(0.5)),
             ("su", lambda: s.kick(0.5)),
-            snp, both,
+            snp,
+            both,
             ("su", lambda: s.restore(POSITION_DENSITY)),
             ("su", lambda: s.advance(1.0)),  # drift with the mid-point velocity
             ("su", lambda: s.restore(VELOCITY)),

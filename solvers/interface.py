@@ -19,6 +19,7 @@ launches (:meth:`Solver.launch`) on its own device and threads.
 All per-particle arrays sit in ``self.arrays`` so that a neighbour search
 that reorders particles can permute all of them together.
 """
+
 from __future__ import annotations
 
 import abc
@@ -119,14 +120,20 @@ class Solver(abc.ABC):
     def supports(cls, scene: Scene) -> None:
         """SceneError naming the parameter unless this solver offers the scene's precision, model,
         integrator and kernel."""
-        for what, offered in (("precision", cls.precisions), ("model", cls.models),
-                              ("integrator", cls.integrators), ("kernel", cls.kernels)):
+        for what, offered in (
+            ("precision", cls.precisions),
+            ("model", cls.models),
+            ("integrator", cls.integrators),
+            ("kernel", cls.kernels),
+        ):
             if getattr(scene, what) not in offered:
                 raise SceneError(f"{what}: {cls.name} offers {', '.join(offered)} (got {getattr(scene, what)!r})")
         missing = sorted(set(scene.boundaries) - set(cls.boundaries))
         if missing:
-            raise SceneError(f"--scene {scene.name}: {cls.name} cannot run its {', '.join(missing)} boundaries "
-                             f"(it supports {', '.join(cls.boundaries)})")
+            raise SceneError(
+                f"--scene {scene.name}: {cls.name} cannot run its {', '.join(missing)} boundaries "
+                f"(it supports {', '.join(cls.boundaries)})"
+            )
 
     # ------------------------------------------------------------ stages
     def input(self, scene: Scene) -> None:
@@ -155,9 +162,13 @@ class Solver(abc.ABC):
         # Lagrangian and fixed: m_j = rho_j(0) dx^2, so m/rho is the true volume at t = 0.
         rho_init = s.rho0 + (0.0 if s.model == "linear" else 1.0) * drho
         a = {
-            "lx": lx, "ly": ly,
-            "sx": xp.zeros(s.n_particles, dt), "sy": xp.zeros(s.n_particles, dt),
-            "u": u.astype(dt), "v": v.astype(dt), "drho": drho.astype(dt),
+            "lx": lx,
+            "ly": ly,
+            "sx": xp.zeros(s.n_particles, dt),
+            "sy": xp.zeros(s.n_particles, dt),
+            "u": u.astype(dt),
+            "v": v.astype(dt),
+            "drho": drho.astype(dt),
             "mass": (rho_init * s.dx * s.dx).astype(dt),
         }
         for name in RATES + ("vol", "pr"):
@@ -202,8 +213,17 @@ class Solver(abc.ABC):
     def advance(self, f: float) -> None:
         """drho += f dt D and, for moving particles, x += f dt u; time += f dt."""
         a = self.arrays
-        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"], self.dtype.type(f * self.scene.dt),
-                    self.moving)
+        self.launch(
+            "advance",
+            a["drho"],
+            a["dd"],
+            a["sx"],
+            a["sy"],
+            a["u"],
+            a["v"],
+            self.dtype.type(f * self.scene.dt),
+            self.moving,
+        )
         self.t += f * self.scene.dt
 
     def save(self) -> None:
@@ -238,9 +258,14 @@ class Solver(abc.ABC):
         order = np.argsort(ids, kind="stable")
         x = s.x_lo + (h["lx"].astype(np.float64) + 0.5) * s.dx + h["sx"]
         y = s.y_lo + (h["ly"].astype(np.float64) + 0.5) * s.dx + h["sy"]
-        return Fields(x=x[order], y=y[order], u=h["u"][order].astype(np.float64),
-                      v=h["v"][order].astype(np.float64), drho=h["drho"][order].astype(np.float64),
-                      t=self.t)
+        return Fields(
+            x=x[order],
+            y=y[order],
+            u=h["u"][order].astype(np.float64),
+            v=h["v"][order].astype(np.float64),
+            drho=h["drho"][order].astype(np.float64),
+            t=self.t,
+        )
 
     def to_host(self, arr) -> np.ndarray:
         return np.asarray(arr)
@@ -275,8 +300,10 @@ def cell_grid(scene: Scene) -> tuple:
     if scene.periodic_x:
         ncx = int(math.floor(scene.width / scene.cutoff + 1e-9))
         if ncx < 3:
-            raise SceneError(f"x_max - x_min must hold 3 cells of one cutoff ({3 * scene.cutoff:.6g} m) for the "
-                             f"x-periodic {scene.name} scene (got {scene.width:.6g} m)")
+            raise SceneError(
+                f"x_max - x_min must hold 3 cells of one cutoff ({3 * scene.cutoff:.6g} m) for the "
+                f"x-periodic {scene.name} scene (got {scene.width:.6g} m)"
+            )
         return scene.width / ncx, scene.height / ncy, ncx, ncy, 0.0, scene.width
     ncx = int(math.ceil((scene.x_max - scene.x_min) / scene.cutoff)) + 2
     return scene.cutoff, scene.height / ncy, ncx, ncy, -scene.cutoff, 0.0
@@ -284,7 +311,18 @@ def cell_grid(scene: Scene) -> tuple:
 
 def tiny_scene(scene: Scene) -> Scene:
     """A few hundred particles with the same scene kind, model, integrator and precision (for JIT warm-up)."""
-    return scene.replace(dx=1.0, x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0, pulse_center=0.0,
-                         pulse_width=scene.default("pulse_width"), mach=scene.default("mach"),
-                         strip_height=None, steps=2, t_end=None, h_factor=scene.default("h_factor"),
-                         cutoff_factor=min(scene.cutoff_factor, 3.0))
+    return scene.replace(
+        dx=1.0,
+        x_min=-10.0,
+        x_max=10.0,
+        y_min=-10.0,
+        y_max=10.0,
+        pulse_center=0.0,
+        pulse_width=scene.default("pulse_width"),
+        mach=scene.default("mach"),
+        strip_height=None,
+        steps=2,
+        t_end=None,
+        h_factor=scene.default("h_factor"),
+        cutoff_factor=min(scene.cutoff_factor, 3.0),
+    )

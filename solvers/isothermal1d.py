@@ -8,6 +8,7 @@ two-step Lax-Wendroff (Richtmyer) scheme, second order, which is accurate for
 the smooth pulse (a Mach 0.05 pulse of width 3 m steepens into a shock only
 after about 70 s).
 """
+
 from __future__ import annotations
 
 import numpy as np

@@ -16,6 +16,7 @@ r_i = (i + 0.5) dr on (0, r_max]; the mass equation is in conservative, r-weight
 vanishes (symmetry: drho even, u odd); the last cell is held at rest (r_max must exceed the reach
 c0 t + ~4 b of the pulse).
 """
+
 from __future__ import annotations
 
 import functools
@@ -25,8 +26,9 @@ import numpy as np
 LN2 = float(np.log(2.0))
 
 
-def isothermal_pulse_radial(t: float, b: float, mach: float, rho0: float, c0: float, r_max: float,
-                            cells_per_m: float = 100.0, cfl: float = 0.8):
+def isothermal_pulse_radial(
+    t: float, b: float, mach: float, rho0: float, c0: float, r_max: float, cells_per_m: float = 100.0, cfl: float = 0.8
+):
     """(r, drho, u_r) at time ``t`` (s): cell centres r_i = (i + 0.5) dr of (0, r_max], m; kg/m^3; m/s.
 
     ``b``: pulse half-width, m; ``mach``: Ma; ``rho0``: kg/m^3; ``c0``: m/s; ``cells_per_m``: 1/dr, 1/m;
@@ -50,7 +52,7 @@ def isothermal_pulse_radial(t: float, b: float, mach: float, rho0: float, c0: fl
         rg = rm * m / (rho0 + d)  # r rho u^2
         # predictor: faces at t + dt/2
         fd[1:] = 0.5 * (d[1:] + d[:-1]) - 0.5 * dt * inv_rf * (rm[1:] - rm[:-1])
-        fm[1:] = (0.5 * (m[1:] + m[:-1]) - 0.5 * dt * (inv_rf * (rg[1:] - rg[:-1]) + c2 * (d[1:] - d[:-1]) / dr))
+        fm[1:] = 0.5 * (m[1:] + m[:-1]) - 0.5 * dt * (inv_rf * (rg[1:] - rg[:-1]) + c2 * (d[1:] - d[:-1]) / dr)
         fd[0] = d[0] - 0.5 * dt * 4.0 * m[0] / dr  # axis: (1/r) d(r m)/dr -> 2 dm/dr, m odd; u = 0 there
         # corrector with the face fluxes
         frm = np.arange(n) * dr * fm  # r m at the faces (0 at the axis)
@@ -61,8 +63,9 @@ def isothermal_pulse_radial(t: float, b: float, mach: float, rho0: float, c0: fl
 
 
 @functools.lru_cache(maxsize=16)
-def isothermal_pulse_radial_cached(t: float, b: float, mach: float, rho0: float, c0: float, r_max: float,
-                                   cells_per_m: float = 100.0, cfl: float = 0.8):
+def isothermal_pulse_radial_cached(
+    t: float, b: float, mach: float, rho0: float, c0: float, r_max: float, cells_per_m: float = 100.0, cfl: float = 0.8
+):
     """`isothermal_pulse_radial`, memoised on its scalar arguments; the arrays returned are read-only."""
     out = isothermal_pulse_radial(t, b, mach, rho0, c0, r_max, cells_per_m=cells_per_m, cfl=cfl)
     for a in out:

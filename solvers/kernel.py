@@ -8,6 +8,7 @@ solver's precision so that float32 loops never promote to float64, and the
 two exp(-x) a kernel such as the Gaussian is given (libm/CUDA, or a table for
 CPU loops).
 """
+
 from __future__ import annotations
 
 import math
@@ -70,15 +71,18 @@ def make_exp_neg_table(dtype):
     scale, inv_scale, last = t(32.0 / math.log(2.0)), t(math.log(2.0) / 32.0), t(size - 1)
     c0, c1, c2, c3, c4, c5, c6, c7 = (t(1.0 / math.factorial(m)) for m in range(8))
     if t is np.float64:
+
         def exp_neg(x):
             s = min(x * scale, last)
             n = int(s)
             f = (s - n) * inv_scale
             return table[n] * (c0 - f * (c1 - f * (c2 - f * (c3 - f * (c4 - f * (c5 - f * (c6 - f * c7)))))))
     else:
+
         def exp_neg(x):
             s = min(x * scale, last)
             n = int(s)
             f = (s - n) * inv_scale
             return table[n] * (c0 - f * (c1 - f * (c2 - f * c3)))
+
     return exp_neg

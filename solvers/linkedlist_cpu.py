@@ -18,6 +18,7 @@ each pair once per search with its kernel factors and updates both sides,
 which is several times faster but takes memory. ``auto`` (the default) takes
 the list where it fits in memory and the gather loop where it does not.
 """
+
 from __future__ import annotations
 
 from functools import lru_cache
@@ -72,8 +73,13 @@ def sweeps(precision: str, kernel: str, parallel: bool) -> dict:
             cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, width, height, cw, ch, ncx, ncy)
 
     jit = numba.njit(nogil=True, parallel=parallel)
-    return {"continuity": jit(continuity), "momentum": jit(momentum), "neighbours": jit(neighbours),
-            "cell_ids": jit(cell_ids), **cpu_updates(precision, parallel)}
+    return {
+        "continuity": jit(continuity),
+        "momentum": jit(momentum),
+        "neighbours": jit(neighbours),
+        "cell_ids": jit(cell_ids),
+        **cpu_updates(precision, parallel),
+    }
 
 
 counting_sort = numba.njit(cache=True, nogil=True)(_counting_sort)
@@ -83,8 +89,10 @@ class LinkedListCPU(CellListSolver):
     """Uniform cell list on the CPU, serial or multi-threaded (``threads``), with the pair list or the gather loop."""
 
     name = "linkedlist-cpu"
-    summary = ("uniform cell list (the paper's cellBegin arrays), serial or --threads N|all;\n"
-               "--pair-loop list (default where it fits) or gather (the paper's loop)")
+    summary = (
+        "uniform cell list (the paper's cellBegin arrays), serial or --threads N|all;\n"
+        "--pair-loop list (default where it fits) or gather (the paper's loop)"
+    )
     pair_loops = ("list", "gather")
     threaded = True
     boundaries = ("free-x", "periodic-x", "periodic-y")
@@ -121,13 +129,16 @@ class LinkedListCPU(CellListSolver):
 
     def check_scene(self, scene) -> None:
         if not isinstance(self.threads, int) or not 1 <= self.threads <= numba.config.NUMBA_NUM_THREADS:
-            raise SceneError(f"threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} "
-                             f"on this machine (got {self.threads!r})")
+            raise SceneError(
+                f"threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} on this machine (got {self.threads!r})"
+            )
         if self.requested_pair_loop == "list" and not self.list_fits(scene):
             arrays, pairs = scene.memory_bytes(), pairlist.list_bytes(scene)
-            raise SceneError(f"pair_loop list: dx = {scene.dx} m needs {pairs / 2**30:.3g} GiB of pair list and "
-                             f"{arrays / 2**30:.3g} GiB of arrays, more than the {scene.memory_limit() / 2**30:.3g} "
-                             "GiB available; use --pair-loop gather (or auto)")
+            raise SceneError(
+                f"pair_loop list: dx = {scene.dx} m needs {pairs / 2**30:.3g} GiB of pair list and "
+                f"{arrays / 2**30:.3g} GiB of arrays, more than the {scene.memory_limit() / 2**30:.3g} "
+                "GiB available; use --pair-loop gather (or auto)"
+            )
 
     def probe(self) -> "LinkedListCPU":
         return type(self)(threads=self.threads, pair_loop=self.pair_loop)

@@ -21,6 +21,7 @@ Without a GPU, ``NUMBA_ENABLE_CUDASIM=1`` runs the same kernels in numba's
 CUDA simulator with NumPy in place of CuPy (small scenes only): that is how
 CI checks the GPU code. Without either, the solver says there is no GPU.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -38,7 +39,7 @@ class LinkedListGPU(CellListSolver):
     """Uniform cell list on a CUDA GPU (or numba's CUDA simulator), one thread per particle."""
 
     name = "linkedlist-gpu"
-    summary = "the cell list on a CUDA GPU, CuPy + numba-cuda (pip install -e \".[gpu]\")"
+    summary = 'the cell list on a CUDA GPU, CuPy + numba-cuda (pip install -e ".[gpu]")'
     device = "gpu"
     serial_why = "one GPU thread per particle"
     resources = {"timing": 1, "GPU": 1}
@@ -65,7 +66,8 @@ class LinkedListGPU(CellListSolver):
             raise SceneError(
                 f"dx = {scene.dx} m needs {scene.n_particles:,} particles and about {need / 2**30:.3g} GiB "
                 f"on the GPU, more than its {free / 2**30:.3g} GiB free; the smallest dx that fits is "
-                f"about {scene.smallest_dx_fitting(free):.3g} m")
+                f"about {scene.smallest_dx_fitting(free):.3g} m"
+            )
 
     def input(self, scene) -> None:
         super().input(scene)
@@ -144,8 +146,21 @@ class LinkedListGPU(CellListSolver):
     def advance(self, f: float) -> None:
         """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""
         a = self.arrays
-        self.launch("advance", a["drho"], a["dd"], a["sx"], a["sy"], a["u"], a["v"],
-                    self.dtype.type(f * self.scene.dt), self.moving, a["mass"], a["vol"], a["pr"], self.k)
+        self.launch(
+            "advance",
+            a["drho"],
+            a["dd"],
+            a["sx"],
+            a["sy"],
+            a["u"],
+            a["v"],
+            self.dtype.type(f * self.scene.dt),
+            self.moving,
+            a["mass"],
+            a["vol"],
+            a["pr"],
+            self.k,
+        )
         self.t += f * self.scene.dt
         self.coefficients_fresh = True
 

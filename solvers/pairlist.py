@@ -32,6 +32,7 @@ On several threads each thread accumulates its particles' pairs into its
 own buffer, and the buffers are summed per particle: no races, no atomics.
 In float32 the loops flush subnormals to zero (solvers/denormals.py).
 """
+
 from __future__ import annotations
 
 import math
@@ -138,8 +139,14 @@ def kernels(precision: str, kernel: str, parallel: bool) -> dict:
             t = U(tt)
             saved = flush_on(flush)
             js, cj = scratch[t, 0], scratch[t, 1]
-            rxs, rys, r2s, crx, cry, cr2 = (fscratch[t, 0], fscratch[t, 1], fscratch[t, 2], fscratch[t, 3],
-                                            fscratch[t, 4], fscratch[t, 5])
+            rxs, rys, r2s, crx, cry, cr2 = (
+                fscratch[t, 0],
+                fscratch[t, 1],
+                fscratch[t, 2],
+                fscratch[t, 3],
+                fscratch[t, 4],
+                fscratch[t, 5],
+            )
             lo, hi = t * n // nt, (t + U(1)) * n // nt
             at, end = lo * budget, hi * budget
             listed = U(0)  # this thread's pairs (a local: a shared array written per particle is false sharing)
@@ -158,8 +165,7 @@ def kernels(precision: str, kernel: str, parallel: bool) -> dict:
                     lxs = lxi - k[NX]
                     e1 = U(begin[cy * ncx + U(1)])
                     b1 = first_beyond(U(begin[cy * ncx]), e1, lxs, sxi, lx, sx, k)
-                    nq = distances(U(begin[cy * ncx]), b1, lxs, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s,
-                                   nq, k)
+                    nq = distances(U(begin[cy * ncx]), b1, lxs, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
                 # the three cells of the row above (across the periodic seam: i shifted down by ny rows)
                 up = cy + U(1)
                 if up >= ncy:
@@ -296,8 +302,10 @@ class PairList:
         rows = np.convolve(per_cell, np.ones(3, np.int64), mode="same")  # 3 consecutive cells (upper bound)
         need = 2 * int(rows.max(initial=0)) + 2 * int(per_cell.max(initial=0)) + 1 + PAD  # + cells across a seam
         if self.scratch is None or self.scratch[0].shape[2] < need:
-            self.scratch = (np.empty((self.threads, 2, need), np.uint32),
-                            np.empty((self.threads, 6, need), self.fx.dtype))
+            self.scratch = (
+                np.empty((self.threads, 2, need), np.uint32),
+                np.empty((self.threads, 6, need), self.fx.dtype),
+            )
         return self.scratch
 
     def build(self, cell, begin, ncx, ncy, lx, ly, sx, sy, k) -> None:
@@ -310,12 +318,14 @@ class PairList:
             self.kernels["build"](*args, self.nbr, self.fx, self.fy, self.start, self.count, *scratch, k)
 
     def continuity(self, u, v, vol, drho, out, k) -> None:
-        self.kernels["continuity"](self.nbr, self.fx, self.fy, self.start, self.count, u, v, vol, drho, out,
-                                   self.buf, k)
+        self.kernels["continuity"](
+            self.nbr, self.fx, self.fy, self.start, self.count, u, v, vol, drho, out, self.buf, k
+        )
 
     def momentum(self, mass, pr, ax, ay) -> None:
-        self.kernels["momentum"](self.nbr, self.fx, self.fy, self.start, self.count, mass, pr, ax, ay, self.buf,
-                                 self.bufy)
+        self.kernels["momentum"](
+            self.nbr, self.fx, self.fy, self.start, self.count, mass, pr, ax, ay, self.buf, self.bufy
+        )
 
     def row(self, i: int) -> tuple:
         """Particle ``i``'s pairs: (neighbour indices, x and y kernel factors)."""

@@ -25,6 +25,7 @@ vol_j = m_j / rho_j and pr_j = c0^2 drho_j / rho_j^2:
 with grad_i W_ij = G_ij r_ij (``gradient``, the kernel's compiled G). ``k`` is the constant tuple
 of :func:`solvers.kernel.constants`, read by its named slots.
 """
+
 import math
 from types import ModuleType
 
@@ -158,10 +159,8 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         acc = k[ZERO]
         for dcy in range(-1, 2):
             j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
-            acc += continuity_range(j0, j1, lx[i], lyi, sx[i], sy[i], u[i], v[i],
-                                    lx, ly, sx, sy, u, v, vol, k)
-            acc += continuity_range(q0, q1, lxq, lyi, sx[i], sy[i], u[i], v[i],
-                                    lx, ly, sx, sy, u, v, vol, k)
+            acc += continuity_range(j0, j1, lx[i], lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
+            acc += continuity_range(q0, q1, lxq, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
     @jit
@@ -171,10 +170,8 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         ay = k[ZERO]
         for dcy in range(-1, 2):
             j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
-            bx, by = momentum_range(j0, j1, lx[i], lyi, sx[i], sy[i], pr[i],
-                                    lx, ly, sx, sy, mass, pr, k)
-            cx_, cy_ = momentum_range(q0, q1, lxq, lyi, sx[i], sy[i], pr[i],
-                                      lx, ly, sx, sy, mass, pr, k)
+            bx, by = momentum_range(j0, j1, lx[i], lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
+            cx_, cy_ = momentum_range(q0, q1, lxq, lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
             ax += bx + cx_
             ay += by + cy_
         return -ax, -ay
@@ -218,8 +215,7 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         for j in range(n):
             lyi = minimum_image_row(ly[i], ly[j], k)
             lxi = minimum_image_column(lx[i], lx[j], k)
-            acc += continuity_range(j, j + 1, lxi, lyi, sx[i], sy[i], u[i], v[i],
-                                    lx, ly, sx, sy, u, v, vol, k)
+            acc += continuity_range(j, j + 1, lxi, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
     @jit
@@ -230,8 +226,7 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         for j in range(n):
             lyi = minimum_image_row(ly[i], ly[j], k)
             lxi = minimum_image_column(lx[i], lx[j], k)
-            bx, by = momentum_range(j, j + 1, lxi, lyi, sx[i], sy[i], pr[i],
-                                    lx, ly, sx, sy, mass, pr, k)
+            bx, by = momentum_range(j, j + 1, lxi, lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
             ax += bx
             ay += by
         return -ax, -ay
@@ -272,12 +267,23 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
 
     pairs = ModuleType(f"{__name__}.compiled", "The pair functions for one backend (see make_pairs).")
     pairs.__dict__.update(
-        gradient=gradient, continuity_range=continuity_range, momentum_range=momentum_range,
+        gradient=gradient,
+        continuity_range=continuity_range,
+        momentum_range=momentum_range,
         neighbours_range=neighbours_range,
-        cell_index=cell_index, stencil_row=stencil_row, continuity_cells=continuity_cells,
-        momentum_cells=momentum_cells, neighbours_cells=neighbours_cells, minimum_image_row=minimum_image_row,
-        minimum_image_column=minimum_image_column, wrap_at=wrap_at,
-        continuity_allpair=continuity_allpair, momentum_allpair=momentum_allpair,
-        neighbours_allpair=neighbours_allpair, coefficients_at=coefficients_at, kick_at=kick_at,
-        advance_at=advance_at)
+        cell_index=cell_index,
+        stencil_row=stencil_row,
+        continuity_cells=continuity_cells,
+        momentum_cells=momentum_cells,
+        neighbours_cells=neighbours_cells,
+        minimum_image_row=minimum_image_row,
+        minimum_image_column=minimum_image_column,
+        wrap_at=wrap_at,
+        continuity_allpair=continuity_allpair,
+        momentum_allpair=momentum_allpair,
+        neighbours_allpair=neighbours_allpair,
+        coefficients_at=coefficients_at,
+        kick_at=kick_at,
+        advance_at=advance_at,
+    )
     return pairs

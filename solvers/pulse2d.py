@@ -12,6 +12,7 @@ drho = rho0 Ma exp(-ln2 r^2/b^2) at t = 0 (r: distance to the centre, m; b: half
 numpy only: the Bessel functions J0, J1 are computed by the trapezoid rule on their integral
 representations (`bessel_j0_j1`).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -97,8 +98,20 @@ class PeriodicPulse:
         return float(np.sum(e) * self.dx**2)
 
 
-def periodic_linear(nx: int, ny: int, dx: float, x_lo: float, y_lo: float, xc: float, yc: float, b: float,
-                    mach: float, rho0: float, c0: float, t: float) -> PeriodicPulse:
+def periodic_linear(
+    nx: int,
+    ny: int,
+    dx: float,
+    x_lo: float,
+    y_lo: float,
+    xc: float,
+    yc: float,
+    b: float,
+    mach: float,
+    rho0: float,
+    c0: float,
+    t: float,
+) -> PeriodicPulse:
     """Exact solution of the linear equations at time ``t`` (s) on the periodic box
     [x_lo, x_lo + nx dx) x [y_lo, y_lo + ny dx) (m), sampled at x = x_lo + (i+0.5) dx, y = y_lo + (j+0.5) dx.
 
@@ -145,9 +158,9 @@ def bessel_j0_j1(x):
     j1 = np.empty(flat.shape)
     step = max(1, 1_000_000 // (m + 1))
     for lo in range(0, flat.size, step):
-        arg = flat[lo:lo + step, None] * sin_tau[None, :]
-        j0[lo:lo + step] = np.cos(arg) @ w
-        j1[lo:lo + step] = np.sin(arg) @ (w * sin_tau)
+        arg = flat[lo : lo + step, None] * sin_tau[None, :]
+        j0[lo : lo + step] = np.cos(arg) @ w
+        j1[lo : lo + step] = np.sin(arg) @ (w * sin_tau)
     return j0.reshape(x.shape), j1.reshape(x.shape)
 
 

@@ -16,6 +16,7 @@ Names are unique: an entry point that repeats a taken name, does not load, or
 does not name a Solver subclass with a ``name`` of its own is left out with one
 :class:`PluginWarning`.
 """
+
 from __future__ import annotations
 
 import ast
@@ -42,17 +43,31 @@ def _declares_a_solver(path: Path) -> bool:
         tree = ast.parse(path.read_text(encoding="utf-8"))
     except (OSError, SyntaxError, UnicodeDecodeError):
         return False
-    return any(isinstance(node, ast.ClassDef) and any(
-        isinstance(stmt, (ast.Assign, ast.AnnAssign)) and any(
-            getattr(t, "id", None) == "name" for t in (stmt.targets if isinstance(stmt, ast.Assign) else [stmt.target]))
-        for stmt in node.body) for node in tree.body)
+    return any(
+        isinstance(node, ast.ClassDef)
+        and any(
+            isinstance(stmt, (ast.Assign, ast.AnnAssign))
+            and any(
+                getattr(t, "id", None) == "name"
+                for t in (stmt.targets if isinstance(stmt, ast.Assign) else [stmt.target])
+            )
+            for stmt in node.body
+        )
+        for node in tree.body
+    )
 
 
 def _solver_classes(module) -> list[type[Solver]]:
     """The named, concrete Solver subclasses defined in ``module``."""
-    return [cls for _, cls in inspect.getmembers(module, inspect.isclass)
-            if issubclass(cls, Solver) and cls.__module__ == module.__name__ and "name" in cls.__dict__
-            and cls.name and not inspect.isabstract(cls)]
+    return [
+        cls
+        for _, cls in inspect.getmembers(module, inspect.isclass)
+        if issubclass(cls, Solver)
+        and cls.__module__ == module.__name__
+        and "name" in cls.__dict__
+        and cls.name
+        and not inspect.isabstract(cls)
+    ]
 
 
 def _builtin() -> list[type[Solver]]:
@@ -84,11 +99,15 @@ def _plugins(taken: set) -> list[type[Solver]]:
         if not (inspect.isclass(cls) and issubclass(cls, Solver)) or inspect.isabstract(cls):
             warn(" left out: not a concrete Solver subclass")
         elif not cls.__dict__.get("name"):  # a subclass of a built-in inherits its name: not its own
-            warn(" left out: the class sets no name of its own" + (f" (it would inherit {cls.name!r})"
-                                                                    if cls.name else ""))
+            warn(
+                " left out: the class sets no name of its own"
+                + (f" (it would inherit {cls.name!r})" if cls.name else "")
+            )
         elif not isinstance(cls.name, str) or not SOLVER_NAME.fullmatch(cls.name):
-            warn(f" left out: the solver name {cls.name!r:.80} is not a plain name (letters, digits, '.', '_', "
-                 "'-', at most 64): it names stored records")
+            warn(
+                f" left out: the solver name {cls.name!r:.80} is not a plain name (letters, digits, '.', '_', "
+                "'-', at most 64): it names stored records"
+            )
         elif cls.name in taken:
             warn(f" left out: the solver name {cls.name!r} is taken")
         else:
@@ -123,8 +142,11 @@ def check_pair_loop(name: str, requested: str) -> None:
     """SceneError unless solver ``name`` offers ``requested`` (or it is ``auto``)."""
     offered = solver_class(name).pair_loops
     if requested != "auto" and requested not in offered:
-        has = f"one pair loop, {offered[0]}: give auto" if len(offered) == 1 else \
-            f"the pair loops {', '.join(offered)}: give one of them or auto"
+        has = (
+            f"one pair loop, {offered[0]}: give auto"
+            if len(offered) == 1
+            else f"the pair loops {', '.join(offered)}: give one of them or auto"
+        )
         raise SceneError(f"--pair-loop: {name} has {has} (got {requested!r})")
 
 

@@ -15,6 +15,7 @@ it checks its arrays against ``memory_limit_bytes`` when it states one and
 never reads the machine (the harness sets that limit to the memory available,
 pcabench/memory.py, before any work).
 """
+
 from __future__ import annotations
 
 import math
@@ -104,13 +105,28 @@ class Scene:
 
         def finite(name: str) -> float:
             value = getattr(self, name)
-            need(isinstance(value, (int, float)) and not isinstance(value, bool)
-                 and math.isfinite(value), f"{name} must be a finite number (got {value!r})")
+            need(
+                isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value),
+                f"{name} must be a finite number (got {value!r})",
+            )
             return float(value)
 
-        for name in ("dx", "x_min", "x_max", "y_min", "y_max", "rho0", "c0", "mach",
-                     "pulse_width", "pulse_center", "h_factor", "cutoff_factor", "cfl",
-                     "blowup_factor"):
+        for name in (
+            "dx",
+            "x_min",
+            "x_max",
+            "y_min",
+            "y_max",
+            "rho0",
+            "c0",
+            "mach",
+            "pulse_width",
+            "pulse_center",
+            "h_factor",
+            "cutoff_factor",
+            "cfl",
+            "blowup_factor",
+        ):
             finite(name)
         need(self.dx > 0, f"dx must be > 0 m (got {self.dx})")
         need(self.x_max > self.x_min, f"x_max must be > x_min (got {self.x_min}..{self.x_max})")
@@ -123,73 +139,100 @@ class Scene:
         if not count <= 2**31 - 1:
             limit, smallest = self.memory_limit(), self.dx_for_particles(2**31 - 1)
             if limit is None:
-                need(False, f"dx = {self.dx} m gives {count:.3g} particles: more than the 2^31-1 supported; "
-                            f"the smallest dx that fits is about {smallest:.3g} m")
-            need(False, f"dx = {self.dx} m gives {count:.3g} particles: more than the 2^31-1 supported and the "
-                        f"memory available ({limit / 2**30:.3g} GiB); the smallest dx that fits is about "
-                        f"{max(self.smallest_dx_fitting(limit), smallest):.3g} m")
+                need(
+                    False,
+                    f"dx = {self.dx} m gives {count:.3g} particles: more than the 2^31-1 supported; "
+                    f"the smallest dx that fits is about {smallest:.3g} m",
+                )
+            need(
+                False,
+                f"dx = {self.dx} m gives {count:.3g} particles: more than the 2^31-1 supported and the "
+                f"memory available ({limit / 2**30:.3g} GiB); the smallest dx that fits is about "
+                f"{max(self.smallest_dx_fitting(limit), smallest):.3g} m",
+            )
         need(self.rho0 > 0, f"rho0 must be > 0 kg/m^3 (got {self.rho0})")
         need(self.c0 > 0, f"c0 must be > 0 m/s (got {self.c0})")
         need(0 < self.mach < 1, f"mach must be in (0, 1) (got {self.mach})")
         need(self.pulse_width > 0, f"pulse_width must be > 0 m (got {self.pulse_width})")
         need(0.5 <= self.h_factor <= 10, f"h_factor (h/dx) must be in [0.5, 10] (got {self.h_factor})")
-        need(self.cutoff_factor >= 1.0,
-             "cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core "
-             f"(got {self.cutoff_factor})")
-        need(self.cutoff_factor <= 5.0,
-             f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7")
+        need(
+            self.cutoff_factor >= 1.0,
+            "cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core "
+            f"(got {self.cutoff_factor})",
+        )
+        need(
+            self.cutoff_factor <= 5.0,
+            f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7",
+        )
         try:
             support = kernel_named(self.kernel).support
         except ValueError as exc:
             raise SceneError(str(exc)) from None
-        need(support is None or self.cutoff_factor == self.default("cutoff_factor"),
-             f"cutoff_factor applies to the truncated Gaussian only: {self.kernel} is cut at its compact support "
-             f"{support or 0:g}h (got cutoff_factor {self.cutoff_factor:g})")
+        need(
+            support is None or self.cutoff_factor == self.default("cutoff_factor"),
+            f"cutoff_factor applies to the truncated Gaussian only: {self.kernel} is cut at its compact support "
+            f"{support or 0:g}h (got cutoff_factor {self.cutoff_factor:g})",
+        )
         reach = self.cutoff_ratio(self.kernel, self.cutoff_factor)
-        need(self.h_factor * reach > 1,
-             f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
-             f"(got {reach:g} * {self.h_factor:g} = {reach * self.h_factor:g})")
+        need(
+            self.h_factor * reach > 1,
+            f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
+            f"(got {reach:g} * {self.h_factor:g} = {reach * self.h_factor:g})",
+        )
         need(self.cfl > 0, f"cfl (dt*c0/dx) must be > 0 (got {self.cfl}); dt must be positive")
         need(self.cfl <= 50, f"cfl (dt*c0/dx) must be <= 50 (got {self.cfl})")
         need(self.blowup_factor > 1, f"blowup_factor must be > 1 (got {self.blowup_factor})")
         need(self.model in MODELS, f"model must be one of {', '.join(MODELS)} (got {self.model!r})")
-        need(self.integrator in INTEGRATORS,
-             f"integrator must be one of {', '.join(INTEGRATORS)} (got {self.integrator!r})")
-        need(self.precision in PRECISIONS,
-             f"precision must be one of {', '.join(PRECISIONS)} (got {self.precision!r})")
+        need(
+            self.integrator in INTEGRATORS,
+            f"integrator must be one of {', '.join(INTEGRATORS)} (got {self.integrator!r})",
+        )
+        need(self.precision in PRECISIONS, f"precision must be one of {', '.join(PRECISIONS)} (got {self.precision!r})")
         need(self.steps is None or self.t_end is None, "give steps or t_end, not both")
         if self.steps is not None:
-            need(isinstance(self.steps, int) and not isinstance(self.steps, bool) and self.steps >= 1,
-                 f"steps must be an integer >= 1 (got {self.steps!r})")
+            need(
+                isinstance(self.steps, int) and not isinstance(self.steps, bool) and self.steps >= 1,
+                f"steps must be an integer >= 1 (got {self.steps!r})",
+            )
             need(self.steps <= MAX_STEPS, f"steps must be <= 1e7 (got {self.steps})")
         if self.t_end is not None:
             finite("t_end")
             need(self.t_end > 0, f"t_end must be > 0 s (got {self.t_end})")
-            need(self.t_end / self.dt_max <= MAX_STEPS,
-                 f"t_end = {self.t_end} s needs more than 1e7 steps at dt = {self.dt_max:g} s")
+            need(
+                self.t_end / self.dt_max <= MAX_STEPS,
+                f"t_end = {self.t_end} s needs more than 1e7 steps at dt = {self.dt_max:g} s",
+            )
         for problem in self.kind.check(self):  # the scene kind's own parameters first: they name its options
             need(False, problem)
         least = STRIP_CUTOFFS * self.cutoff
-        need(self.height >= least * (1 - 1e-9),
-             f"{'strip_height' if self.strip_height is not None else 'y_max - y_min'} must be at least "
-             f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
-             f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)")
+        need(
+            self.height >= least * (1 - 1e-9),
+            f"{'strip_height' if self.strip_height is not None else 'y_max - y_min'} must be at least "
+            f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
+            f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)",
+        )
         need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
         if self.periodic_x:
-            need(self.width >= least * (1 - 1e-9),
-                 f"x_max - x_min must be at least 3 cutoffs = {least:.6g} m at dx = {self.dx} for the x-periodic "
-                 f"{self.name} scene (got {self.width:.6g} m)")
+            need(
+                self.width >= least * (1 - 1e-9),
+                f"x_max - x_min must be at least 3 cutoffs = {least:.6g} m at dx = {self.dx} for the x-periodic "
+                f"{self.name} scene (got {self.width:.6g} m)",
+            )
         breaking = self.kind.breaking_time(self)
-        need(self.model == "linear" or self.t_final < breaking,
-             f"--t-end: t = {self.t_final:g} s passes the pulse's nonlinear breaking time {breaking:.3g} s at "
-             f"--mach {self.mach:g}, --pulse-width {self.pulse_width:g} m (the isothermal solution has a shock "
-             f"there): end earlier, lower --mach, or use the linear model")
+        need(
+            self.model == "linear" or self.t_final < breaking,
+            f"--t-end: t = {self.t_final:g} s passes the pulse's nonlinear breaking time {breaking:.3g} s at "
+            f"--mach {self.mach:g}, --pulse-width {self.pulse_width:g} m (the isothermal solution has a shock "
+            f"there): end earlier, lower --mach, or use the linear model",
+        )
         limit = self.memory_limit()  # None: the scene states no limit (the harness gives it one)
         if limit is not None:
-            need(self.memory_bytes() <= limit,
-                 f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
-                 f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
-                 f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m")
+            need(
+                self.memory_bytes() <= limit,
+                f"dx = {self.dx} m needs {self.n_particles:,} particles and about "
+                f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
+                f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m",
+            )
 
     # ------------------------------------------------------------ geometry
     @property
@@ -327,8 +370,9 @@ class Scene:
         return cls.default("cutoff_factor") if cutoff_factor is None else cutoff_factor
 
     @classmethod
-    def thinnest_strip(cls, dx: float, cutoff_factor: float | None = None,
-                       h_factor: float | None = None, kernel: str | None = None) -> float:
+    def thinnest_strip(
+        cls, dx: float, cutoff_factor: float | None = None, h_factor: float | None = None, kernel: str | None = None
+    ) -> float:
         """The thinnest y-periodic strip height the rules accept at ``dx``, in whole rows, m."""
         h_factor = cls.default("h_factor") if h_factor is None else h_factor
         return math.ceil(STRIP_CUTOFFS * cls.cutoff_ratio(kernel, cutoff_factor) * h_factor * (1 + 1e-9)) * dx
@@ -344,14 +388,23 @@ class Scene:
     def as_dict(self) -> dict:
         d = asdict(self)
         d.pop("memory_limit_bytes")
-        d.update(n_particles=self.n_particles, dt=self.dt, n_steps=self.n_steps,
-                 t_final=self.t_final, h=self.h, cutoff=self.cutoff, height=self.height)
+        d.update(
+            n_particles=self.n_particles,
+            dt=self.dt,
+            n_steps=self.n_steps,
+            t_final=self.t_final,
+            h=self.h,
+            cutoff=self.cutoff,
+            height=self.height,
+        )
         return d
 
     def describe(self) -> str:
         scene = "" if self.name == DEFAULT_SCENE else f"{self.name}, "
-        return (f"{scene}{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
-                f"{self.kernel} kernel, h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
-                f"{self.n_steps} steps to t = {self.t_final:.4g} s, "
-                f"{self.model}/{self.integrator}/{self.precision}, "
-                f"arrays <= {self.memory_bytes() / 2**20:.1f} MiB")
+        return (
+            f"{scene}{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
+            f"{self.kernel} kernel, h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
+            f"{self.n_steps} steps to t = {self.t_final:.4g} s, "
+            f"{self.model}/{self.integrator}/{self.precision}, "
+            f"arrays <= {self.memory_bytes() / 2**20:.1f} MiB"
+        )

@@ -1,4 +1,5 @@
 """Shared fixtures: small scenes and a helper that runs a scene and returns record + fields."""
+
 from __future__ import annotations
 
 import numpy as np

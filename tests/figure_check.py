@@ -10,6 +10,7 @@
 
 ``record()`` hooks ``Figure.savefig``, so that every figure a report writes is checked as it is saved.
 """
+
 from __future__ import annotations
 
 import os
@@ -51,8 +52,11 @@ def _points(ax) -> np.ndarray:
             t = np.linspace(0, 1, 25)[:, None, None]
             xy = (xy[:-1] + t * (xy[1:] - xy[:-1])).reshape(-1, 2)
         pts.append(xy)
-    pts += [c.get_offset_transform().transform(c.get_offsets()) for c in ax.collections
-            if len(getattr(c, "get_offsets", lambda: [])())]
+    pts += [
+        c.get_offset_transform().transform(c.get_offsets())
+        for c in ax.collections
+        if len(getattr(c, "get_offsets", lambda: [])())
+    ]
     for p in ax.patches:
         if isinstance(p, Rectangle) and p.get_width() and p.get_height():
             pts.append(p.get_window_extent().get_points())
@@ -89,8 +93,10 @@ def problems(fig: Figure) -> list[str]:
         box = lg.get_window_extent(renderer)
         for ax in fig.axes:
             pts = _points(ax)
-            if len(pts) and ((pts[:, 0] > box.x0) & (pts[:, 0] < box.x1) & (pts[:, 1] > box.y0)
-                             & (pts[:, 1] < box.y1)).any():
+            if (
+                len(pts)
+                and ((pts[:, 0] > box.x0) & (pts[:, 0] < box.x1) & (pts[:, 1] > box.y0) & (pts[:, 1] < box.y1)).any()
+            ):
                 out.append(f"a legend lies over the data of '{ax.get_title() or title}'")
         labels = [t.get_text() for t in lg.get_texts()]
         texts += labels
@@ -106,10 +112,13 @@ def problems(fig: Figure) -> list[str]:
     for ax in fig.axes:
         for axis in (ax.xaxis, ax.yaxis):
             boxes = [(t.get_text(), t.get_window_extent(renderer)) for t in _tick_labels(axis)]
-            out += [f"tick label '{t}' in 'a x 10^b' form on a log axis of '{ax.get_title() or title}'"
-                    for t, _ in boxes if re.search(r"\d\s*\\times\s*10\^", t)]
+            out += [
+                f"tick label '{t}' in 'a x 10^b' form on a log axis of '{ax.get_title() or title}'"
+                for t, _ in boxes
+                if re.search(r"\d\s*\\times\s*10\^", t)
+            ]
             for i, (ta, a) in enumerate(boxes):
-                for tb, b in boxes[i + 1:]:
+                for tb, b in boxes[i + 1 :]:
                     if _overlap(a, b):
                         out.append(f"tick labels '{ta}' and '{tb}' overlap in '{ax.get_title() or title}'")
         seen = {}
@@ -124,8 +133,11 @@ def problems(fig: Figure) -> list[str]:
             if any(isinstance(p, Rectangle) and p.get_width() and not p.get_hatch() for p in ax.patches):
                 out.append(f"the published bars of '{ax.get_title()}' are not hatched")
     canvas = fig.bbox
-    for text in [fig._suptitle, *(t for ax in fig.axes for t in (ax.title, ax._left_title, ax.xaxis.label,
-                                                                  ax.yaxis.label)), *_legends(fig)]:
+    for text in [
+        fig._suptitle,
+        *(t for ax in fig.axes for t in (ax.title, ax._left_title, ax.xaxis.label, ax.yaxis.label)),
+        *_legends(fig),
+    ]:
         if text is not None and text.get_visible() and (not hasattr(text, "get_text") or text.get_text()):
             box = text.get_window_extent(renderer)
             if box.x0 < canvas.x0 - 1 or box.x1 > canvas.x1 + 1 or box.y0 < canvas.y0 - 1 or box.y1 > canvas.y1 + 1:
@@ -146,10 +158,15 @@ def _published_style(line: Line2D) -> bool:
 def _channels(fig, texts) -> list[str]:
     """A channel named in a title or legend must take more than one value among the data series."""
     lines = [ln for ax in fig.axes for ln in _series(ax) if not PUBLISHED.search(ln.get_label())]
-    values = {"colour": {_style(ln)[0] for ln in lines}, "marker": {_style(ln)[1] for ln in lines},
-              "line": {_style(ln)[3] for ln in lines}, "hollow": {_style(ln)[2] for ln in lines}}
-    values["colour"] |= {tuple(np.round(c, 3)) for ax in fig.axes for coll in ax.collections
-                         for c in coll.get_facecolors()}
+    values = {
+        "colour": {_style(ln)[0] for ln in lines},
+        "marker": {_style(ln)[1] for ln in lines},
+        "line": {_style(ln)[3] for ln in lines},
+        "hollow": {_style(ln)[2] for ln in lines},
+    }
+    values["colour"] |= {
+        tuple(np.round(c, 3)) for ax in fig.axes for coll in ax.collections for c in coll.get_facecolors()
+    }
     out = []
     for text in texts:
         for m in CHANNEL.finditer(text or ""):

@@ -1,4 +1,5 @@
 """pcabench advise: the fastest stored run reaching an error, like with like, and the paper's method beside it."""
+
 from __future__ import annotations
 
 import json
@@ -65,13 +66,15 @@ def test_lagrangian_is_judged_against_its_own_limit(results):
 
 
 def test_advise_command_json_and_what_no_run_reaches(results, capsys):
-    rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", "m", "--json",
-                            capsys=capsys)
+    rc, out, err = cli_main(
+        "advise", "--error", "0.01", "--results", str(results), "--machine", "m", "--json", capsys=capsys
+    )
     assert rc == 0, err
     data = json.loads(out)
     assert {"command", "error", "seconds", "paper_seconds"} <= set(data)
-    rc, out, err = cli_main("advise", "--error", "0.02", "--t-end", "5", "--results", str(results), "--machine", "m",
-                            capsys=capsys)
+    rc, out, err = cli_main(
+        "advise", "--error", "0.02", "--t-end", "5", "--results", str(results), "--machine", "m", capsys=capsys
+    )
     assert rc == 1 and "none of the 0 stored runs" in out and "pcabench study" in out
     rc, out, err = cli_main("advise", "--error", "2", "--results", str(results), capsys=capsys)
     assert rc == 2 and "--error" in err and "Traceback" not in err
@@ -82,11 +85,11 @@ def test_advise_takes_a_machine_prefix_as_runs_does(results, capsys):
     for r in store.read_rows(results):
         store.append(dict(r, profile_id="mach-two", run_id=r["run_id"] + "-2"), other)
     for given, meant in (("mach", "mach-two"), ("m", "m")):  # a prefix of one machine; an exact name wins
-        rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", given,
-                                "--json", capsys=capsys)
+        rc, out, err = cli_main(
+            "advise", "--error", "0.01", "--results", str(results), "--machine", given, "--json", capsys=capsys
+        )
         assert rc == 0 and json.loads(out)["machine"] == meant, err
-    rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", "zz",
-                            capsys=capsys)
+    rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--machine", "zz", capsys=capsys)
     assert rc == 2 and "--machine 'zz'" in err and len(err.strip().splitlines()) == 1
 
 
@@ -109,27 +112,61 @@ def test_a_run_past_its_predicted_stable_cfl_is_never_advised(results, capsys):
     # only the run past its limit reaches 0.0015: nothing is advised, in text and in JSON (exit 1 both)
     rc, text, _ = cli_main("advise", "--error", "0.0015", "--results", str(results), "--machine", "m", capsys=capsys)
     assert rc == 1 and "below its predicted stable CFL" in text and "CFL 3 is past" in text and ".py" not in text
-    rc, text, _ = cli_main("advise", "--error", "0.0015", "--results", str(results), "--machine", "m", "--json",
-                           capsys=capsys)
+    rc, text, _ = cli_main(
+        "advise", "--error", "0.0015", "--results", str(results), "--machine", "m", "--json", capsys=capsys
+    )
     data = json.loads(text, parse_constant=_refuse)
     assert rc == 1 and data["found"] is False and data["unstable_by_prediction"][0]["cfl"] == 3.0
 
 
 def test_advise_json_is_strict_and_the_paper_configuration_is_not_compared_with_itself(results, capsys):
-    rc, text, _ = cli_main("advise", "--error", "0.0115", "--model", "lagrangian", "--results", str(results),
-                           "--machine", "m", capsys=capsys)
+    rc, text, _ = cli_main(
+        "advise",
+        "--error",
+        "0.0115",
+        "--model",
+        "lagrangian",
+        "--results",
+        str(results),
+        "--machine",
+        "m",
+        capsys=capsys,
+    )
     assert rc == 0 and "this is the paper's configuration" in text and "slower" not in text, text
     assert text.count("pcabench run ") == 1, text  # the command once, not twice with "1x"
-    rc, text, _ = cli_main("advise", "--error", "0.0115", "--model", "lagrangian", "--results", str(results),
-                           "--machine", "m", "--json", capsys=capsys)
+    rc, text, _ = cli_main(
+        "advise",
+        "--error",
+        "0.0115",
+        "--model",
+        "lagrangian",
+        "--results",
+        str(results),
+        "--machine",
+        "m",
+        "--json",
+        capsys=capsys,
+    )
     data = json.loads(text, parse_constant=_refuse)
     assert rc == 0 and data["is_paper_configuration"] is True and data["strip_height"] == 4.0
-    rc, text, _ = cli_main("advise", "--error", "0.01", "--domain", "full", "--results", str(results), "--machine",
-                           "m", "--json", capsys=capsys)
+    rc, text, _ = cli_main(
+        "advise",
+        "--error",
+        "0.01",
+        "--domain",
+        "full",
+        "--results",
+        str(results),
+        "--machine",
+        "m",
+        "--json",
+        capsys=capsys,
+    )
     data = json.loads(text, parse_constant=_refuse)  # a full-domain run: its strip height is null, never NaN
     assert rc == 0 and data["strip_height"] is None
     assert data["stable_cfl"] == float(f"{data['stable_cfl']:.3g}") and data["cfl_fraction"] == round(
-        data["cfl_fraction"], 2)  # rounded as the text prints them
+        data["cfl_fraction"], 2
+    )  # rounded as the text prints them
 
 
 def test_a_moving_model_past_its_long_run_limit_is_never_advised(tmp_path, capsys):
@@ -148,6 +185,7 @@ def test_a_moving_model_past_its_long_run_limit_is_never_advised(tmp_path, capsy
     assert stability.assess({"scene": "acoustic-pulse", "model": "fixed", "cfl": 4.8})["past_limit"]
     out = advise(load_frame(path.parent), 0.01, 10.0, model="lagrangian")
     assert out["seconds"] == pytest.approx(80.0) and out["unstable_by_prediction"][0]["cfl"] == 4.85
-    rc, text, _ = cli_main("advise", "--error", "0.01", "--model", "lagrangian", "--results", str(path.parent),
-                           capsys=capsys)
+    rc, text, _ = cli_main(
+        "advise", "--error", "0.01", "--model", "lagrangian", "--results", str(path.parent), capsys=capsys
+    )
     assert rc == 0 and "CFL 4.85 is past the stable 4.8 measured over long runs" in text, text

@@ -1,4 +1,5 @@
 """The benchmark suites themselves: the ratio checker can fail, and no suite touches CUDA at import."""
+
 from __future__ import annotations
 
 import subprocess
@@ -26,10 +27,12 @@ def test_ratio_checks_pass_and_fail():
 
 
 def test_benchmark_modules_import_without_cuda():
-    code = ("import sys; sys.path.insert(0, '.')\n"
-            "import benchmarks.bench_step, benchmarks.bench_gpu, benchmarks.bench_accuracy, "
-            "benchmarks.bench_memory, benchmarks.bench_jit, benchmarks.common\n"
-            "bad = [m for m in sys.modules if m.startswith(('cupy', 'numba.cuda'))]\n"
-            "assert not bad, bad")
+    code = (
+        "import sys; sys.path.insert(0, '.')\n"
+        "import benchmarks.bench_step, benchmarks.bench_gpu, benchmarks.bench_accuracy, "
+        "benchmarks.bench_memory, benchmarks.bench_jit, benchmarks.common\n"
+        "bad = [m for m in sys.modules if m.startswith(('cupy', 'numba.cuda'))]\n"
+        "assert not bad, bad"
+    )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr

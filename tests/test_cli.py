@@ -1,4 +1,5 @@
 """The command line contract: the stage table, --json, --fields, and clear errors on bad input."""
+
 from __future__ import annotations
 
 import json
@@ -14,26 +15,66 @@ from .conftest import cli_main
 
 
 def pcabench(*args, timeout=600):
-    return subprocess.run([sys.executable, "-m", "pcabench.cli", *args], capture_output=True,
-                          text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "pcabench.cli", *args], capture_output=True, text=True, timeout=timeout
+    )
 
 
 def test_run_prints_stage_table_and_errors():
     proc = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "10")
     assert proc.returncode == 0, proc.stderr
-    for word in ("input", "init", "snp", "pi", "su", "output", "jit", "particles", "mean neighbours",
-                 "MSE", "ME", "1,000"):
+    for word in (
+        "input",
+        "init",
+        "snp",
+        "pi",
+        "su",
+        "output",
+        "jit",
+        "particles",
+        "mean neighbours",
+        "MSE",
+        "ME",
+        "1,000",
+    ):
         assert word in proc.stdout
 
 
 def test_json_is_one_object_with_the_contract(tmp_path):
     fields = tmp_path / "f.npz"
-    proc = pcabench("run", "--solver", "allpair-cpu", "--dx", "1", "--t-end", "2", "--model", "linear",
-                    "--json", "--fields", str(fields))
+    proc = pcabench(
+        "run",
+        "--solver",
+        "allpair-cpu",
+        "--dx",
+        "1",
+        "--t-end",
+        "2",
+        "--model",
+        "linear",
+        "--json",
+        "--fields",
+        str(fields),
+    )
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
-    for key in ("solver", "precision", "model", "integrator", "dx", "n_particles", "steps", "t_end",
-                "stages", "jit_seconds", "mse", "me", "mean_neighbours", "status", "failed_step"):
+    for key in (
+        "solver",
+        "precision",
+        "model",
+        "integrator",
+        "dx",
+        "n_particles",
+        "steps",
+        "t_end",
+        "stages",
+        "jit_seconds",
+        "mse",
+        "me",
+        "mean_neighbours",
+        "status",
+        "failed_step",
+    ):
         assert key in out
     assert set(out["stages"]) == {"input", "init", "snp", "pi", "su", "output"}
     assert out["n_particles"] == 1000 and out["steps"] == 10 and out["t_end"] == pytest.approx(2.0)
@@ -44,29 +85,33 @@ def test_json_is_one_object_with_the_contract(tmp_path):
 
 
 def test_unstable_run_reports_status_and_step_with_exit_1():
-    proc = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
-                    "--model", "linear", "--json")
+    proc = pcabench(
+        "run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12", "--model", "linear", "--json"
+    )
     assert proc.returncode == 1
     out = json.loads(proc.stdout)
     assert out["status"] == "unstable" and out["failed_step"] >= 1
 
 
-@pytest.mark.parametrize("args,words", [
-    (["--dx", "0"], ["dx", "> 0"]),
-    (["--dx", "-1"], ["dx", "> 0"]),
-    (["--dx", "nan"], ["--dx", "finite"]),
-    (["--dx", "0.00001"], ["dx", "smallest dx that fits"]),
-    (["--dx", "1", "--cutoff", "0.5"], ["--cutoff", ">= 1"]),
-    (["--dx", "1", "--cfl", "0"], ["--cfl", "> 0"]),
-    (["--dx", "1", "--steps", "0"], ["--steps", ">= 1"]),
-    (["--dx", "1", "--t-end", "-5"], ["--t-end", "> 0"]),
-    (["--dx", "0.1", "--strip-height", "0.5"], ["--strip-height", "3 cutoffs"]),
-    (["--dx", "1", "--threads", "0"], ["--threads", ">= 1"]),
-    (["--dx", "1", "--threads", "100000"], ["--threads", "between 1 and"]),
-    (["--dx", "1", "--precision", "float16"], ["precision", "float64"]),
-    (["--dx", "1", "--integrator", "leapfrog"], ["integrator", "verlet"]),
-    (["--dx", "1", "--model", "eulerian"], ["model", "lagrangian"]),
-])
+@pytest.mark.parametrize(
+    "args,words",
+    [
+        (["--dx", "0"], ["dx", "> 0"]),
+        (["--dx", "-1"], ["dx", "> 0"]),
+        (["--dx", "nan"], ["--dx", "finite"]),
+        (["--dx", "0.00001"], ["dx", "smallest dx that fits"]),
+        (["--dx", "1", "--cutoff", "0.5"], ["--cutoff", ">= 1"]),
+        (["--dx", "1", "--cfl", "0"], ["--cfl", "> 0"]),
+        (["--dx", "1", "--steps", "0"], ["--steps", ">= 1"]),
+        (["--dx", "1", "--t-end", "-5"], ["--t-end", "> 0"]),
+        (["--dx", "0.1", "--strip-height", "0.5"], ["--strip-height", "3 cutoffs"]),
+        (["--dx", "1", "--threads", "0"], ["--threads", ">= 1"]),
+        (["--dx", "1", "--threads", "100000"], ["--threads", "between 1 and"]),
+        (["--dx", "1", "--precision", "float16"], ["precision", "float64"]),
+        (["--dx", "1", "--integrator", "leapfrog"], ["integrator", "verlet"]),
+        (["--dx", "1", "--model", "eulerian"], ["model", "lagrangian"]),
+    ],
+)
 def test_bad_input_exits_2_with_a_clear_message(args, words, capsys):
     code, out, err = cli_main("run", "--solver", "linkedlist-cpu", *args, capsys=capsys)
     assert code == 2, (out, err)
@@ -107,10 +152,24 @@ def test_exit_codes_are_distinct_and_listed_in_the_help(tmp_path, capsys):
     code, _, err = cli_main("advise", "--error", "0.1", "--results", str(empty), capsys=capsys)
     assert code == codes["no results"] and "no stored runs" in err and len(err.strip().splitlines()) == 1
     codes["bad input"] = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "0", capsys=capsys)[0]
-    codes["ok"] = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "2", "--quiet",
-                           capsys=capsys)[0]
-    codes["run failed"] = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
-                                   "--model", "linear", "--quiet", capsys=capsys)[0]
+    codes["ok"] = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "2", "--quiet", capsys=capsys)[
+        0
+    ]
+    codes["run failed"] = cli_main(
+        "run",
+        "--solver",
+        "linkedlist-cpu",
+        "--dx",
+        "1",
+        "--steps",
+        "300",
+        "--cfl",
+        "12",
+        "--model",
+        "linear",
+        "--quiet",
+        capsys=capsys,
+    )[0]
     assert codes == {"no results": cli.EXIT_NO_RESULTS, "bad input": 2, "ok": 0, "run failed": 1}
     assert len(set(codes.values()) | {cli.EXIT_UNAVAILABLE}) == 5  # one meaning per code
     assert not (tmp_path / "out").exists()  # refused before writing anything
@@ -157,8 +216,15 @@ def _refuse(name):
 def test_json_is_strict_everywhere(capsys):
     from pcabench import jsonout
 
-    text = jsonout.dumps({"a": float("nan"), "b": [float("inf"), -float("inf")], "c": np.float32(1.5),
-                          "d": np.int64(3), "e": np.bool_(True)})
+    text = jsonout.dumps(
+        {
+            "a": float("nan"),
+            "b": [float("inf"), -float("inf")],
+            "c": np.float32(1.5),
+            "d": np.int64(3),
+            "e": np.bool_(True),
+        }
+    )
     assert json.loads(text, parse_constant=_refuse) == {"a": None, "b": [None, None], "c": 1.5, "d": 3, "e": True}
     code, out, _ = cli_main("accuracy", "--dx", "0.25", "--integrator", "euler", "--json", capsys=capsys)
     assert json.loads(out, parse_constant=_refuse)["stable_cfl"] == 0

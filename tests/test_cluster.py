@@ -1,4 +1,5 @@
 """Sweeps on a Dask cluster: the same runs as a serial sweep, resume, worker loss, and the optional extra."""
+
 from __future__ import annotations
 
 import os
@@ -16,14 +17,21 @@ SWEEP = ["--dx", "1", "0.5", "--solver", "linkedlist-cpu", "allpair-cpu", "--ste
 
 
 def study(results, *args, **kw):
-    return subprocess.run([sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(results)],
-                          capture_output=True, text=True, timeout=600, **kw)
+    return subprocess.run(
+        [sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(results)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        **kw,
+    )
 
 
 def outcome(results):
     """What a sweep found, without timings or where it ran: one entry per run."""
-    return sorted((r["solver"], r["dx"], r["status"], r["steps"], round(r["mse"], 12), r["pair_loop"])
-                  for r in store.read_rows(results))
+    return sorted(
+        (r["solver"], r["dx"], r["status"], r["steps"], round(r["mse"], 12), r["pair_loop"])
+        for r in store.read_rows(results)
+    )
 
 
 def test_a_cluster_sweep_makes_the_same_runs_as_a_serial_one_and_resumes(tmp_path):
@@ -60,8 +68,12 @@ def run_child_under_a_worker(root: int) -> tuple[int, int] | None:
 
 def test_a_killed_worker_loses_and_duplicates_nothing(tmp_path):
     args = ["--dx", "0.25", "0.2", "--steps", "150", "--no-report", "--cluster", "local:2"]
-    proc = subprocess.Popen([sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(tmp_path)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(tmp_path)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     found = None
     deadline = time.time() + 180
     while time.time() < deadline and found is None and proc.poll() is None:
@@ -102,7 +114,11 @@ def test_a_local_cluster_listens_on_loopback_only():
     with ExitStack() as stack:
         client = connect("local:1", stack)
         here = psutil.Process()
-        listening = [c.laddr for p in (here, *here.children(recursive=True))
-                     for c in p.net_connections("inet") if c.status == psutil.CONN_LISTEN]
+        listening = [
+            c.laddr
+            for p in (here, *here.children(recursive=True))
+            for c in p.net_connections("inet")
+            if c.status == psutil.CONN_LISTEN
+        ]
         assert listening and all(addr.ip == "127.0.0.1" for addr in listening), listening
         assert "127.0.0.1" in client.dashboard_link

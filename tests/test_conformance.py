@@ -4,6 +4,7 @@ example passes it, and a deliberately broken solver fails the check it breaks.
 The GPU solver runs it in numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1) in a subprocess, through the
 command line, as CI does.
 """
+
 from __future__ import annotations
 
 import json
@@ -42,10 +43,19 @@ def test_every_builtin_cpu_solver_conforms(name):
 
 @pytest.mark.parametrize("name", GPU_SOLVERS)
 def test_the_gpu_solver_conforms_in_the_simulator(name):
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", PYTHONPATH=os.pathsep.join(
-        [str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
-    proc = subprocess.run([sys.executable, "-m", "pcabench.cli", "check-solver", name, "--quick", "--json"],
-                          capture_output=True, text=True, env=env, cwd=ROOT, timeout=1800)
+    env = dict(
+        os.environ,
+        NUMBA_ENABLE_CUDASIM="1",
+        PYTHONPATH=os.pathsep.join([str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]),
+    )
+    proc = subprocess.run(
+        [sys.executable, "-m", "pcabench.cli", "check-solver", name, "--quick", "--json"],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=ROOT,
+        timeout=1800,
+    )
     assert proc.returncode == 0, (proc.stdout[-3000:], proc.stderr[-3000:])
     data = json.loads(proc.stdout.strip().splitlines()[-1])
     status = {c["name"]: c["status"] for c in data["checks"]}

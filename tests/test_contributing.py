@@ -7,6 +7,7 @@ scene is in the scene registry with finite initial fields, the section is in the
 preset expands to runs that a sweep stores. Every recipe unregisters what it registered: the registries
 are checked to be as they were.
 """
+
 from __future__ import annotations
 
 import re
@@ -113,8 +114,9 @@ def test_the_scene_recipe_registers_a_scene_with_finite_initial_fields(run_recip
         assert kind.name in scene_names()
         scene = Scene(name=kind.name, dx=0.5, steps=2, model="linear")
         assert scene.periodic_x and scene.n_particles == 40 * 40
-        x, y = np.meshgrid(scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx,
-                           scene.y_lo + (np.arange(scene.ny) + 0.5) * scene.dx)
+        x, y = np.meshgrid(
+            scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx, scene.y_lo + (np.arange(scene.ny) + 0.5) * scene.dx
+        )
         u, v, drho = kind.initial_fields(scene, x, y, np)
     assert all(np.all(np.isfinite(f)) for f in (u, v, drho))
     assert np.isclose(np.abs(drho).max(), scene.rho0 * scene.mach, rtol=1e-2) and not u.any() and not v.any()

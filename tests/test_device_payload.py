@@ -1,5 +1,6 @@
 """The device payload: what a lent GPU machine gets fits the 64 MiB a run carries, and the device side reports
 instead of raising."""
+
 from __future__ import annotations
 
 import subprocess

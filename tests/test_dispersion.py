@@ -4,6 +4,7 @@ The prediction is exact linear algebra of the `linear` model's discrete operator
 step program on an unbounded lattice, so a run must agree with it to many digits while the pulse and its
 dispersive tail stay clear of the domain's ends, and the stable CFL it gives must be where runs blow up.
 """
+
 from __future__ import annotations
 
 import json
@@ -21,14 +22,29 @@ from .conftest import cli_main
 def strip_scene(dx, **kw) -> Scene:
     """The pulse's scene on a strip, 110 m long: its error waves stay clear of the ends (which the unbounded
     lattice of the prediction does not have) up to t = 10 s at every step tested."""
-    return Scene(dx=dx, t_end=10.0, model="linear", x_min=-40.0, x_max=70.0, **kw,
-                 strip_height=Scene.thinnest_strip(dx, kw.get("cutoff_factor"), kw.get("h_factor"), kw.get("kernel")))
+    return Scene(
+        dx=dx,
+        t_end=10.0,
+        model="linear",
+        x_min=-40.0,
+        x_max=70.0,
+        **kw,
+        strip_height=Scene.thinnest_strip(dx, kw.get("cutoff_factor"), kw.get("h_factor"), kw.get("kernel")),
+    )
 
 
-@pytest.mark.parametrize("kw", [dict(dx=0.2), dict(dx=0.1, h_factor=1.5), dict(dx=0.2, cfl=1.0),
-                                dict(dx=0.25, h_factor=1.3, cutoff_factor=2.5), dict(dx=0.2, integrator="kdk1"),
-                                dict(dx=0.2, kernel="wendland-c4", h_factor=1.6, cfl=1.5),
-                                dict(dx=0.2, kernel="wendland-c2")])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        dict(dx=0.2),
+        dict(dx=0.1, h_factor=1.5),
+        dict(dx=0.2, cfl=1.0),
+        dict(dx=0.25, h_factor=1.3, cutoff_factor=2.5),
+        dict(dx=0.2, integrator="kdk1"),
+        dict(dx=0.2, kernel="wendland-c4", h_factor=1.6, cfl=1.5),
+        dict(dx=0.2, kernel="wendland-c2"),
+    ],
+)
 def test_predicted_error_is_the_measured_error(kw):
     scene = strip_scene(**kw)
     measured = run(RunSpec("linkedlist-cpu", scene))
@@ -63,8 +79,7 @@ def test_accuracy_command_json(capsys):
     rc, out, err = cli_main("accuracy", "--dx", "0.2", "--t-end", "10", "--h-factor", "1.5", "--json", capsys=capsys)
     assert rc == 0, err
     data = json.loads(out)
-    assert data["predicted_error"] == pytest.approx(predict(strip_scene(0.2, h_factor=1.5)).predicted_error,
-                                                    rel=1e-6)
+    assert data["predicted_error"] == pytest.approx(predict(strip_scene(0.2, h_factor=1.5)).predicted_error, rel=1e-6)
     assert data["stable_cfl"] > 1
     rc, out, err = cli_main("accuracy", "--dx", "0.2", "--cfl", "0", capsys=capsys)
     assert rc == 2 and "cfl" in err and "Traceback" not in err

@@ -6,6 +6,7 @@ quick study holds every section of the report's section registry (pcabench/repor
 ``SECTIONS``) with every figure that section declares, each passing the checks: the list of sections
 and figures is the registry's, never one kept here. The committed reference's figures pass them too.
 """
+
 from __future__ import annotations
 
 import matplotlib
@@ -47,22 +48,50 @@ def quick_records() -> list[RunRecord]:
             status, steps, failed = "unstable", 12, 12
         elif s.cfl >= 5:
             mse = 0.3
-        stages = {"input": 1e-4, "init": 1e-6 * n, "output": 1e-6 * n,
-                  "snp": 0.3 * step * steps, "pi": 0.65 * step * steps, "su": 0.05 * step * steps}
-        out.append(RunRecord(
-            solver=spec.solver, precision=s.precision, model=s.model, integrator=s.integrator, dx=s.dx,
-            n_particles=n, steps=steps, t_end=s.t_final, stages=stages, jit_seconds=1.0, mse=mse, me=mse / 20,
-            mean_neighbours=120.0, status=status, failed_step=failed, threads=int(spec.threads),
-            pair_loop=spec.pair_loop, steps_requested=s.n_steps, scene=s.as_dict(),
-            mse_isothermal=mse / 2 if s.model == "lagrangian" else None,
-            message="predicted 999 s > run budget 120 s" if status == "skipped" else "", profile_id=PROFILE,
-            commit="abc1234", preset="quick", host="host1",
-            timestamp=f"2026-01-01T00:{i // 60:02d}:{i % 60:02d}+00:00"))
+        stages = {
+            "input": 1e-4,
+            "init": 1e-6 * n,
+            "output": 1e-6 * n,
+            "snp": 0.3 * step * steps,
+            "pi": 0.65 * step * steps,
+            "su": 0.05 * step * steps,
+        }
+        out.append(
+            RunRecord(
+                solver=spec.solver,
+                precision=s.precision,
+                model=s.model,
+                integrator=s.integrator,
+                dx=s.dx,
+                n_particles=n,
+                steps=steps,
+                t_end=s.t_final,
+                stages=stages,
+                jit_seconds=1.0,
+                mse=mse,
+                me=mse / 20,
+                mean_neighbours=120.0,
+                status=status,
+                failed_step=failed,
+                threads=int(spec.threads),
+                pair_loop=spec.pair_loop,
+                steps_requested=s.n_steps,
+                scene=s.as_dict(),
+                mse_isothermal=mse / 2 if s.model == "lagrangian" else None,
+                message="predicted 999 s > run budget 120 s" if status == "skipped" else "",
+                profile_id=PROFILE,
+                commit="abc1234",
+                preset="quick",
+                host="host1",
+                timestamp=f"2026-01-01T00:{i // 60:02d}:{i % 60:02d}+00:00",
+            )
+        )
     return out
 
 
 def recorded(section: sections.Section, texts: dict, drawn: dict) -> sections.Section:
     """``section`` as the registry declares it, its Markdown and each figure it draws recorded by its name."""
+
     def text(rows, ctx):
         lines = section.text(rows, ctx)
         texts.setdefault(section.name, []).extend(lines)
@@ -73,6 +102,7 @@ def recorded(section: sections.Section, texts: dict, drawn: dict) -> sections.Se
             path = draw(rows, ctx)
             drawn.setdefault(section.name, []).append(path)
             return path
+
         return drawn_by
 
     return dataclasses.replace(section, text=text, figures=tuple(figure(f) for f in section.figures))

@@ -5,6 +5,7 @@ CUDA simulator (NUMBA_ENABLE_CUDASIM=1, NumPy in place of CuPy) in a
 subprocess, on a few hundred particles. The ``gpu`` tests run on a real GPU
 and skip cleanly without one.
 """
+
 from __future__ import annotations
 
 import json
@@ -42,8 +43,13 @@ print(json.dumps(out))
 
 def _simulate(precision, model, steps, integrator="verlet", kernel="gaussian"):
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps), integrator, kernel],
-                          capture_output=True, text=True, env=env, timeout=900)
+    proc = subprocess.run(
+        [sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps), integrator, kernel],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=900,
+    )
     assert proc.returncode == 0, proc.stderr[-3000:]
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
@@ -53,10 +59,13 @@ def _max_rel(a, b):
     return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
 
 
-@pytest.mark.parametrize("precision,model,steps,tol", [
-    ("float64", "lagrangian", 20, 1e-12),
-    ("float32", "linear", 8, 2e-5),
-])
+@pytest.mark.parametrize(
+    "precision,model,steps,tol",
+    [
+        ("float64", "lagrangian", 20, 1e-12),
+        ("float32", "linear", 8, 2e-5),
+    ],
+)
 def test_simulated_gpu_kernels_match_cpu(precision, model, steps, tol):
     out = _simulate(precision, model, steps)
     cpu, gpu = out["linkedlist-cpu"], out["linkedlist-gpu"]
@@ -84,8 +93,13 @@ def test_gpu_cli_without_gpu_exits_clearly():
     if gpu_available():
         pytest.skip("a GPU is present")
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_ENABLE_CUDASIM"}
-    proc = subprocess.run([sys.executable, "-m", "pcabench.cli", "run", "--solver", "linkedlist-gpu",
-                           "--dx", "1"], capture_output=True, text=True, env=env, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, "-m", "pcabench.cli", "run", "--solver", "linkedlist-gpu", "--dx", "1"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
     assert proc.returncode == 3
     assert "GPU" in proc.stderr and "Traceback" not in proc.stderr
 
@@ -174,8 +188,7 @@ def test_simulated_step_launches_and_host_round_trips():
     """A lagrangian Verlet step is at most 8 kernel launches, touches no array-module operation (each would be
     a CuPy launch or a host round trip on a GPU) and never synchronises; the one-block cellBegin scan is exact."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run([sys.executable, "-c", LAUNCH_SCRIPT], capture_output=True, text=True, env=env,
-                          timeout=900)
+    proc = subprocess.run([sys.executable, "-c", LAUNCH_SCRIPT], capture_output=True, text=True, env=env, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     verlet = out["verlet"]

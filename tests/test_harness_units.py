@@ -1,4 +1,5 @@
 """Units of the harness that break first: the thread policy, run identity, the time predictor, the clock."""
+
 from __future__ import annotations
 
 import math
@@ -24,13 +25,16 @@ def test_threads_policy_one_spelling_each():
     assert resolve_threads(ALL_CORES, "allpair-cpu") == 1  # "every core" of a serial solver is one
 
 
-@pytest.mark.parametrize("threads,solver,words", [
-    (0, "linkedlist-cpu", ">= 1"),
-    ("two", "linkedlist-cpu", "'all'"),
-    (2, "allpair-cpu", "allpair-cpu is serial"),
-    (2, "linkedlist-gpu", "linkedlist-gpu is serial"),
-    (numba.config.NUMBA_NUM_THREADS + 1, "linkedlist-cpu", "between 1 and"),
-])
+@pytest.mark.parametrize(
+    "threads,solver,words",
+    [
+        (0, "linkedlist-cpu", ">= 1"),
+        ("two", "linkedlist-cpu", "'all'"),
+        (2, "allpair-cpu", "allpair-cpu is serial"),
+        (2, "linkedlist-gpu", "linkedlist-gpu is serial"),
+        (numba.config.NUMBA_NUM_THREADS + 1, "linkedlist-cpu", "between 1 and"),
+    ],
+)
 def test_bad_threads_name_the_option(threads, solver, words):
     with pytest.raises(OptionError, match="--threads") as exc:
         resolve_threads(threads, solver)
@@ -47,12 +51,14 @@ def test_a_spec_and_its_stored_row_have_one_identity():
     key = spec.key("machine-a", "abc", "h1")
     assert row_identity(row) == key
     # a different scene, thread count, preset, machine, commit or host is another run
-    others = [identity(spec.solver, spec.threads, spec.scene.replace(cfl=0.2), "quick", "machine-a", "abc", "h1"),
-              identity(spec.solver, spec.threads + 1, spec.scene, "quick", "machine-a", "abc", "h1"),
-              identity(spec.solver, spec.threads, spec.scene, "paper", "machine-a", "abc", "h1"),
-              identity(spec.solver, spec.threads, spec.scene, "quick", "machine-b", "abc", "h1"),
-              identity(spec.solver, spec.threads, spec.scene, "quick", "machine-a", "abd", "h1"),
-              identity(spec.solver, spec.threads, spec.scene, "quick", "machine-a", "abc", "h2")]
+    others = [
+        identity(spec.solver, spec.threads, spec.scene.replace(cfl=0.2), "quick", "machine-a", "abc", "h1"),
+        identity(spec.solver, spec.threads + 1, spec.scene, "quick", "machine-a", "abc", "h1"),
+        identity(spec.solver, spec.threads, spec.scene, "paper", "machine-a", "abc", "h1"),
+        identity(spec.solver, spec.threads, spec.scene, "quick", "machine-b", "abc", "h1"),
+        identity(spec.solver, spec.threads, spec.scene, "quick", "machine-a", "abd", "h1"),
+        identity(spec.solver, spec.threads, spec.scene, "quick", "machine-a", "abc", "h2"),
+    ]
     assert key not in others and len(set(others)) == len(others)
 
 
@@ -61,8 +67,15 @@ def _ok_row(solver, n_dx, step_s, steps=10, threads=1):
     scene = Scene(dx=n_dx, steps=steps)
     stages = {s: 0.0 for s in STAGES}
     stages["pi"] = step_s * steps
-    return {"status": "ok", "solver": solver, "threads": threads, "scene": scene.as_dict(),
-            "n_particles": scene.n_particles, "steps": steps, "stages": stages}
+    return {
+        "status": "ok",
+        "solver": solver,
+        "threads": threads,
+        "scene": scene.as_dict(),
+        "n_particles": scene.n_particles,
+        "steps": steps,
+        "stages": stages,
+    }
 
 
 def test_predictor_fits_the_power_law_and_extrapolates():

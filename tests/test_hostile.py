@@ -3,6 +3,7 @@
 Each probe is a hostile user's: a store merged from another machine, a solver that prints, a link left in a
 folder, a full disk. Everything is built in tmp dirs; the tests signal only processes they started.
 """
+
 from __future__ import annotations
 
 import errno
@@ -109,12 +110,12 @@ def test_report_runs_advise_and_study_survive_every_hostile_row_at_once(tmp_path
         warnings.simplefilter("ignore", store.StoreWarning)
         code, out, err = cli_main("runs", "--results", str(results), capsys=capsys)
         assert code == 0 and "Traceback" not in err and len(out.splitlines()) == 2, (out, err)
-        code, out, err = cli_main("report", "--results", str(results), "--out", str(tmp_path / "out"),
-                                  capsys=capsys)
+        code, out, err = cli_main("report", "--results", str(results), "--out", str(tmp_path / "out"), capsys=capsys)
         assert code == 0, err
         assert sorted(p.name for p in (tmp_path / "out").iterdir() if p.is_dir()) == ["m"]
-        code, out, err = cli_main("advise", "--results", str(results), "--error", "0.5", "--machine", "m",
-                                  capsys=capsys)
+        code, out, err = cli_main(
+            "advise", "--results", str(results), "--error", "0.5", "--machine", "m", capsys=capsys
+        )
         assert code == 0 and "pcabench run --solver linkedlist-cpu" in out, (out, err)
         monkeypatch.setattr(sweep_module, "machine_id", lambda: "m")
         monkeypatch.setattr(sweep_module, "host_id", lambda: "h")
@@ -124,8 +125,7 @@ def test_report_runs_advise_and_study_survive_every_hostile_row_at_once(tmp_path
             made.append(spec)
             return store.to_row(record(host="h"))
 
-        sweep([RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))], path, run_budget=60, sweep_budget=60,
-              runner=child)
+        sweep([RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))], path, run_budget=60, sweep_budget=60, runner=child)
     assert len(made) == 1 and good["run_id"]
 
 
@@ -149,8 +149,13 @@ def test_a_newer_schema_last_line_is_kept_and_skipped_not_moved_out_as_torn(tmp_
 
 def test_a_record_that_would_not_read_back_is_never_written(tmp_path):
     path = tmp_path / "s.jsonl"
-    for bad in ({"solver": "name\nwith a newline"}, {"commit": "abc\x1b"}, {"profile_id": "README.md"},
-                {"host": "h" * 300}, {"dx": 1e308}):
+    for bad in (
+        {"solver": "name\nwith a newline"},
+        {"commit": "abc\x1b"},
+        {"profile_id": "README.md"},
+        {"host": "h" * 300},
+        {"dx": 1e308},
+    ):
         with pytest.raises(store.InvalidRecord, match="would not read back"):
             store.append(dict(good_row(), **bad), path)
     assert not path.exists() or path.read_bytes() == b""
@@ -164,8 +169,9 @@ def test_a_sweep_stores_a_record_that_would_not_read_back_as_an_error(tmp_path, 
     def forging_child(spec, timeout, commit, machine, stream=None):
         return dict(store.to_row(record(host="h")), solver="../../forged")
 
-    stored = sweep([RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))], path, run_budget=60, sweep_budget=60,
-                   runner=forging_child)
+    stored = sweep(
+        [RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2))], path, run_budget=60, sweep_budget=60, runner=forging_child
+    )
     rows = store.read_rows(path)
     assert [r["status"] for r in stored] == ["error"] and [r["solver"] for r in rows] == ["linkedlist-cpu"]
     assert "would not read back" in rows[0]["message"] and "solver" in rows[0]["message"]
@@ -173,8 +179,17 @@ def test_a_sweep_stores_a_record_that_would_not_read_back_as_an_error(tmp_path, 
 
 def test_the_schema_tolerates_a_named_scene_and_extra_plain_keys():
     row = good_row()
-    row["scene"] = dict(row["scene"], name="acoustic-pulse", x_min=-20.0, x_max=20.0, y_min=-20.0, y_max=20.0,
-                        strip_height=None, tube_length=12.5, wall="rigid")
+    row["scene"] = dict(
+        row["scene"],
+        name="acoustic-pulse",
+        x_min=-20.0,
+        x_max=20.0,
+        y_min=-20.0,
+        y_max=20.0,
+        strip_height=None,
+        tube_length=12.5,
+        wall="rigid",
+    )
     row["scene_name"] = "acoustic-pulse"
     row["scene_parameters"] = {"tube_length": 12.5, "wall": "rigid"}
     assert store.validate(row) == ""
@@ -222,8 +237,12 @@ def test_a_plugin_whose_name_would_not_read_back_is_left_out(tmp_path, monkeypat
 
     from .test_registry import install
 
-    site = install(tmp_path / "site", "badname_solver", BAD_NAMES,
-                   {"newline": "badname_solver:Newline", "path": "badname_solver:Path"})
+    site = install(
+        tmp_path / "site",
+        "badname_solver",
+        BAD_NAMES,
+        {"newline": "badname_solver:Newline", "path": "badname_solver:Path"},
+    )
     monkeypatch.syspath_prepend(str(site))
     registry.cache_clear()
     try:
@@ -244,8 +263,12 @@ def test_a_fifo_or_a_link_to_dev_zero_in_the_store_folder_is_skipped_with_a_warn
     os.mkfifo(results / "fifo.jsonl")
     (results / "zero.jsonl").symlink_to("/dev/zero")
     (results / "elsewhere.jsonl").symlink_to(results / "m.jsonl")
-    code = subprocess.run([sys.executable, "-W", "always", "-m", "pcabench.cli", "runs", "--results", str(results)],
-                          capture_output=True, text=True, timeout=120)
+    code = subprocess.run(
+        [sys.executable, "-W", "always", "-m", "pcabench.cli", "runs", "--results", str(results)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert code.returncode == 0, code.stderr
     assert len(code.stdout.splitlines()) == 2
     for name in ("fifo.jsonl", "zero.jsonl", "elsewhere.jsonl"):
@@ -306,11 +329,24 @@ def test_run_json_prints_exactly_one_object_whatever_the_solver_prints(tmp_path,
 
 
 def test_run_takes_a_run_budget(capsys):
-    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "0.05", "--steps", "100000", "--model",
-                              "linear", "--run-budget", "3", "--json", "--quiet", capsys=capsys)
+    code, out, err = cli_main(
+        "run",
+        "--solver",
+        "linkedlist-cpu",
+        "--dx",
+        "0.05",
+        "--steps",
+        "100000",
+        "--model",
+        "linear",
+        "--run-budget",
+        "3",
+        "--json",
+        "--quiet",
+        capsys=capsys,
+    )
     assert code == 1 and json.loads(out)["status"] == "timeout", (out, err)
-    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--run-budget", "0",
-                              capsys=capsys)
+    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--run-budget", "0", capsys=capsys)
     assert code == 2 and "--run-budget" in err
 
 
@@ -370,8 +406,16 @@ def test_gpu_check_out_link_is_refused(tmp_path, capsys):
     outside = tmp_path / "outside"
     outside.mkdir()
     (tmp_path / "out").symlink_to(outside)
-    code, _, err = cli_main("gpu-check", "--out", str(tmp_path / "out"), "--results", str(tmp_path / "r"),
-                            "--reports", str(tmp_path / "rep"), capsys=capsys)
+    code, _, err = cli_main(
+        "gpu-check",
+        "--out",
+        str(tmp_path / "out"),
+        "--results",
+        str(tmp_path / "r"),
+        "--reports",
+        str(tmp_path / "rep"),
+        capsys=capsys,
+    )
     assert code == 2 and "symbolic link" in err, err
     assert list(outside.iterdir()) == []
 
@@ -391,9 +435,19 @@ def test_gpu_check_writes_files_in_its_folder_without_following_links(tmp_path):
 def test_advise_quotes_every_command_for_the_shell():
     from pcabench.advise import command
 
-    r = {"solver": "x; touch /tmp/pwned", "model": "linear", "precision": "float64", "threads": 1, "dx": 0.5,
-         "kernel": "gaussian $(id)", "h_factor": 2.13, "cutoff_factor": 3.0, "cfl": 0.2, "integrator": "verlet",
-         "strip_height": None}
+    r = {
+        "solver": "x; touch /tmp/pwned",
+        "model": "linear",
+        "precision": "float64",
+        "threads": 1,
+        "dx": 0.5,
+        "kernel": "gaussian $(id)",
+        "h_factor": 2.13,
+        "cutoff_factor": 3.0,
+        "cfl": 0.2,
+        "integrator": "verlet",
+        "strip_height": None,
+    }
     line = command(r, 10.0)
     words = shlex.split(line)
     assert words[:4] == ["pcabench", "run", "--solver", "x; touch /tmp/pwned"]

@@ -5,6 +5,7 @@ function to break a circle still is one). ``from package import Name`` is
 followed to the module the package's ``__init__`` takes ``Name`` from, so a
 package's face re-exporting its modules is not itself a circle.
 """
+
 from __future__ import annotations
 
 import ast
@@ -142,6 +143,10 @@ def test_solvers_never_import_the_harness():
 
 def test_no_private_imports():
     """No module reaches into another module's private (_underscore) names."""
-    found = [f"{MODULES[m].relative_to(ROOT)}:{line} imports {', '.join(names)} from {t}"
-             for m in MODULES for line, t, names in _imports(m) if names and t != m]
+    found = [
+        f"{MODULES[m].relative_to(ROOT)}:{line} imports {', '.join(names)} from {t}"
+        for m in MODULES
+        for line, t, names in _imports(m)
+        if names and t != m
+    ]
     assert found == []

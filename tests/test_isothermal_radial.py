@@ -1,5 +1,6 @@
 """The radial isothermal Euler reference of the 2D pulse (solvers.isothermal_radial): its own convergence,
 its small-Mach limit (the linear open-domain solution), its nonlinearity at Ma = 0.05, and mass."""
+
 from __future__ import annotations
 
 import functools
@@ -52,8 +53,9 @@ def test_second_order_convergence():
     errs = []
     for c in (25, 50, 100):
         _, d, u = sols[c]
-        errs.append([np.max(np.abs(d - to_coarse(d_ref, 200 // c, 1.0))),
-                     np.max(np.abs(u - to_coarse(u_ref, 200 // c, -1.0)))])
+        errs.append(
+            [np.max(np.abs(d - to_coarse(d_ref, 200 // c, 1.0))), np.max(np.abs(u - to_coarse(u_ref, 200 // c, -1.0)))]
+        )
     orders = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
     assert np.all(orders >= 1.8), orders
     assert errs[-1][0] < 1e-5 * RHO0 * 0.05  # measured 1.2e-6 rho0 Ma at 100 cells/m

@@ -12,6 +12,7 @@ The lattice bounds are measured values with a little margin, at Scene's default 
 Both depend on h/dx only, not on dx: at fixed h/dx they set an error floor for every kernel (a sound-speed
 bias about the gradient sum's deviation), the Gaussian's including its truncation.
 """
+
 from __future__ import annotations
 
 import math
@@ -155,8 +156,9 @@ ERROR_AT_02 = {"gaussian": 0.070, "wendland-c2": 0.040, "wendland-c4": 0.031}
 def test_linear_converges_at_second_order_for_each_kernel(name):
     errors = []
     for dx in CONVERGENCE_DX:
-        scene = Scene(dx=dx, t_end=10.0, model="linear", kernel=name,
-                      strip_height=Scene.thinnest_strip(dx, kernel=name))
+        scene = Scene(
+            dx=dx, t_end=10.0, model="linear", kernel=name, strip_height=Scene.thinnest_strip(dx, kernel=name)
+        )
         rec = run(RunSpec("linkedlist-cpu", scene))
         assert rec.status == "ok", rec.message
         errors.append(rec.mse)
@@ -196,8 +198,16 @@ def test_the_scene_decides_the_cutoff_and_refuses_what_does_not_apply():
 def test_rows_without_a_kernel_are_gaussian_to_resume():
     spec = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=10))
     old = {k: v for k, v in spec.scene.as_dict().items() if k != "kernel"}  # a row from before kernels
-    row = {"solver": "linkedlist-cpu", "threads": 1, "scene": old, "preset": "quick", "profile_id": "m",
-           "commit": "c", "host": "h", "pair_loop": "list"}
+    row = {
+        "solver": "linkedlist-cpu",
+        "threads": 1,
+        "scene": old,
+        "preset": "quick",
+        "profile_id": "m",
+        "commit": "c",
+        "host": "h",
+        "pair_loop": "list",
+    }
     key = identity("linkedlist-cpu", 1, spec.scene, "quick", "m", "c", "h", "list")
     assert row_identity(row) == key
     assert scene_from_row(row) == spec.scene
@@ -206,8 +216,9 @@ def test_rows_without_a_kernel_are_gaussian_to_resume():
 
 
 def test_kernel_option_runs_and_the_matrix_takes_kernel_lists(capsys):
-    args = cli.build_parser().parse_args(["study", "--dx", "0.2", "--kernel", "gaussian", "wendland-c4",
-                                          "--h-factor", "1.5", "2.13", "--strip"])
+    args = cli.build_parser().parse_args(
+        ["study", "--dx", "0.2", "--kernel", "gaussian", "wendland-c4", "--h-factor", "1.5", "2.13", "--strip"]
+    )
     name, specs = cli.study_specs(args)
     assert name == "matrix" and len(specs) == 4
     assert sorted({s.scene.kernel for s in specs}) == ["gaussian", "wendland-c4"]
@@ -215,8 +226,21 @@ def test_kernel_option_runs_and_the_matrix_takes_kernel_lists(capsys):
         assert s.scene.strip_height == Scene.thinnest_strip(0.2, h_factor=s.scene.h_factor, kernel=s.scene.kernel)
     assert "kernel=wendland-c4" in next(s.label for s in specs if s.scene.kernel == "wendland-c4")
     assert {s.scene.kernel for s in matrix(dxs=[0.5], kernel=list(BUILTIN))} == set(BUILTIN)
-    code = cli.main(["run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "2", "--kernel",
-                     "wendland-c2", "--json", "--quiet"])
+    code = cli.main(
+        [
+            "run",
+            "--solver",
+            "linkedlist-cpu",
+            "--dx",
+            "1",
+            "--steps",
+            "2",
+            "--kernel",
+            "wendland-c2",
+            "--json",
+            "--quiet",
+        ]
+    )
     out = capsys.readouterr().out
     assert code == 0 and '"kernel": "wendland-c2"' in out
 
@@ -254,6 +278,7 @@ class Quintic(Kernel):
             a, b, c = three - q, max(two - q, zero), max(one - q, zero)
             a2, b2, c2_ = a * a, b * b, c * c
             return k[GRAD0] * (c0 * a2 * a2 - c2 * b2 * b2 + c1 * c2_ * c2_) / q
+
         return gradient
 
 
@@ -319,8 +344,14 @@ def test_register_refuses_what_cannot_be_a_kernel(quintic):
     class Other(Quintic):  # the registered name again, another class: caches are by name
         name = "test-quintic"
 
-    for cls, why in ((Nameless, "no name of its own"), (Taken, "'gaussian' is taken"), (Odd, "not a plain name"),
-                     (Wide, "support 9.0"), (Other, "is taken"), (Kernel, "not a concrete Kernel")):
+    for cls, why in (
+        (Nameless, "no name of its own"),
+        (Taken, "'gaussian' is taken"),
+        (Odd, "not a plain name"),
+        (Wide, "support 9.0"),
+        (Other, "is taken"),
+        (Kernel, "not a concrete Kernel"),
+    ):
         with pytest.raises(ValueError, match=why):
             register(cls)
     with pytest.raises(ValueError, match="only those can be removed"):
@@ -334,12 +365,15 @@ def test_an_installed_plugin_kernel_is_found_through_its_entry_point(tmp_path, m
     site = tmp_path / "site"
     info = site / "plugin_kernel-0.1.dist-info"
     info.mkdir(parents=True)
-    (site / "plugin_kernel.py").write_text("from tests.test_kernels import Quintic\n\n\n"
-                                           "class PluginQuintic(Quintic):\n    name = 'plugin-quintic'\n")
+    (site / "plugin_kernel.py").write_text(
+        "from tests.test_kernels import Quintic\n\n\nclass PluginQuintic(Quintic):\n    name = 'plugin-quintic'\n"
+    )
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: plugin-kernel\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text(f"[{kernel_registry.ENTRY_POINT_GROUP}]\n"
-                                           "plugin-quintic = plugin_kernel:PluginQuintic\n"
-                                           "broken = plugin_kernel:Missing\n")
+    (info / "entry_points.txt").write_text(
+        f"[{kernel_registry.ENTRY_POINT_GROUP}]\n"
+        "plugin-quintic = plugin_kernel:PluginQuintic\n"
+        "broken = plugin_kernel:Missing\n"
+    )
     monkeypatch.syspath_prepend(str(site))
     kernel_registry._found.cache_clear()
     try:

@@ -3,6 +3,7 @@ folder and Table 6's same-machine test all use :func:`pcabench.profiles.machine_
 
 The GPU is faked (``PCABENCH_FAKE_GPU``) in this process and, through the environment, in every child.
 """
+
 from __future__ import annotations
 
 import subprocess
@@ -77,8 +78,12 @@ def test_a_child_records_its_parents_id_not_its_own(machine):
 
 def test_the_same_study_again_stores_nothing_new(machine):
     mid, results, _ = machine
-    again = subprocess.run([sys.executable, "-m", "pcabench.cli", *STUDY, "--results", str(results), "--no-report"],
-                           capture_output=True, text=True, timeout=300)  # a new process: the id computed anew
+    again = subprocess.run(
+        [sys.executable, "-m", "pcabench.cli", *STUDY, "--results", str(results), "--no-report"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )  # a new process: the id computed anew
     assert again.returncode == 0 and "already stored" in again.stderr, again.stderr
     assert len(store.read_rows(results / store.store_name(mid))) == 1
 
@@ -92,9 +97,14 @@ def test_table6_finds_a_gpu_and_the_cpu_of_its_own_host(machine, tmp_path):
     mid, results, _ = machine
     path = results / store.store_name(mid)
     cpu = store.read_rows(path)[0]
-    gpu = dict(cpu, solver="linkedlist-gpu", device="gpu", pair_loop="gather",
-               stages={k: v / 10 for k, v in cpu["stages"].items()},
-               run_id="a-gpu-run-on-this-machine")  # as a GPU sweep here would store it
+    gpu = dict(
+        cpu,
+        solver="linkedlist-gpu",
+        device="gpu",
+        pair_loop="gather",
+        stages={k: v / 10 for k, v in cpu["stages"].items()},
+        run_id="a-gpu-run-on-this-machine",
+    )  # as a GPU sweep here would store it
     merged = tmp_path / "results"
     store.append(cpu, merged / path.name)
     store.append(gpu, merged / path.name)

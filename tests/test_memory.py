@@ -1,5 +1,6 @@
 """The memory check lives in the harness (pcabench/memory.py); a Scene is a pure value; an
 out-of-memory is recognised by the exception's type, not its text."""
+
 from __future__ import annotations
 
 import builtins
@@ -42,8 +43,11 @@ def test_bounded_gives_a_scene_the_memory_available_and_refuses_what_does_not_fi
 @pytest.mark.parametrize("command", ["run", "study"])
 def test_a_run_that_does_not_fit_is_one_line_before_any_work(command, monkeypatch, capsys, tmp_path):
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: 1 << 30)
-    argv = ["run", "--solver", "linkedlist-cpu", "--dx", "0.01"] if command == "run" else \
-        ["study", "--dx", "0.01", "--results", str(tmp_path), "--no-report"]
+    argv = (
+        ["run", "--solver", "linkedlist-cpu", "--dx", "0.01"]
+        if command == "run"
+        else ["study", "--dx", "0.01", "--results", str(tmp_path), "--no-report"]
+    )
     with pytest.raises(SystemExit) as exc:
         cli.main(argv)
     err = capsys.readouterr().err

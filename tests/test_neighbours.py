@@ -1,5 +1,6 @@
 """mean_neighbours has no side effect: it counts on a cell list of its own, leaving the particles, their
 order and the solver's cell list as they were, and counts what re-sorting the state counted."""
+
 from __future__ import annotations
 
 import json
@@ -105,8 +106,9 @@ print(json.dumps({"same": bool(same), "mean": mean, "resorted": int(counts.sum()
 
 def test_simulated_gpu_mean_neighbours_leaves_the_state_as_it_was():
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", PYTHONPATH=ROOT)
-    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT], capture_output=True, text=True, env=env, timeout=900,
-                          cwd=ROOT)
+    proc = subprocess.run(
+        [sys.executable, "-c", SIM_SCRIPT], capture_output=True, text=True, env=env, timeout=900, cwd=ROOT
+    )
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     assert out["same"] and out["mean"] == out["resorted"] == pytest.approx(out["cpu"]), out

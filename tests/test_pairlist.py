@@ -1,4 +1,5 @@
 """The CPU pair list: the same physics as the paper's gather loop, each pair once, and a fallback that fits."""
+
 from __future__ import annotations
 
 import numba
@@ -74,7 +75,7 @@ def test_cells_sorted_by_x_after_the_search():
     a = s.arrays
     x = (a["lx"] + 0.5) * scene.dx + a["sx"]
     for c in range(len(s.begin) - 1):
-        seg = x[s.begin[c]:s.begin[c + 1]]
+        seg = x[s.begin[c] : s.begin[c + 1]]
         assert np.all(np.diff(seg) >= 0), c
 
 
@@ -124,9 +125,12 @@ def _compress_both(js, rxs, rys, r2s, outs_v, outs_s, nq, limit):
     return kept_v, kept_s
 
 
-@pytest.mark.skipif(not compress.VECTOR_COMPRESS, reason="the vector compress is built only where numba's LLVM has it "
-                    "(>= 19) and the core has AVX-512; elsewhere LLVM 22 aborts the process expanding it (measured on "
-                    "an AMD EPYC without AVX-512), and the build uses the scalar loop")
+@pytest.mark.skipif(
+    not compress.VECTOR_COMPRESS,
+    reason="the vector compress is built only where numba's LLVM has it "
+    "(>= 19) and the core has AVX-512; elsewhere LLVM 22 aborts the process expanding it (measured on "
+    "an AMD EPYC without AVX-512), and the build uses the scalar loop",
+)
 @pytest.mark.parametrize("precision", ["float64", "float32"])
 def test_vector_compress_keeps_exactly_the_scalar_loops_entries(precision):
     """The build's vector compress (vcompress, on cores with AVX-512) keeps the same candidates in the same
@@ -138,8 +142,12 @@ def test_vector_compress_keeps_exactly_the_scalar_loops_entries(precision):
         for share in (0.0, 0.5, 1.0):
             r2s = rng.random(length).astype(dt)
             r2s[nq:] = -1  # past nq: would be kept if the count were ignored
-            rows = (np.arange(length, dtype=np.uint32), rng.random(length).astype(dt),
-                    rng.random(length).astype(dt), r2s)
+            rows = (
+                np.arange(length, dtype=np.uint32),
+                rng.random(length).astype(dt),
+                rng.random(length).astype(dt),
+                r2s,
+            )
             outs_v = tuple(np.full(length, 99, r.dtype) for r in rows)
             outs_s = tuple(np.full(length, 99, r.dtype) for r in rows)
             kept_v, kept_s = _compress_both(*rows, outs_v, outs_s, nq, dt(share))

@@ -1,5 +1,6 @@
 """Physics: errors against the analytic pulse and the isothermal reference, agreement
 between solvers and precisions, periodicity, the strip, convergence, stability."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -122,8 +123,16 @@ def test_isothermal_reference_differs_from_linear_pulse_by_5_percent():
 
 
 def test_forward_euler_is_caught_as_unstable():
-    scene = Scene(dx=0.5, x_min=-10, x_max=20, t_end=400.0, cfl=1.0, integrator="euler",
-                  model="linear", strip_height=strip_for(0.5))
+    scene = Scene(
+        dx=0.5,
+        x_min=-10,
+        x_max=20,
+        t_end=400.0,
+        cfl=1.0,
+        integrator="euler",
+        model="linear",
+        strip_height=strip_for(0.5),
+    )
     rec = run(RunSpec("linkedlist-cpu", scene))
     assert rec.status == "unstable"
     assert 1 < rec.failed_step < scene.n_steps
@@ -131,8 +140,7 @@ def test_forward_euler_is_caught_as_unstable():
 
 
 def test_oversized_dt_is_caught_as_unstable():
-    scene = Scene(dx=0.5, x_min=-10, x_max=20, steps=400, cfl=8.0, model="linear",
-                  strip_height=strip_for(0.5))
+    scene = Scene(dx=0.5, x_min=-10, x_max=20, steps=400, cfl=8.0, model="linear", strip_height=strip_for(0.5))
     rec = run(RunSpec("linkedlist-cpu", scene))
     assert rec.status == "unstable" and rec.failed_step is not None
 
@@ -140,8 +148,9 @@ def test_oversized_dt_is_caught_as_unstable():
 def test_kdk1_amplitude_grows_while_verlet_holds(tmp_path):
     amps = {}
     for integrator in ("verlet", "kdk1"):
-        scene = Scene(dx=0.5, x_min=-10, x_max=50, t_end=30.0, model="linear", integrator=integrator,
-                      strip_height=strip_for(0.5))
+        scene = Scene(
+            dx=0.5, x_min=-10, x_max=50, t_end=30.0, model="linear", integrator=integrator, strip_height=strip_for(0.5)
+        )
         rec, f = run_fields(scene, "linkedlist-cpu", tmp_path)
         assert rec.status == "ok"
         amps[integrator] = np.max(np.abs(f["u"])) / (scene.mach * scene.c0)
@@ -152,8 +161,16 @@ def test_rk2_and_verlet_agree_at_small_dt(tmp_path):
     """Both are second order in time: at a small dt their fields agree far below the error."""
     fields = {}
     for integrator in ("rk2", "verlet"):
-        scene = Scene(dx=0.5, x_min=-10, x_max=20, t_end=5.0, cfl=0.05, integrator=integrator,
-                      model="linear", strip_height=strip_for(0.5))
+        scene = Scene(
+            dx=0.5,
+            x_min=-10,
+            x_max=20,
+            t_end=5.0,
+            cfl=0.05,
+            integrator=integrator,
+            model="linear",
+            strip_height=strip_for(0.5),
+        )
         rec, fields[integrator] = run_fields(scene, "linkedlist-cpu", tmp_path)
         assert rec.status == "ok"
     assert max_rel(fields["rk2"]["u"], fields["verlet"]["u"]) < 1e-3
@@ -162,14 +179,21 @@ def test_rk2_and_verlet_agree_at_small_dt(tmp_path):
 def test_lagrangian_records_carry_the_error_against_their_own_limit():
     """A lagrangian run's record scores it against the isothermal solution too, and that error falls with dx
     while the error against the linear pulse stops at the equations' difference."""
-    recs = [run(RunSpec("linkedlist-cpu", Scene(dx=dx, t_end=10.0, model="lagrangian",
-                                                strip_height=Scene.thinnest_strip(dx)))) for dx in (0.2, 0.1)]
+    recs = [
+        run(
+            RunSpec(
+                "linkedlist-cpu", Scene(dx=dx, t_end=10.0, model="lagrangian", strip_height=Scene.thinnest_strip(dx))
+            )
+        )
+        for dx in (0.2, 0.1)
+    ]
     assert all(r.status == "ok" for r in recs)
     coarse, fine = (r.mse_isothermal for r in recs)
     assert fine < coarse / 2.5  # second order: 6.5 % -> 2.0 %
     assert fine < recs[1].mse / 3  # the linear pulse is 8 % away from what lagrangian converges to
     # every model is scored against the isothermal physics too (which model a scene needs): `linear` has a floor
     # there, the two equations' distance (9.8 % at Mach 0.05, t = 10 s), whatever its dx
-    linear = run(RunSpec("linkedlist-cpu", Scene(dx=0.1, t_end=10.0, model="linear",
-                                                 strip_height=Scene.thinnest_strip(0.1))))
+    linear = run(
+        RunSpec("linkedlist-cpu", Scene(dx=0.1, t_end=10.0, model="linear", strip_height=Scene.thinnest_strip(0.1)))
+    )
     assert linear.mse < 0.03 and 0.08 < linear.mse_isothermal < 0.12

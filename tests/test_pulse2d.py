@@ -1,5 +1,6 @@
 """Exact references of the 2D acoustic pulse (solvers.pulse2d): the periodic spectral solution, its
 Taylor evaluation off the lattice, and the open-domain Hankel integral, against each other."""
+
 from __future__ import annotations
 
 import numpy as np

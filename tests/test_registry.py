@@ -5,6 +5,7 @@ temporary site folder with its dist-info, exactly as pip leaves an installed
 package: importlib.metadata finds it on ``sys.path`` (``PYTHONPATH`` for the
 command line's processes).
 """
+
 from __future__ import annotations
 
 import json
@@ -33,7 +34,7 @@ NAME = "readme-argsort"  # the README's solver under a name no user's installed 
 def readme_example() -> str:
     """The plug-in module of the README's section "Add your own solver" (named :data:`NAME`)."""
     text = (ROOT / "README.md").read_text()
-    section = text[text.index("### Add your own solver"):]
+    section = text[text.index("### Add your own solver") :]
     code = re.search(r"```python\n# argsort_solver.py\n(.*?)```", section, re.S).group(1)
     assert 'name = "argsort-cpu"' in code
     return code.replace('name = "argsort-cpu"', f'name = "{NAME}"')
@@ -46,8 +47,9 @@ def install(site: Path, module: str, source: str, entries: dict) -> Path:
     info = site / f"{module}-0.1.dist-info"
     info.mkdir()
     (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {module}\nVersion: 0.1\n")
-    (info / "entry_points.txt").write_text(f"[{ENTRY_POINT_GROUP}]\n"
-                                           + "".join(f"{k} = {v}\n" for k, v in entries.items()))
+    (info / "entry_points.txt").write_text(
+        f"[{ENTRY_POINT_GROUP}]\n" + "".join(f"{k} = {v}\n" for k, v in entries.items())
+    )
     return site
 
 
@@ -75,8 +77,9 @@ def test_the_builtin_solvers_are_found_and_state_what_they_can_do():
 
 
 def test_finding_the_solvers_touches_no_gpu_library():
-    code = ("import sys, solvers; solvers.registry(); "
-            "print(any(m.startswith(('cupy', 'numba.cuda')) for m in sys.modules))")
+    code = (
+        "import sys, solvers; solvers.registry(); print(any(m.startswith(('cupy', 'numba.cuda')) for m in sys.modules))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
     assert out.stdout.strip() == "False"
 
@@ -95,11 +98,17 @@ def test_the_readme_plugin_is_found_and_matches_the_paper_cell_list_bit_for_bit(
         np.testing.assert_array_equal(fields[NAME][key], fields["linkedlist-cpu"][key])
 
 
-BROKEN = ("import numpy\nfrom solvers.linkedlist_cpu import LinkedListCPU\nNOT_A_SOLVER = 1\n\n\n"
-          "class NoName(LinkedListCPU):\n    pass\n\n\nclass Renamed(LinkedListCPU):\n    name = 'renamed-cpu'\n")
-BROKEN_ENTRIES = {"nothing": "broken_solver:NOT_A_SOLVER", "missing": "broken_solver:Absent",
-                  "linkedlist-cpu": "solvers.allpair_cpu:AllPairCPU", "noname": "broken_solver:NoName",
-                  "other-key": "broken_solver:Renamed"}
+BROKEN = (
+    "import numpy\nfrom solvers.linkedlist_cpu import LinkedListCPU\nNOT_A_SOLVER = 1\n\n\n"
+    "class NoName(LinkedListCPU):\n    pass\n\n\nclass Renamed(LinkedListCPU):\n    name = 'renamed-cpu'\n"
+)
+BROKEN_ENTRIES = {
+    "nothing": "broken_solver:NOT_A_SOLVER",
+    "missing": "broken_solver:Absent",
+    "linkedlist-cpu": "solvers.allpair_cpu:AllPairCPU",
+    "noname": "broken_solver:NoName",
+    "other-key": "broken_solver:Renamed",
+}
 
 
 def test_a_broken_or_clashing_plugin_is_left_out_with_one_warning(site):
@@ -111,26 +120,37 @@ def test_a_broken_or_clashing_plugin_is_left_out_with_one_warning(site):
     assert not {"nothing", "missing", "noname", "other-key"} & set(found) and "renamed-cpu" in found
     assert found["linkedlist-cpu"].__name__ == "LinkedListCPU"  # a plug-in never replaces a built-in
     assert len(mine) == 5, mine
-    for words in ("does not load", "not a concrete Solver subclass", "is taken",
-                  "no name of its own (it would inherit 'linkedlist-cpu')", "registered as 'renamed-cpu'"):
+    for words in (
+        "does not load",
+        "not a concrete Solver subclass",
+        "is taken",
+        "no name of its own (it would inherit 'linkedlist-cpu')",
+        "registered as 'renamed-cpu'",
+    ):
         assert sum(words in m for m in mine) == 1, (words, mine)
 
 
 def test_a_plugin_runs_through_run_a_study_a_report_and_the_benchmarks(tmp_path):
     site = install(tmp_path / "site", "argsort_solver", readme_example(), {NAME: "argsort_solver:ArgsortCellList"})
     install(site, "broken_solver", BROKEN, {"missing": "broken_solver:Absent"})  # one broken plug-in beside it
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)]),
-           "PCABENCH_HOME": str(tmp_path / "home")}
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)]), "PCABENCH_HOME": str(tmp_path / "home")}
 
     def cli(*args):
-        return subprocess.run([sys.executable, "-m", "pcabench.cli", *args], capture_output=True, text=True,
-                              env=env, cwd=tmp_path, timeout=600)
+        return subprocess.run(
+            [sys.executable, "-m", "pcabench.cli", *args],
+            capture_output=True,
+            text=True,
+            env=env,
+            cwd=tmp_path,
+            timeout=600,
+        )
 
     helped = cli("run", "--help")
     assert NAME in helped.stdout  # in --solver's choices and the solvers' help
     assert helped.stderr.splitlines() == [  # the broken one: one line, no source line
         f"pcabench: warning: entry point 'missing' of group {ENTRY_POINT_GROUP} (broken_solver:Absent) left out: "
-        "it does not load (AttributeError: module 'broken_solver' has no attribute 'Absent')"]
+        "it does not load (AttributeError: module 'broken_solver' has no attribute 'Absent')"
+    ]
     out = cli("run", "--solver", NAME, "--dx", "1", "--steps", "5", "--json")
     assert out.returncode == 0, out.stderr
     assert json.loads(out.stdout)["solver"] == NAME
@@ -139,13 +159,32 @@ def test_a_plugin_runs_through_run_a_study_a_report_and_the_benchmarks(tmp_path)
         assert refused.returncode == 2 and words in refused.stderr.splitlines()[-1], refused.stderr
     results, reports = tmp_path / "results", tmp_path / "reports"
     # the matrix: the plug-in takes the loop and thread count it has; each run once
-    out = cli("study", "--solver", NAME, "linkedlist-cpu", "--pair-loop", "list", "gather", "--threads", "1", "2",
-              "--dx", "1", "--steps", "5", "--results", str(results), "--reports", str(reports))
+    out = cli(
+        "study",
+        "--solver",
+        NAME,
+        "linkedlist-cpu",
+        "--pair-loop",
+        "list",
+        "gather",
+        "--threads",
+        "1",
+        "2",
+        "--dx",
+        "1",
+        "--steps",
+        "5",
+        "--results",
+        str(results),
+        "--reports",
+        str(reports),
+    )
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stderr.count("left out") == 1  # said once, by the sweep, not again by each run's process
     rows = [json.loads(line) for f in results.glob("*.jsonl") for line in f.read_text().splitlines()]
     assert sorted((r["solver"], r["pair_loop"], r["threads"]) for r in rows) == sorted(
-        [(NAME, "gather", 1)] + [("linkedlist-cpu", loop, n) for loop in ("list", "gather") for n in (1, 2)])
+        [(NAME, "gather", 1)] + [("linkedlist-cpu", loop, n) for loop in ("list", "gather") for n in (1, 2)]
+    )
     assert all(r["status"] == "ok" for r in rows) and "5 runs on" in out.stderr
     assert NAME in "".join(p.read_text() for p in reports.rglob("report.md"))
     code = "from benchmarks.common import solver_names; print(' '.join(solver_names('cpu')))"

@@ -1,5 +1,6 @@
 """Scenes (solvers/scenes/): the registry, the 2D acoustic pulse on every solver, its exact prediction,
 its convergence to the exact reference, conservation on the periodic square, and one-line refusals."""
+
 from __future__ import annotations
 
 import json
@@ -47,23 +48,36 @@ def test_the_registry_offers_the_paper_scene_first_and_the_2d_pulse():
 def test_rows_stored_before_the_registry_read_as_the_paper_scene():
     old = {"dx": 0.5, "steps": 10, "x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
     assert scene_from_row({"scene": old}).name == DEFAULT_SCENE
-    row = {"solver": "linkedlist-cpu", "scene": old, "stages": {s: 0.0 for s in
-           ("input", "init", "snp", "pi", "su", "output")}, "steps": 10, "status": "ok", "profile_id": "m",
-           "host": "h", "commit": "c", "mse": 0.1}
+    row = {
+        "solver": "linkedlist-cpu",
+        "scene": old,
+        "stages": {s: 0.0 for s in ("input", "init", "snp", "pi", "su", "output")},
+        "steps": 10,
+        "status": "ok",
+        "profile_id": "m",
+        "host": "h",
+        "commit": "c",
+        "mse": 0.1,
+    }
     assert frame([row]).scene.iloc[0] == DEFAULT_SCENE
     # the resume key tells the scenes apart
     a, b = Scene(dx=0.5, t_end=5.0), pulse(dx=0.5, t_end=5.0, steps=None)
     assert identity("linkedlist-cpu", 1, a, "", "m", "c", "h") != identity("linkedlist-cpu", 1, b, "", "m", "c", "h")
-    assert identity("linkedlist-cpu", 1, a, "", "m", "c", "h") == identity("linkedlist-cpu", 1, old | {"t_end": 5.0,
-                                                                            "steps": None}, "", "m", "c", "h")
+    assert identity("linkedlist-cpu", 1, a, "", "m", "c", "h") == identity(
+        "linkedlist-cpu", 1, old | {"t_end": 5.0, "steps": None}, "", "m", "c", "h"
+    )
 
 
 @pytest.mark.parametrize("model", ["linear", "lagrangian"])
 def test_every_cpu_solver_agrees_on_the_periodic_square(model):
     scene = pulse(model=model, mach=0.2)
     ref = evolve("allpair-cpu", scene)
-    for kw in (dict(pair_loop="gather"), dict(pair_loop="list"), dict(pair_loop="list", threads=2),
-               dict(pair_loop="gather", threads=2)):
+    for kw in (
+        dict(pair_loop="gather"),
+        dict(pair_loop="list"),
+        dict(pair_loop="list", threads=2),
+        dict(pair_loop="gather", threads=2),
+    ):
         got = evolve("linkedlist-cpu", scene, **kw)
         for field in ("drho", "u", "v", "x", "y"):
             assert np.abs(getattr(got, field) - getattr(ref, field)).max() < 1e-14, (kw, field)
@@ -115,8 +129,15 @@ def test_the_gpu_solver_runs_the_periodic_square_in_the_simulator():
         assert np.abs(gpu - cpu).max() <= tol * np.abs(cpu).max()
 
 
-@pytest.mark.parametrize("kw", [dict(), dict(kernel="wendland-c2", h_factor=1.3, cfl=1.5),
-                                dict(kernel="wendland-c4", h_factor=1.6, cfl=2.0), dict(integrator="kdk1")])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        dict(),
+        dict(kernel="wendland-c2", h_factor=1.3, cfl=1.5),
+        dict(kernel="wendland-c4", h_factor=1.6, cfl=2.0),
+        dict(integrator="kdk1"),
+    ],
+)
 def test_the_2d_prediction_is_the_linear_run(kw):
     """The linear operator is diagonal in the periodic lattice's Fourier basis: the prediction (no simulation)
     is the run to round-off, error measures included."""
@@ -134,8 +155,9 @@ def test_the_2d_prediction_is_the_linear_run(kw):
 def test_the_2d_pulse_converges_to_the_exact_reference():
     """At fixed h/dx the linear model converges to the exact 2D pulse (prediction = run, tested above): the
     paper's method, 10.7 % at dx 0.25 and 3.1 % at dx 0.125, order 1.81 (measured)."""
-    errors = [predict(Scene(dx=dx, name="acoustic-pulse", t_end=10.0, model="linear")).predicted_error
-              for dx in (0.25, 0.125)]
+    errors = [
+        predict(Scene(dx=dx, name="acoustic-pulse", t_end=10.0, model="linear")).predicted_error for dx in (0.25, 0.125)
+    ]
     order = np.log(errors[0] / errors[1]) / np.log(2.0)
     assert errors[1] < 0.05 and order > 1.7, (errors, order)
 
@@ -172,15 +194,18 @@ def test_a_solver_without_periodic_x_is_refused_in_one_line():
     OldCellList.supports(Scene(dx=1.0))
 
 
-@pytest.mark.parametrize("args,words", [
-    (("--scene", "no-such"), "--scene"),
-    (("--scene", "acoustic-pulse", "--mach", "0.5"), "--mach"),
-    (("--scene", "acoustic-pulse", "--pulse-width", "50"), "--pulse-width"),
-    (("--scene", "acoustic-pulse", "--strip-height", "20"), "--strip-height"),
-    (("--domain-size", "30"), "--domain-size"),
-    (("--t-end", "100", "--model", "lagrangian"), "breaking time"),
-    (("--scene", "acoustic-pulse", "--domain-size", "10"), "--domain-size"),
-])
+@pytest.mark.parametrize(
+    "args,words",
+    [
+        (("--scene", "no-such"), "--scene"),
+        (("--scene", "acoustic-pulse", "--mach", "0.5"), "--mach"),
+        (("--scene", "acoustic-pulse", "--pulse-width", "50"), "--pulse-width"),
+        (("--scene", "acoustic-pulse", "--strip-height", "20"), "--strip-height"),
+        (("--domain-size", "30"), "--domain-size"),
+        (("--t-end", "100", "--model", "lagrangian"), "breaking time"),
+        (("--scene", "acoustic-pulse", "--domain-size", "10"), "--domain-size"),
+    ],
+)
 def test_bad_scene_input_is_one_line(args, words, capsys):
     rc, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", *args, capsys=capsys)
     assert rc == 2 and words in err and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
@@ -191,7 +216,8 @@ def test_the_accuracy_command_predicts_a_scene(capsys):
     assert rc == 0, err
     data = json.loads(out)
     assert data["predicted_error"] == pytest.approx(
-        predict(Scene(dx=0.5, name="acoustic-pulse", t_end=10.0, model="linear")).predicted_error, rel=1e-12)
+        predict(Scene(dx=0.5, name="acoustic-pulse", t_end=10.0, model="linear")).predicted_error, rel=1e-12
+    )
     assert data["scene"]["name"] == "acoustic-pulse" and "axis_rms" in data["measures"]
 
 
@@ -206,8 +232,16 @@ def test_the_fast_methods_come_from_the_prediction():
     assert len({m["kernel"] for m in found}) == len(found) == 3
     for m in found:
         assert m["predicted_error"] <= paper and m["cfl"] <= MARGIN["linear"] * m["stable_cfl"] + 0.01
-        scene = Scene(dx=m["dx"], t_end=10.0, model="linear", kernel=m["kernel"], h_factor=m["h_factor"],
-                      cfl=m["cfl"], memory_limit_bytes=2**62)
+        scene = Scene(
+            dx=m["dx"],
+            t_end=10.0,
+            model="linear",
+            kernel=m["kernel"],
+            h_factor=m["h_factor"],
+            cfl=m["cfl"],
+            memory_limit_bytes=2**62,
+        )
         assert predict(scene).predicted_error == pytest.approx(m["predicted_error"])
-    assert [dict(kernel=m["kernel"], h_factor=m["h_factor"], cfl=m["cfl"], dx=m["dx"]) for m in found] == \
-        list(fast_methods("linear"))
+    assert [dict(kernel=m["kernel"], h_factor=m["h_factor"], cfl=m["cfl"], dx=m["dx"]) for m in found] == list(
+        fast_methods("linear")
+    )

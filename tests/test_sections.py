@@ -1,4 +1,5 @@
 """The report's sections registry: each table computed once, and a new section is one entry."""
+
 from __future__ import annotations
 
 import pytest
@@ -59,14 +60,36 @@ def _stability_frame(tmp_path):
     from .test_study import row
 
     path = tmp_path / "stab" / "m.jsonl"
-    for cfl, status, mse in ((0.2, "ok", 0.1), (1.0, "ok", 0.1), (2.0, "ok", 0.1), (3.0, "ok", 0.1), (4.0, "ok", 0.1),
-                             (4.5, "ok", 0.3), (5.0, "ok", 0.1), (6.0, "ok", 0.5), (7.0, "ok", 0.4),
-                             (8.0, "unstable", 1.0)):
-        store.append(row(model="linear", preset="stability", dx=0.25, t_end=10.0, strip_height=5.0, cfl=cfl,
-                         status=status, failed_step=4 if status == "unstable" else None, mse=mse), path)
+    for cfl, status, mse in (
+        (0.2, "ok", 0.1),
+        (1.0, "ok", 0.1),
+        (2.0, "ok", 0.1),
+        (3.0, "ok", 0.1),
+        (4.0, "ok", 0.1),
+        (4.5, "ok", 0.3),
+        (5.0, "ok", 0.1),
+        (6.0, "ok", 0.5),
+        (7.0, "ok", 0.4),
+        (8.0, "unstable", 1.0),
+    ):
+        store.append(
+            row(
+                model="linear",
+                preset="stability",
+                dx=0.25,
+                t_end=10.0,
+                strip_height=5.0,
+                cfl=cfl,
+                status=status,
+                failed_step=4 if status == "unstable" else None,
+                mse=mse,
+            ),
+            path,
+        )
     for cfl, mse in ((0.2, 0.3), (4.0, 0.13)):  # a longer run: inaccurate at 0.2, accurate at 4
-        store.append(row(model="linear", preset="stability", dx=0.25, t_end=30.0, strip_height=5.0, cfl=cfl,
-                         mse=mse), path)
+        store.append(
+            row(model="linear", preset="stability", dx=0.25, t_end=30.0, strip_height=5.0, cfl=cfl, mse=mse), path
+        )
     return frame.load(path.parent)
 
 
@@ -146,13 +169,30 @@ def test_the_long_run_table_measures_each_models_limit_below_its_first_blow_up(t
     from .test_study import row
 
     path = tmp_path / "long" / "m.jsonl"
-    runs = {"linear": {4.6: ("ok", None), 4.9: ("ok", None), 5.0: ("unstable", 200)},
-            "fixed": {4.6: ("ok", None), 4.7: ("unstable", 236), 4.8: ("ok", None), 4.9: ("unstable", 47)}}
+    runs = {
+        "linear": {4.6: ("ok", None), 4.9: ("ok", None), 5.0: ("unstable", 200)},
+        "fixed": {4.6: ("ok", None), 4.7: ("unstable", 236), 4.8: ("ok", None), 4.9: ("unstable", 47)},
+    }
     for model, by_cfl in runs.items():
         for cfl, (status, step) in by_cfl.items():
-            store.append(row(name="acoustic-pulse", model=model, preset="stability-long", dx=1.0, t_end=30.0,
-                             x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0, cfl=cfl, status=status,
-                             failed_step=step, steps=60), path)
+            store.append(
+                row(
+                    name="acoustic-pulse",
+                    model=model,
+                    preset="stability-long",
+                    dx=1.0,
+                    t_end=30.0,
+                    x_min=-10.0,
+                    x_max=10.0,
+                    y_min=-10.0,
+                    y_max=10.0,
+                    cfl=cfl,
+                    status=status,
+                    failed_step=step,
+                    steps=60,
+                ),
+                path,
+            )
     rows = {r["model"]: r for r in T.long_run_limits(frame.load(path.parent))}
     lin, fixed = rows["linear"], rows["fixed"]
     assert lin["predicted"] == pytest.approx(4.97, abs=0.01) and lin["bounded_to"] == 4.9

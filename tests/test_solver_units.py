@@ -1,5 +1,6 @@
 """Units of the solvers that break first: the constant layout, the stencil at the periodic seam,
 the counting sort, and the step programs. In-process and small."""
+
 from __future__ import annotations
 
 import math
@@ -35,7 +36,7 @@ def test_the_pair_code_reads_the_slots_it_names():
     sx, sy = np.array([0.0, 0.25]), np.zeros(2)
     u, v, vol = np.array([0.3, 0.1]), np.zeros(2), np.array([2.0, 3.0])
     rx = -1.25  # x_0 - x_1
-    g = -2 / (math.pi * scene.h**4) * math.exp(-rx**2 / scene.h**2)
+    g = -2 / (math.pi * scene.h**4) * math.exp(-(rx**2) / scene.h**2)
     got = P.continuity_range(1, 2, lx[0], ly[0], sx[0], sy[0], u[0], v[0], lx, ly, sx, sy, u, v, vol, k)
     assert got == pytest.approx(vol[1] * g * (u[0] - u[1]) * rx, rel=1e-13)
     far = np.array([0.0, 100.0])  # beyond the cutoff: nothing

@@ -1,4 +1,5 @@
 """The results store: append-only, readable after a torn write, mergeable across machines."""
+
 from __future__ import annotations
 
 import pytest

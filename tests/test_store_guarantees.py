@@ -1,5 +1,6 @@
 """The store's guarantees, each probe of a demanding user: torn tails, two writers, killed parents,
 unwritable and full stores, corrupt rows, killed children, retries, and the memory actually available."""
+
 from __future__ import annotations
 
 import errno
@@ -119,7 +120,7 @@ def test_reports_and_runs_survive_corrupt_rows(tmp_path, capsys):
     path = results / "m.jsonl"
     store.append(record(), path)
     with open(path, "ab") as f:
-        f.write(b"null\n{\"solver\": 3}\n")
+        f.write(b'null\n{"solver": 3}\n')
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", store.StoreWarning)
         assert cli.main(["report", "--results", str(results), "--out", str(tmp_path / "out")]) == 0
@@ -128,9 +129,27 @@ def test_reports_and_runs_survive_corrupt_rows(tmp_path, capsys):
 
 # ---------------------------------------------------------------- two writers and killed parents
 def _study(results, *args):
-    return subprocess.Popen([sys.executable, "-m", "pcabench.cli", "study", "--dx", "1", "0.5", "--steps", "3",
-                             "--no-report", "--results", str(results), *args],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    return subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "pcabench.cli",
+            "study",
+            "--dx",
+            "1",
+            "0.5",
+            "--steps",
+            "3",
+            "--no-report",
+            "--results",
+            str(results),
+            *args,
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
 
 
 def test_two_sweeps_on_one_store_never_duplicate(tmp_path):
@@ -148,10 +167,26 @@ def test_two_sweeps_on_one_store_never_duplicate(tmp_path):
 
 
 def test_a_killed_parent_takes_its_running_child_with_it(tmp_path):
-    proc = subprocess.Popen([sys.executable, "-m", "pcabench.cli", "study", "--dx", "0.25", "--steps", "100000",
-                             "--model", "linear",  # (a lagrangian run this long would pass the pulse's breaking time)
-                             "--no-report", "--results", str(tmp_path)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "pcabench.cli",
+            "study",
+            "--dx",
+            "0.25",
+            "--steps",
+            "100000",
+            "--model",
+            "linear",  # (a lagrangian run this long would pass the pulse's breaking time)
+            "--no-report",
+            "--results",
+            str(tmp_path),
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     child = None
     deadline = time.time() + 120
     while time.time() < deadline and child is None:
@@ -180,11 +215,13 @@ def test_a_killed_child_names_its_signal_and_oom_only_when_it_was():
 
 def fake_child(made: list):
     """A run child that runs nothing: it notes the spec in ``made`` and returns an ok record of 2 steps."""
+
     def child(spec, timeout, commit, machine, stream=None):
         made.append(spec)
         rec = sweep_module.failed_record(spec, "ok", "", machine)
         rec.steps = 2
         return store.to_row(rec)
+
     return child
 
 
@@ -193,8 +230,7 @@ def test_retry_failed_runs_timeouts_skips_and_errors_again(tmp_path, monkeypatch
     spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2)).resolved()
     made = []
     monkeypatch.setattr(sweep_module, "run_child", fake_child(made))
-    store.append(sweep_module.failed_record(spec, "timeout", "past the run budget", machine_id()),
-                 path)
+    store.append(sweep_module.failed_record(spec, "timeout", "past the run budget", machine_id()), path)
     sweep([spec], path, run_budget=60, sweep_budget=60)
     assert made == []  # stored (as a timeout): a plain rerun skips it
     sweep([spec], path, run_budget=60, sweep_budget=60, retry_failed=True)
@@ -225,15 +261,18 @@ def test_the_memory_check_uses_the_cgroup_limit(tmp_path, monkeypatch):
     assert memory.available_memory_bytes() > (1 << 30)  # no limit: the host's available memory
 
 
-@pytest.mark.parametrize("command,args,words", [
-    ("run", ["--solver", "linkedlist-cpu", "--dx", "1e-300"], ["dx", "smallest dx that fits"]),
-    ("study", ["--dx", "1e-300"], ["dx", "smallest dx that fits"]),
-    ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--t-end", "0"], ["--t-end", "> 0"]),
-    ("study", ["--dx", "1", "--t-end", "0"], ["--t-end", "> 0"]),
-    ("study", ["--dx", "1", "--t-end", "1e300"], ["--t-end", "1e7 steps"]),
-    ("study", ["--dx", "1", "--cfl", "1e-300", "--t-end", "1"], ["--t-end", "1e7 steps"]),
-    ("study", ["--quick", "--sweep-budget", "-1"], ["--sweep-budget", "> 0"]),
-])
+@pytest.mark.parametrize(
+    "command,args,words",
+    [
+        ("run", ["--solver", "linkedlist-cpu", "--dx", "1e-300"], ["dx", "smallest dx that fits"]),
+        ("study", ["--dx", "1e-300"], ["dx", "smallest dx that fits"]),
+        ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--t-end", "0"], ["--t-end", "> 0"]),
+        ("study", ["--dx", "1", "--t-end", "0"], ["--t-end", "> 0"]),
+        ("study", ["--dx", "1", "--t-end", "1e300"], ["--t-end", "1e7 steps"]),
+        ("study", ["--dx", "1", "--cfl", "1e-300", "--t-end", "1"], ["--t-end", "1e7 steps"]),
+        ("study", ["--quick", "--sweep-budget", "-1"], ["--sweep-budget", "> 0"]),
+    ],
+)
 def test_numeric_options_refuse_meaningless_values_in_run_and_study(command, args, words, capsys, tmp_path):
     extra = ["--results", str(tmp_path)] if command == "study" else []
     with pytest.raises(SystemExit) as exc:
@@ -289,7 +328,7 @@ def test_a_full_disk_stores_the_run_in_the_reserve_and_stops_the_sweep(tmp_path,
 
     def filling(fd, data):  # the disk fills during the store's first write: half the line, then ENOSPC
         if os.readlink(f"/proc/self/fd/{fd}") == str(path) and (tmp_path / "s.jsonl.reserve").exists():
-            full.append(real_write(fd, data[:len(data) // 2]))
+            full.append(real_write(fd, data[: len(data) // 2]))
             raise OSError(errno.ENOSPC, "No space left on device")
         return real_write(fd, data)
 
@@ -420,12 +459,20 @@ def test_a_cluster_sweep_locks_its_results_folder_before_any_work(tmp_path, monk
 # ---------------------------------------------------------------- memory: nested cgroups and the pair list
 def test_the_memory_check_sees_a_nested_cgroup_v1_limit_and_its_oom_kills(tmp_path, monkeypatch):
     unlimited = "9223372036854771712\n"
-    fake_cgroups(tmp_path, monkeypatch, "5:memory:/jobs/small\n0::/\n", {
-        "memory/memory.limit_in_bytes": unlimited, "memory/memory.usage_in_bytes": "0\n",
-        "memory/jobs/memory.limit_in_bytes": unlimited, "memory/jobs/memory.usage_in_bytes": "0\n",
-        "memory/jobs/small/memory.limit_in_bytes": f"{512 << 20}\n",
-        "memory/jobs/small/memory.usage_in_bytes": f"{12 << 20}\n",
-        "memory/jobs/small/memory.oom_control": "oom_kill_disable 0\nunder_oom 0\noom_kill 2\n"})
+    fake_cgroups(
+        tmp_path,
+        monkeypatch,
+        "5:memory:/jobs/small\n0::/\n",
+        {
+            "memory/memory.limit_in_bytes": unlimited,
+            "memory/memory.usage_in_bytes": "0\n",
+            "memory/jobs/memory.limit_in_bytes": unlimited,
+            "memory/jobs/memory.usage_in_bytes": "0\n",
+            "memory/jobs/small/memory.limit_in_bytes": f"{512 << 20}\n",
+            "memory/jobs/small/memory.usage_in_bytes": f"{12 << 20}\n",
+            "memory/jobs/small/memory.oom_control": "oom_kill_disable 0\nunder_oom 0\noom_kill 2\n",
+        },
+    )
     assert memory.available_memory_bytes() == 500 << 20
     with pytest.raises(SceneError, match="smallest dx that fits"):
         memory.bounded(Scene(dx=0.02))  # 2.5M particles, about 0.56 GiB of arrays: more than the 0.49 GiB left
@@ -436,8 +483,7 @@ def test_pair_loop_list_is_checked_against_the_memory_available(monkeypatch, cap
     from solvers.pairlist import list_bytes
 
     scene = Scene(dx=0.1, steps=2)
-    monkeypatch.setattr(memory, "available_memory_bytes",
-                        lambda: scene.memory_bytes() + list_bytes(scene) // 2)
+    monkeypatch.setattr(memory, "available_memory_bytes", lambda: scene.memory_bytes() + list_bytes(scene) // 2)
     with pytest.raises(SystemExit) as exc:
         cli.main(["run", "--solver", "linkedlist-cpu", "--dx", "0.1", "--steps", "2", "--pair-loop", "list"])
     err = capsys.readouterr().err
@@ -465,8 +511,18 @@ def test_unwritable_home_reports_and_out_are_one_line_before_any_work(tmp_path, 
     assert "PCABENCH_HOME" in err
     assert "PCABENCH_HOME" in one_line_error(capsys, "profile", "--save", "--no-gpu")
     monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
-    err = one_line_error(capsys, "study", "--dx", "1", "--steps", "2", "--results", str(tmp_path / "r"),
-                         "--reports", str(blocker / "reports"))
+    err = one_line_error(
+        capsys,
+        "study",
+        "--dx",
+        "1",
+        "--steps",
+        "2",
+        "--results",
+        str(tmp_path / "r"),
+        "--reports",
+        str(blocker / "reports"),
+    )
     assert "--reports" in err and not list((tmp_path / "r").glob("*.jsonl"))
     store.append(record(), tmp_path / "r" / "m.jsonl")
     err = one_line_error(capsys, "report", "--results", str(tmp_path / "r"), "--out", str(blocker / "out"))
@@ -486,17 +542,23 @@ def test_a_malformed_hardware_profile_is_one_warning_not_a_traceback(tmp_path, c
     assert named == {str(tmp_path / "hardware_profiles" / "m.json"), str(tmp_path / "hardware_profiles" / "n.json")}
 
 
-@pytest.mark.parametrize("command,args,words", [
-    ("run", ["--solver", "linkedlist-cpu", "--dx", "\uff11"], ["--dx", "number"]),  # a full-width 1
-    ("study", ["--dx", "1", "--steps", "\u0662"], ["--steps", "integer"]),  # an Arabic-Indic 2
-    ("study", ["--dx", "1", "--threads", "\u0662"], ["--threads", "integer"]),
-    ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--fields", ""], ["--fields", "file name"]),
-    ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--fields", "/proc/x.npz"], ["--fields", "not writable"]),
-    ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--h-factor", "0.5", "--cutoff", "1"],
-     ["--cutoff * --h-factor", "> 1"]),
-    ("study", ["--dx", "1", "--results", ""], ["--results", "folder"]),
-    ("report", ["--out", ""], ["--out", "folder"]),
-])
+@pytest.mark.parametrize(
+    "command,args,words",
+    [
+        ("run", ["--solver", "linkedlist-cpu", "--dx", "\uff11"], ["--dx", "number"]),  # a full-width 1
+        ("study", ["--dx", "1", "--steps", "\u0662"], ["--steps", "integer"]),  # an Arabic-Indic 2
+        ("study", ["--dx", "1", "--threads", "\u0662"], ["--threads", "integer"]),
+        ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--fields", ""], ["--fields", "file name"]),
+        ("run", ["--solver", "linkedlist-cpu", "--dx", "1", "--fields", "/proc/x.npz"], ["--fields", "not writable"]),
+        (
+            "run",
+            ["--solver", "linkedlist-cpu", "--dx", "1", "--h-factor", "0.5", "--cutoff", "1"],
+            ["--cutoff * --h-factor", "> 1"],
+        ),
+        ("study", ["--dx", "1", "--results", ""], ["--results", "folder"]),
+        ("report", ["--out", ""], ["--out", "folder"]),
+    ],
+)
 def test_smaller_bad_inputs_are_one_line_before_any_work(command, args, words, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))

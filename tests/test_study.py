@@ -1,4 +1,5 @@
 """The study: resume after a kill, predicted skips, tables of known values, every figure drawn."""
+
 from __future__ import annotations
 
 import os
@@ -20,14 +21,18 @@ SWEEP = ["--dx", "1", "0.5", "--solver", "linkedlist-cpu", "allpair-cpu", "--ste
 
 
 def study(results, *args):
-    return subprocess.Popen([sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(results)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    return subprocess.Popen(
+        [sys.executable, "-m", "pcabench.cli", "study", *args, "--results", str(results)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
 
 
 def outcome(path):
     """What a sweep found, without its timings: one entry per run."""
-    return sorted((r["solver"], r["dx"], r["status"], r["steps"], round(r["mse"], 12))
-                  for r in store.read_rows(path))
+    return sorted((r["solver"], r["dx"], r["status"], r["steps"], round(r["mse"], 12)) for r in store.read_rows(path))
 
 
 def test_killed_sweep_resumes_to_the_same_store(tmp_path):
@@ -51,13 +56,16 @@ def test_killed_sweep_resumes_to_the_same_store(tmp_path):
     assert len(outcome(path)) == 4
 
 
-@pytest.mark.parametrize("args,words", [
-    (["--dx", "0"], ["dx", "> 0"]),
-    (["--dx", "1", "--cfl", "-1"], ["cfl", "> 0"]),
-    (["--quick", "--run-budget", "0"], ["--run-budget", "> 0"]),
-    (["--dx", "1", "--threads", "9999"], ["threads", "between 1 and"]),
-    (["--dx", "1", "--solver", "allpair-cpu", "--threads", "2"], ["allpair-cpu is serial"]),
-])
+@pytest.mark.parametrize(
+    "args,words",
+    [
+        (["--dx", "0"], ["dx", "> 0"]),
+        (["--dx", "1", "--cfl", "-1"], ["cfl", "> 0"]),
+        (["--quick", "--run-budget", "0"], ["--run-budget", "> 0"]),
+        (["--dx", "1", "--threads", "9999"], ["threads", "between 1 and"]),
+        (["--dx", "1", "--solver", "allpair-cpu", "--threads", "2"], ["allpair-cpu is serial"]),
+    ],
+)
 def test_bad_study_input_exits_2_before_any_run(tmp_path, args, words):
     proc = study(tmp_path, *args)
     _, err = proc.communicate(timeout=120)
@@ -67,18 +75,53 @@ def test_bad_study_input_exits_2_before_any_run(tmp_path, args, words):
 
 
 # ---------------------------------------------------------------- a small fixed results file
-def row(profile="machine-a", solver="linkedlist-cpu", threads=1, step_ms=(1.0, 4.0, 0.1), steps=10, mse=0.01,
-        status="ok", failed_step=None, preset="", stamp=0, message="", **scene):
+def row(
+    profile="machine-a",
+    solver="linkedlist-cpu",
+    threads=1,
+    step_ms=(1.0, 4.0, 0.1),
+    steps=10,
+    mse=0.01,
+    status="ok",
+    failed_step=None,
+    preset="",
+    stamp=0,
+    message="",
+    **scene,
+):
     """A stored run with chosen stage times (SNP, PI, SU in ms per step) and error."""
     s = Scene(**scene) if "t_end" in scene else Scene(steps=steps, **scene)
-    stages = {"input": 0.001, "init": 0.002, "output": 0.003,
-              **{k: v * steps / 1e3 for k, v in zip(("snp", "pi", "su"), step_ms)}}
-    rec = RunRecord(solver=solver, precision=s.precision, model=s.model, integrator=s.integrator, dx=s.dx,
-                    n_particles=s.n_particles, steps=steps if status == "ok" else 0, t_end=s.t_final,
-                    stages=stages, jit_seconds=1.0, mse=mse, me=mse / 20, mean_neighbours=128.0, status=status,
-                    failed_step=failed_step, threads=threads, steps_requested=s.n_steps, scene=s.as_dict(),
-                    message=message, profile_id=profile, commit="abc", preset=preset,
-                    timestamp=f"2026-01-01T00:00:{stamp:02d}+00:00")
+    stages = {
+        "input": 0.001,
+        "init": 0.002,
+        "output": 0.003,
+        **{k: v * steps / 1e3 for k, v in zip(("snp", "pi", "su"), step_ms)},
+    }
+    rec = RunRecord(
+        solver=solver,
+        precision=s.precision,
+        model=s.model,
+        integrator=s.integrator,
+        dx=s.dx,
+        n_particles=s.n_particles,
+        steps=steps if status == "ok" else 0,
+        t_end=s.t_final,
+        stages=stages,
+        jit_seconds=1.0,
+        mse=mse,
+        me=mse / 20,
+        mean_neighbours=128.0,
+        status=status,
+        failed_step=failed_step,
+        threads=threads,
+        steps_requested=s.n_steps,
+        scene=s.as_dict(),
+        message=message,
+        profile_id=profile,
+        commit="abc",
+        preset=preset,
+        timestamp=f"2026-01-01T00:00:{stamp:02d}+00:00",
+    )
     return rec
 
 
@@ -88,28 +131,67 @@ def fixture_rows():
     for dx, n_scale in ((1.0, 1), (0.5, 4)):
         rows.append(row(step_ms=(1.0 * n_scale, 4.0 * n_scale, 0.1 * n_scale), dx=dx, steps=10))
         rows.append(row(threads=2, step_ms=(0.5 * n_scale, 2.0 * n_scale, 0.05 * n_scale), dx=dx, steps=10))
-        rows.append(row(solver="allpair-cpu", step_ms=(20.0 * n_scale ** 2, 4.0 * n_scale, 0.1 * n_scale), dx=dx))
+        rows.append(row(solver="allpair-cpu", step_ms=(20.0 * n_scale**2, 4.0 * n_scale, 0.1 * n_scale), dx=dx))
         rows.append(row(solver="linkedlist-gpu", precision="float32", step_ms=(0.02, 0.08, 0.01), dx=dx))
     rows.append(row(solver="allpair-cpu", status="skipped", dx=0.25, message="predicted 999 s > run budget"))
     # Fig. 8: linear errors exactly second order; lagrangian stops falling at dx = 0.2
     for dx in (0.4, 0.2, 0.1, 0.05):
         h = Scene.thinnest_strip(dx)
         rows.append(row(model="linear", mse=0.016 * (dx / 0.1) ** 2, dx=dx, t_end=10.0, strip_height=h))
-        rows.append(row(model="linear", precision="float32", mse=0.016 * (dx / 0.1) ** 2 * (3 if dx == 0.05 else 1),
-                        dx=dx, t_end=10.0, strip_height=h, step_ms=(0.5, 2.0, 0.05)))
-        rows.append(row(model="lagrangian", mse={0.4: 0.2, 0.2: 0.05, 0.1: 0.06, 0.05: 0.08}[dx], dx=dx,
-                        t_end=10.0, strip_height=h, step_ms=(2.0, 4.0, 0.1)))
+        rows.append(
+            row(
+                model="linear",
+                precision="float32",
+                mse=0.016 * (dx / 0.1) ** 2 * (3 if dx == 0.05 else 1),
+                dx=dx,
+                t_end=10.0,
+                strip_height=h,
+                step_ms=(0.5, 2.0, 0.05),
+            )
+        )
+        rows.append(
+            row(
+                model="lagrangian",
+                mse={0.4: 0.2, 0.2: 0.05, 0.1: 0.06, 0.05: 0.08}[dx],
+                dx=dx,
+                t_end=10.0,
+                strip_height=h,
+                step_ms=(2.0, 4.0, 0.1),
+            )
+        )
     rows.append(row(model="linear", mse=0.004, dx=0.2, t_end=10.0, step_ms=(10.0, 40.0, 1.0)))  # full domain
     # stability: verlet stable to CFL 4, inaccurate at 5, unstable at 6; euler unstable at once
     for cfl, cls in ((0.2, "ok"), (1.0, "ok"), (4.0, "ok"), (5.0, "inaccurate"), (6.0, "unstable")):
-        rows.append(row(model="linear", preset="stability", dx=0.25, t_end=10.0, strip_height=5.0, cfl=cfl,
-                        status="unstable" if cls == "unstable" else "ok", failed_step=7 if cls == "unstable" else None,
-                        mse=0.3 if cls == "inaccurate" else 0.016 * 2.5 ** 2))  # on the linear dx^2 line
-    rows.append(row(model="linear", preset="stability", dx=0.25, t_end=10.0, strip_height=5.0, cfl=0.2,
-                    integrator="euler", status="unstable", failed_step=30))
+        rows.append(
+            row(
+                model="linear",
+                preset="stability",
+                dx=0.25,
+                t_end=10.0,
+                strip_height=5.0,
+                cfl=cfl,
+                status="unstable" if cls == "unstable" else "ok",
+                failed_step=7 if cls == "unstable" else None,
+                mse=0.3 if cls == "inaccurate" else 0.016 * 2.5**2,
+            )
+        )  # on the linear dx^2 line
+    rows.append(
+        row(
+            model="linear",
+            preset="stability",
+            dx=0.25,
+            t_end=10.0,
+            strip_height=5.0,
+            cfl=0.2,
+            integrator="euler",
+            status="unstable",
+            failed_step=30,
+        )
+    )
     # a second machine, merged: a GPU card at 1,000 particles
-    rows.append(row(profile="machine-b", solver="linkedlist-gpu", precision="float64", step_ms=(0.01, 0.04, 0.005),
-                    dx=1.0))
+    rows.append(
+        row(profile="machine-b", solver="linkedlist-gpu", precision="float64", step_ms=(0.01, 0.04, 0.005), dx=1.0)
+    )
     return rows
 
 
@@ -130,8 +212,9 @@ def test_tables_from_a_fixed_results_file(results):
     assert t4[("linkedlist-cpu float64", 1, 1000)]["init"] == pytest.approx(2.0)
     assert t4[("linkedlist-cpu float64", 1, 1000)]["protocol"] == "10 steps, full, gather, 1 thread"
     t5 = {(r["config"], r["protocol"], r["N"]): r for r in T.table5(rows4)}
-    assert t5[("linkedlist-cpu float64", "10 steps, full, gather, 2 threads", 1000)]["snp"] == \
-        pytest.approx(100 * 0.5 / 2.55)
+    assert t5[("linkedlist-cpu float64", "10 steps, full, gather, 2 threads", 1000)]["snp"] == pytest.approx(
+        100 * 0.5 / 2.55
+    )
     six = {(r["gpu_profile"], r["N"], r["precision"]): r for r in T.table6(df)}
     assert six[("machine-a", 4000, "float32")]["speedup"] == pytest.approx(4 * 5.1 / 0.11)
     assert six[("machine-a", 4000, "float32")]["speedup_all_cores"] == pytest.approx(4 * 2.55 / 0.11)
@@ -174,17 +257,39 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
 
     out = tmp_path / "reports"
     write_reports(results, out)
-    expected = [f"machine-a/{name}.png" for name in ("fig8_error_vs_dx", "fig9_allpair_vs_linkedlist",
-                                                     "fig10_runtime_vs_N", "fig11_step_shares", "fig13_task_shares",
-                                                     "fig14_speedup_vs_N", "speed_vs_accuracy", "stability_map")]
+    expected = [
+        f"machine-a/{name}.png"
+        for name in (
+            "fig8_error_vs_dx",
+            "fig9_allpair_vs_linkedlist",
+            "fig10_runtime_vs_N",
+            "fig11_step_shares",
+            "fig13_task_shares",
+            "fig14_speedup_vs_N",
+            "speed_vs_accuracy",
+            "stability_map",
+        )
+    ]
     expected += ["machine-b/fig10_runtime_vs_N.png", "fig14_speedup_vs_N.png", "cards_step_vs_N.png"]
     for name in expected:
         image = mpimg.imread(out / name)
         assert image.shape[0] > 100 and image.shape[1] > 100 and image.std() > 0, name
     a = (out / "machine-a" / "report.md").read_text()
-    for words in ("Table 4", "Table 5", "Table 6", "Fig. 9", "Fig. 8", "fitted order 2.00", "stops falling at dx = 0.2",
-                  "Time to a given accuracy", "paper / fastest", "cost of each simplification", "predicted stable CFL",
-                  "unstable by prediction", "skipped"):
+    for words in (
+        "Table 4",
+        "Table 5",
+        "Table 6",
+        "Fig. 9",
+        "Fig. 8",
+        "fitted order 2.00",
+        "stops falling at dx = 0.2",
+        "Time to a given accuracy",
+        "paper / fastest",
+        "cost of each simplification",
+        "predicted stable CFL",
+        "unstable by prediction",
+        "skipped",
+    ):
         assert words in a, words
     cards = (out / "cards.md").read_text()
     assert "machine-b" in cards and "Tesla K20c" in cards and "Quadro M4000" in cards

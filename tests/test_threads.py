@@ -1,5 +1,6 @@
 """numba's thread count is set where a solver decides it (input), not on every launch, and a launch
 still runs on its solver's count when solvers with different counts alternate in one process."""
+
 from __future__ import annotations
 
 import json
@@ -74,8 +75,9 @@ SCRIPT = textwrap.dedent("""
 
 def test_alternating_solvers_each_launch_on_their_own_thread_count():
     env = dict(os.environ, NUMBA_NUM_THREADS="4", PYTHONPATH=ROOT)
-    proc = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=600,
-                          cwd=ROOT)
+    proc = subprocess.run(
+        [sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=600, cwd=ROOT
+    )
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout.strip().splitlines()[-1])
     seen, calls = out["seen"], out["calls"]

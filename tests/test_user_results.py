@@ -1,5 +1,6 @@
 """What a new user meets in the first hour: their own store, honest comparisons, progress, output paths,
 a CLI that agrees with the README, and a table of stored runs."""
+
 from __future__ import annotations
 
 import io
@@ -92,14 +93,36 @@ def test_a_sweep_shows_the_run_in_progress_its_size_and_a_qualified_eta(tmp_path
 
 
 def test_a_bad_fields_path_is_refused_before_the_run(tmp_path, capsys):
-    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--fields",
-                          str(tmp_path / "no" / "such" / "f.npz"), capsys=capsys)
+    code, out, err = cli_main(
+        "run",
+        "--solver",
+        "linkedlist-cpu",
+        "--dx",
+        "1",
+        "--fields",
+        str(tmp_path / "no" / "such" / "f.npz"),
+        capsys=capsys,
+    )
     assert code == 2 and "--fields" in err and "Traceback" not in err and "stage" not in out
 
 
 def test_json_is_standard_json_null_never_nan(capsys):
-    code, out, _ = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "300", "--cfl", "12",
-                        "--model", "linear", "--json", "--quiet", capsys=capsys)
+    code, out, _ = cli_main(
+        "run",
+        "--solver",
+        "linkedlist-cpu",
+        "--dx",
+        "1",
+        "--steps",
+        "300",
+        "--cfl",
+        "12",
+        "--model",
+        "linear",
+        "--json",
+        "--quiet",
+        capsys=capsys,
+    )
 
     def refuse(name):
         raise ValueError(f"non-standard JSON constant {name}")
@@ -191,14 +214,17 @@ def test_asv_smoke_config_writes_only_to_ignored_scratch_and_selects_few_benchma
     try:
         conf = asv_util.load_json(str(config), js_comments=True)
         git = ["git", "-C", str(root)]
-        ignored = subprocess.run([*git, "check-ignore", "--no-index", str(config), conf["results_dir"]],
-                                 capture_output=True, text=True).stdout.split()
+        ignored = subprocess.run(
+            [*git, "check-ignore", "--no-index", str(config), conf["results_dir"]], capture_output=True, text=True
+        ).stdout.split()
         assert ignored == [str(config), conf["results_dir"]], ignored  # both git-ignored
         tracked = subprocess.run([*git, "ls-files", "--", conf["results_dir"]], capture_output=True, text=True)
         assert tracked.stdout == "" and not conf["results_dir"].startswith(str(root / "reports"))
-        assert {k: v for k, v in conf.items() if k != "results_dir"} == \
-            {k: v for k, v in asv_util.load_json(str(root / "asv.conf.json"), js_comments=True).items()
-             if k != "results_dir"}
+        assert {k: v for k, v in conf.items() if k != "results_dir"} == {
+            k: v
+            for k, v in asv_util.load_json(str(root / "asv.conf.json"), js_comments=True).items()
+            if k != "results_dir"
+        }
     finally:
         config.unlink()
     # each pattern picks a few parameter sets of the committed suite's benchmarks, as asv matches them
@@ -206,8 +232,12 @@ def test_asv_smoke_config_writes_only_to_ignored_scratch_and_selects_few_benchma
     import re
 
     suite = json.loads((root / "reports/asv/results/benchmarks.json").read_text())
-    names = [f"{name}({', '.join(p)})" for name, b in suite.items() if isinstance(b, dict)
-             for p in itertools.product(*b["params"])]
+    names = [
+        f"{name}({', '.join(p)})"
+        for name, b in suite.items()
+        if isinstance(b, dict)
+        for p in itertools.product(*b["params"])
+    ]
     picked = [[n for n in names if re.search(pattern, n)] for pattern in asv_smoke.SELECTION]
     assert all(picked) and sum(map(len, picked)) <= 6, picked
     assert asv_smoke.main(["--results", str(root / "reports/asv/results")]) == 2

@@ -1,4 +1,5 @@
 """SPH kernels, one file per kernel (see base.py), found by registry.py."""
+
 from __future__ import annotations
 
 from .base import Kernel
@@ -14,5 +15,15 @@ from .registry import (
     unregister,
 )
 
-__all__ = ["Kernel", "DEFAULT_KERNEL", "ENTRY_POINT_GROUP", "KernelPluginWarning", "kernel_named", "kernel_names",
-           "kernels", "register", "truncated", "unregister"]
+__all__ = [
+    "Kernel",
+    "DEFAULT_KERNEL",
+    "ENTRY_POINT_GROUP",
+    "KernelPluginWarning",
+    "kernel_named",
+    "kernel_names",
+    "kernels",
+    "register",
+    "truncated",
+    "unregister",
+]

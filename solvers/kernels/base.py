@@ -16,6 +16,7 @@ entry-point group ``pcabench.kernels``) with a ``name``. It states
 
 grad_i W_ij = G(r_ij) (x_i - x_j): the pair loops never divide by r.
 """
+
 from __future__ import annotations
 
 import abc

@@ -5,6 +5,7 @@ G(r) = W'(r) / r = -2 exp(-r^2/h^2) / (pi h^4) (1/m^4), G(0) = -2 / (pi h^4).
 The truncation is not renormalised: at a 3h cutoff it biases the sound speed
 by about 0.12 % (9 % at 2h), an error floor the reports state.
 """
+
 from __future__ import annotations
 
 import math
@@ -25,14 +26,16 @@ class Gaussian(Kernel):
 
     def value(self, r, h: float):
         r = np.asarray(r, dtype=np.float64)
-        return np.exp(-(r / h) ** 2) / (math.pi * h * h)
+        return np.exp(-((r / h) ** 2)) / (math.pi * h * h)
 
     def gradient(self, r, h: float):
         r = np.asarray(r, dtype=np.float64)
-        return -2.0 * np.exp(-(r / h) ** 2) / (math.pi * h**4)
+        return -2.0 * np.exp(-((r / h) ** 2)) / (math.pi * h**4)
 
     def compiled_gradient(self, dtype, exp_neg):
         """G(0) exp(-r^2/h^2) through the caller's ``exp_neg``."""
+
         def gradient(r2, k):
             return k[GRAD0] * exp_neg(r2 * k[INV_H2])
+
         return gradient

@@ -13,6 +13,7 @@ plain name of its own or repeats a taken name is left out with one
 The compiled pair loops and the predictions are cached by kernel name, so a
 name keeps one class for the life of the process.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -45,8 +46,11 @@ def _builtin() -> list[type[Kernel]]:
         if info.name in ("base", "registry"):
             continue
         module = importlib.import_module(f"{__package__}.{info.name}")
-        found += [cls for _, cls in inspect.getmembers(module, inspect.isclass)
-                  if issubclass(cls, Kernel) and cls.__module__ == module.__name__ and cls.__dict__.get("name")]
+        found += [
+            cls
+            for _, cls in inspect.getmembers(module, inspect.isclass)
+            if issubclass(cls, Kernel) and cls.__module__ == module.__name__ and cls.__dict__.get("name")
+        ]
     return found
 
 
@@ -58,8 +62,10 @@ def _problem(cls, taken) -> str | None:
     if not name:
         return "the class sets no name of its own"
     if not isinstance(name, str) or not KERNEL_NAME.fullmatch(name):
-        return f"the kernel name {name!r:.80} is not a plain name (letters, digits, '.', '_', '-', at most 32): " \
-               "it names stored records"
+        return (
+            f"the kernel name {name!r:.80} is not a plain name (letters, digits, '.', '_', '-', at most 32): "
+            "it names stored records"
+        )
     if name in taken:
         return f"the kernel name {name!r} is taken"
     if cls.support is not None and not (isinstance(cls.support, (int, float)) and 0 < cls.support <= 5):
@@ -76,8 +82,9 @@ def _plugins(taken: set) -> list[type[Kernel]]:
         try:
             cls = entry.load()
         except Exception as exc:  # noqa: BLE001 - a broken plug-in must not take pcabench down
-            warnings.warn(f"{where} left out: it does not load ({type(exc).__name__}: {exc})", KernelPluginWarning,
-                          stacklevel=2)
+            warnings.warn(
+                f"{where} left out: it does not load ({type(exc).__name__}: {exc})", KernelPluginWarning, stacklevel=2
+            )
             continue
         why = _problem(cls, taken)
         if why:

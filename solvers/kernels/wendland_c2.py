@@ -4,6 +4,7 @@ W(r) = 7 / (4 pi h^2) (1 - q/2)^4 (2q + 1) (1/m^2);
 G(r) = W'(r) / r = -35 / (4 pi h^4) (1 - q/2)^3 (1/m^4), G(0) = -35 / (4 pi h^4).
 Nothing is truncated and no exp is needed, only q.
 """
+
 from __future__ import annotations
 
 import math
@@ -40,4 +41,5 @@ class WendlandC2(Kernel):
         def gradient(r2, k):
             s = one - half * math.sqrt(r2 * k[INV_H2])
             return k[GRAD0] * (s * s * s)
+
         return gradient

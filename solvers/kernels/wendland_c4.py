@@ -3,6 +3,7 @@
 W(r) = 9 / (4 pi h^2) (1 - q/2)^6 (35/12 q^2 + 3q + 1) (1/m^2);
 G(r) = W'(r) / r = -21 / (4 pi h^4) (1 - q/2)^5 (5q + 2) (1/m^4), G(0) = -21 / (2 pi h^4).
 """
+
 from __future__ import annotations
 
 import math
@@ -41,4 +42,5 @@ class WendlandC4(Kernel):
             s = one - half * q
             s2 = s * s
             return k[GRAD0] * (s2 * s2 * s) * (one + c4_slope * q)
+
         return gradient

@@ -1,8 +1,8 @@
 """Scenes: what to simulate and what it is scored against, one file per scene kind (see base.py)."""
+
 from __future__ import annotations
 
 from .base import BOUNDARY_KINDS, SceneKind
 from .registry import DEFAULT_SCENE, ENTRY_POINT_GROUP, scene_kind, scene_names, scenes
 
-__all__ = ["BOUNDARY_KINDS", "SceneKind", "DEFAULT_SCENE", "ENTRY_POINT_GROUP", "scene_kind", "scene_names",
-           "scenes"]
+__all__ = ["BOUNDARY_KINDS", "SceneKind", "DEFAULT_SCENE", "ENTRY_POINT_GROUP", "scene_kind", "scene_names", "scenes"]

@@ -17,6 +17,7 @@ drho and of the velocity vector over the domain, and the relative RMS of drho
 along the lattice axes through the centre and along its diagonals, apart
 (the lattice's phase error depends on the direction of travel).
 """
+
 from __future__ import annotations
 
 import math
@@ -45,8 +46,7 @@ def measures(scene, x, y, drho, u, v, ref) -> dict:
     du, dv = np.asarray(u, float) - r_u, np.asarray(v, float) - r_v
     if not (np.all(np.isfinite(d)) and np.all(np.isfinite(du)) and np.all(np.isfinite(dv))):
         nan = float("nan")
-        return {"mse": nan, "me": nan, "velocity_rms": nan, "velocity_max": nan, "axis_rms": nan,
-                "diagonal_rms": nan}
+        return {"mse": nan, "me": nan, "velocity_rms": nan, "velocity_max": nan, "axis_rms": nan, "diagonal_rms": nan}
     xc, yc = centre(scene)
     px, py = wrapped(x - xc, scene.x_max - scene.x_min), wrapped(y - yc, scene.y_max - scene.y_min)
     axis = (np.abs(px) < scene.dx) | (np.abs(py) < scene.dx)
@@ -55,13 +55,24 @@ def measures(scene, x, y, drho, u, v, ref) -> dict:
     t = scene.t_final
     ray_axis = (py > 0) & (py < scene.dx) & (px > 0)  # the row just above the centre, to the right
     ray_diagonal = (np.abs(px - py) < 0.5 * scene.dx) & (px > 0)
-    return {"mse": _relative(d, r_drho), "me": float(np.max(np.abs(d))),
-            "velocity_rms": _relative(speed_err, np.hypot(r_u, r_v)), "velocity_max": float(speed_err.max()),
-            "axis_rms": _relative(d[axis], r_drho[axis]), "diagonal_rms": _relative(d[diagonal], r_drho[diagonal]),
-            "front_axis": front_shift(px[ray_axis], py[ray_axis], np.asarray(drho, float)[ray_axis],
-                                      r_drho[ray_axis], scene.c0 * t),
-            "front_diagonal": front_shift(px[ray_diagonal], py[ray_diagonal], np.asarray(drho, float)[ray_diagonal],
-                                          r_drho[ray_diagonal], scene.c0 * t)}
+    return {
+        "mse": _relative(d, r_drho),
+        "me": float(np.max(np.abs(d))),
+        "velocity_rms": _relative(speed_err, np.hypot(r_u, r_v)),
+        "velocity_max": float(speed_err.max()),
+        "axis_rms": _relative(d[axis], r_drho[axis]),
+        "diagonal_rms": _relative(d[diagonal], r_drho[diagonal]),
+        "front_axis": front_shift(
+            px[ray_axis], py[ray_axis], np.asarray(drho, float)[ray_axis], r_drho[ray_axis], scene.c0 * t
+        ),
+        "front_diagonal": front_shift(
+            px[ray_diagonal],
+            py[ray_diagonal],
+            np.asarray(drho, float)[ray_diagonal],
+            r_drho[ray_diagonal],
+            scene.c0 * t,
+        ),
+    }
 
 
 def peak_radius(r, values, beyond: float) -> float:
@@ -74,7 +85,7 @@ def peak_radius(r, values, beyond: float) -> float:
     i = out[0] + int(np.argmax(values[out]))
     if i == 0 or i >= r.size - 1:
         return float(r[i])
-    a, b, _c = np.polyfit(r[i - 1:i + 2] - r[i], values[i - 1:i + 2], 2)
+    a, b, _c = np.polyfit(r[i - 1 : i + 2] - r[i], values[i - 1 : i + 2], 2)
     return float(r[i] - b / (2 * a)) if a < 0 else float(r[i])
 
 
@@ -115,8 +126,20 @@ class AcousticPulse(SceneKind):
         from ..pulse2d import periodic_linear
 
         xc, yc = centre(scene)
-        return periodic_linear(scene.nx, scene.ny, scene.dx, scene.x_lo, scene.y_lo, xc, yc, scene.pulse_width,
-                               scene.mach, scene.rho0, scene.c0, t)
+        return periodic_linear(
+            scene.nx,
+            scene.ny,
+            scene.dx,
+            scene.x_lo,
+            scene.y_lo,
+            xc,
+            yc,
+            scene.pulse_width,
+            scene.mach,
+            scene.rho0,
+            scene.c0,
+            t,
+        )
 
     def exact_fields(self, scene, t: float):
         from ..interface import Fields
@@ -143,10 +166,14 @@ class AcousticPulse(SceneKind):
         px = wrapped(fields.x - xc, scene.x_max - scene.x_min)
         py = wrapped(fields.y - yc, scene.y_max - scene.y_min)
         r = np.hypot(px, py)
-        r_max = 0.5 * math.hypot(scene.x_max - scene.x_min, scene.y_max - scene.y_min) + scene.c0 * fields.t + \
-            4 * scene.pulse_width
-        rr, drho, _u = isothermal_pulse_radial_cached(fields.t, scene.pulse_width, scene.mach, scene.rho0, scene.c0,
-                                               round(r_max, 3))
+        r_max = (
+            0.5 * math.hypot(scene.x_max - scene.x_min, scene.y_max - scene.y_min)
+            + scene.c0 * fields.t
+            + 4 * scene.pulse_width
+        )
+        rr, drho, _u = isothermal_pulse_radial_cached(
+            fields.t, scene.pulse_width, scene.mach, scene.rho0, scene.c0, round(r_max, 3)
+        )
         ref = np.interp(r, rr, drho)
         d = np.asarray(fields.drho, float) - ref
         return _relative(d, ref) if np.all(np.isfinite(d)) else float("nan")
@@ -165,8 +192,10 @@ class AcousticPulse(SceneKind):
         xc, yc = centre(scene)
         half = 0.5 * min(scene.x_max - scene.x_min, scene.y_max - scene.y_min)
         if not 3 * scene.pulse_width <= half:
-            out.append(f"--domain-size must be at least 6 pulse widths ({6 * scene.pulse_width:g} m) so that the "
-                       f"pulse fits in the square (got {2 * half:g} m)")
+            out.append(
+                f"--domain-size must be at least 6 pulse widths ({6 * scene.pulse_width:g} m) so that the "
+                f"pulse fits in the square (got {2 * half:g} m)"
+            )
         if not scene.x_min <= xc <= scene.x_max:
             out.append(f"pulse_center must be inside the square [{scene.x_min:g}, {scene.x_max:g}] m (got {xc:g})")
         return out

@@ -19,6 +19,7 @@ the entry-point group ``pcabench.scenes``) with a ``name``. It states
 The numerical method (kernel, h/dx, CFL, integrator, precision, model) is
 the Scene's, not the kind's: every kind runs with every method.
 """
+
 from __future__ import annotations
 
 import math
@@ -42,8 +43,9 @@ class SceneKind:
 
     def boundaries(self, scene=None) -> frozenset:
         """The boundary kinds this scene needs of a solver."""
-        return frozenset(("periodic-x" if "x" in self.periodic else "free-x",
-                          "periodic-y" if "y" in self.periodic else "free-y"))
+        return frozenset(
+            ("periodic-x" if "x" in self.periodic else "free-x", "periodic-y" if "y" in self.periodic else "free-y")
+        )
 
     def check(self, scene) -> list[str]:
         """Problems with ``scene``'s parameters for this kind, one line each naming the option and range."""

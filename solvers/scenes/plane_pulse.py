@@ -7,6 +7,7 @@ answer. Scored on u (the paper's eq. 11); the lagrangian model also against
 the 1D isothermal solution (solvers/isothermal1d.py), which steepens into a
 shock at t_b = w / (c0 Ma sqrt(2/e)) (70 s at the defaults).
 """
+
 from __future__ import annotations
 
 import math

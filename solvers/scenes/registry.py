@@ -6,6 +6,7 @@ A scene kind is a :class:`~solvers.scenes.base.SceneKind` subclass with a
 A plug-in that does not load, is not a SceneKind or repeats a taken name is
 left out with one :class:`~solvers.registry.PluginWarning`.
 """
+
 from __future__ import annotations
 
 import importlib
@@ -32,8 +33,11 @@ def _builtin() -> list[type[SceneKind]]:
         if info.name in ("base", "registry"):
             continue
         module = importlib.import_module(f"{__package__}.{info.name}")
-        found += [cls for _, cls in inspect.getmembers(module, inspect.isclass)
-                  if issubclass(cls, SceneKind) and cls.__module__ == module.__name__ and cls.__dict__.get("name")]
+        found += [
+            cls
+            for _, cls in inspect.getmembers(module, inspect.isclass)
+            if issubclass(cls, SceneKind) and cls.__module__ == module.__name__ and cls.__dict__.get("name")
+        ]
     return found
 
 
@@ -44,12 +48,14 @@ def _plugins(taken: set) -> list[type[SceneKind]]:
         try:
             cls = entry.load()
         except Exception as exc:  # noqa: BLE001 - a broken plug-in must not take pcabench down
-            warnings.warn(f"{where} left out: it does not load ({type(exc).__name__}: {exc})", ScenePluginWarning,
-                          stacklevel=2)
+            warnings.warn(
+                f"{where} left out: it does not load ({type(exc).__name__}: {exc})", ScenePluginWarning, stacklevel=2
+            )
             continue
         if not (inspect.isclass(cls) and issubclass(cls, SceneKind)) or not cls.__dict__.get("name"):
-            warnings.warn(f"{where} left out: not a SceneKind subclass with a name of its own", ScenePluginWarning,
-                          stacklevel=2)
+            warnings.warn(
+                f"{where} left out: not a SceneKind subclass with a name of its own", ScenePluginWarning, stacklevel=2
+            )
         elif cls.name in taken:
             warnings.warn(f"{where} left out: the scene name {cls.name!r} is taken", ScenePluginWarning, stacklevel=2)
         else:

@@ -8,6 +8,7 @@ only slow a round down):
 - the linked list takes less time per step than all-pair at every size tested;
 - a step's best SNP + PI + SU add up to its best step (within 25 %).
 """
+
 from __future__ import annotations
 
 import json
@@ -38,14 +39,17 @@ def check(med: dict) -> list[str]:
             checked += 1
             ratio = sum(parts) / t
             if abs(ratio - 1) > STEP_SUM_TOLERANCE:
-                failures.append(f"{solver} {precision} N={n}: SNP+PI+SU = {sum(parts):.3g} s is {ratio:.2f}x "
-                                f"the measured step {t:.3g} s (allowed 1 +- {STEP_SUM_TOLERANCE})")
+                failures.append(
+                    f"{solver} {precision} N={n}: SNP+PI+SU = {sum(parts):.3g} s is {ratio:.2f}x "
+                    f"the measured step {t:.3g} s (allowed 1 +- {STEP_SUM_TOLERANCE})"
+                )
         if solver == "allpair-cpu" and ("linkedlist-cpu", precision, n, "step") in med:
             checked += 1
             ll = med[("linkedlist-cpu", precision, n, "step")]
             if not ll < t:
-                failures.append(f"{precision} N={n}: linked list {ll:.3g} s per step is not faster than "
-                                f"all-pair {t:.3g} s")
+                failures.append(
+                    f"{precision} N={n}: linked list {ll:.3g} s per step is not faster than all-pair {t:.3g} s"
+                )
     if checked == 0:
         failures.append("no benchmark pairs to compare: was the suite run with --benchmark-only?")
     return failures

@@ -1,4 +1,5 @@
 """pytest-benchmark: this machine's hardware profile goes into every saved run's machine info."""
+
 from __future__ import annotations
 
 

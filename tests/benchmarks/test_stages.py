@@ -9,6 +9,7 @@ id in its extra info. Compilation happens before the timed rounds.
 check_ratios.py then checks ratios measured in the same run, which must hold
 on any machine; absolute times are not asserted anywhere.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -43,9 +44,18 @@ def test_stage(benchmark, solver, precision, dx, stage):
     else:  # one stage repeated alone is not a time step: score the state it was timed on
         err = p.errors()
         benchmark.pedantic(lambda: p.stage(stage), rounds=ROUNDS, iterations=1, warmup_rounds=1)
-    benchmark.extra_info.update({"solver": solver, "precision": precision, "n_particles": p.n_particles,
-                                 "stage": stage, "mse": err.mse, "me": err.me, "jit_seconds": p.jit_seconds,
-                                 "profile_id": machine_id()})
+    benchmark.extra_info.update(
+        {
+            "solver": solver,
+            "precision": precision,
+            "n_particles": p.n_particles,
+            "stage": stage,
+            "mse": err.mse,
+            "me": err.me,
+            "jit_seconds": p.jit_seconds,
+            "profile_id": machine_id(),
+        }
+    )
     assert err.mse < 0.3  # the timed state is still the pulse (0.18 after 10 steps at N = 1,000)
 
 
@@ -57,8 +67,12 @@ def test_stage(benchmark, solver, precision, dx, stage):
 # the best round.
 
 LIST_DX = 0.1  # 100,000 particles on the paper's domain
-CONFIGS = {"gaussian": {"kernel": "gaussian"}, "wendland-c2": {"kernel": "wendland-c2"},
-           "wendland-c4": {"kernel": "wendland-c4"}, "gaussian 2h": {"kernel": "gaussian", "cutoff_factor": 2.0}}
+CONFIGS = {
+    "gaussian": {"kernel": "gaussian"},
+    "wendland-c2": {"kernel": "wendland-c2"},
+    "wendland-c4": {"kernel": "wendland-c4"},
+    "gaussian 2h": {"kernel": "gaussian", "cutoff_factor": 2.0},
+}
 
 
 def candidates(solver) -> int:
@@ -86,19 +100,30 @@ def test_list_build(benchmark, name, precision):
     solver.init()
     solver.snp()
     benchmark.group = f"pair-list build, {precision}, N={solver.scene.n_particles}"
-    benchmark.pedantic(lambda: solver.pairs.build(*solver.geometry(), solver.k), rounds=7, iterations=1,
-                       warmup_rounds=1)
+    benchmark.pedantic(
+        lambda: solver.pairs.build(*solver.geometry(), solver.k), rounds=7, iterations=1, warmup_rounds=1
+    )
     n, cand, pairs = solver.scene.n_particles, candidates(solver), solver.pairs.pairs
     best = benchmark.stats.stats.min
-    benchmark.extra_info.update({"kernel": name, "precision": precision, "n_particles": n,
-                                 "candidates_per_particle": cand / n, "pairs_per_particle": pairs / n,
-                                 "ns_per_candidate": 1e9 * best / cand, "ns_per_pair": 1e9 * best / pairs})
+    benchmark.extra_info.update(
+        {
+            "kernel": name,
+            "precision": precision,
+            "n_particles": n,
+            "candidates_per_particle": cand / n,
+            "pairs_per_particle": pairs / n,
+            "ns_per_candidate": 1e9 * best / cand,
+            "ns_per_pair": 1e9 * best / pairs,
+        }
+    )
     assert pairs / n == pytest.approx(np.pi * (solver.scene.cutoff / LIST_DX) ** 2 / 2, rel=0.1)  # each pair once
 
 
 # ---------------------------------------------------------------- one step of every scene (small sizes)
-SCENE_CASES = {"plane-pulse": {"dx": 1.0}, "acoustic-pulse": {"dx": 1.0, "x_min": -16.0, "x_max": 16.0,
-                                                             "y_min": -16.0, "y_max": 16.0}}
+SCENE_CASES = {
+    "plane-pulse": {"dx": 1.0},
+    "acoustic-pulse": {"dx": 1.0, "x_min": -16.0, "x_max": 16.0, "y_min": -16.0, "y_max": 16.0},
+}
 # how closely the run's error must be the prediction's: exact on the periodic square; the plane pulse's tail
 # meets the free left end at -10 m, which the prediction's unbounded lattice lacks (3e-6 measured)
 SCENE_AGREEMENT = {"plane-pulse": 1e-4, "acoustic-pulse": 1e-8}
@@ -130,9 +155,15 @@ def test_scene_step(benchmark, scene):
     benchmark.group = f"scene {scene} N={s.n_particles}"
     benchmark.pedantic(step, rounds=ROUNDS, iterations=1, warmup_rounds=1)
     record = run(RunSpec("linkedlist-cpu", s))  # the scene's error measures after 10 steps, by the harness
-    benchmark.extra_info.update({"scene": scene, "n_particles": s.n_particles, "mse": record.mse,
-                                 "errors": record.errors, "profile_id": machine_id()})
+    benchmark.extra_info.update(
+        {
+            "scene": scene,
+            "n_particles": s.n_particles,
+            "mse": record.mse,
+            "errors": record.errors,
+            "profile_id": machine_id(),
+        }
+    )
     from solvers.dispersion import predict
 
-    assert record.status == "ok" and record.mse == pytest.approx(predict(s).predicted_error,
-                                                                   rel=SCENE_AGREEMENT[scene])
+    assert record.status == "ok" and record.mse == pytest.approx(predict(s).predicted_error, rel=SCENE_AGREEMENT[scene])
