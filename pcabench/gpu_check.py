@@ -4,9 +4,11 @@
     pcabench gpu-check --rehearse --out DIR              # anywhere: the same script in numba's simulator
 
 A GPU machine is lent rarely and briefly, so the first real run has to work
-and bring everything back from one call. The check runs these stages in
-order of value, each given what is left of the budget, and stops cleanly
-when the budget is spent, keeping what it has:
+and bring everything back from one call. The check runs these stages
+(:data:`STAGES`, a registry like the report's sections: a stage is one
+function of the shared :class:`Check` and one entry) in order of value, each
+given what is left of the budget, and stops cleanly when the budget is
+spent, keeping what it has:
 
 1. ``profile``: the hardware profile, with the card's measured ceilings
    (device copy bandwidth, FP32 and FP64 FMA rates, the SM clock);
@@ -49,6 +51,7 @@ import tarfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -510,11 +513,186 @@ def markdown(profile: dict, results: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+# ---------------------------------------------------------------- the stages
+@dataclass
+class Check:
+    """What the stages share: the plan, where they write, the budget, and the results so far (``state``)."""
+
+    plan: Plan
+    out: Path
+    budget: Budget
+    state: dict
+    profile: dict
+    cupy: object  # CuPy on a GPU, None in the simulator
+    store_path: Path
+    rehearse: bool
+    env: dict  # the environment of the stages' child processes
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One stage of the check: it runs if ``need_s`` seconds are left; ``work(check)`` returns False when it
+    failed (an exception fails it too, and the next stage still runs)."""
+
+    name: str
+    need_s: float
+    work: Callable[[Check], object]
+
+
+def measure(c: Check):
+    if c.cupy is None:
+        c.profile["measured"] = {"note": "rehearsal: no GPU, no ceilings"}
+    else:
+        c.profile["measured"] = measure_ceilings(c.cupy)
+    from . import profiles
+
+    profiles.save(c.profile)
+    write_file(c.out / "profile.json", json.dumps(c.profile, indent=2) + "\n")
+
+
+def compare(c: Check) -> bool:
+    c.state["compare"] = compare_with_cpu(c.plan, c.out)
+    tol = {"float64": 1e-12, "float32": 1e-4}
+    return all(r["max_rel_diff_u"] < tol[r["precision"]] for r in c.state["compare"])
+
+
+def gpu_sweep(c: Check) -> bool:
+    from .sweep import sweep
+
+    c.state["gpu_rows"] = sweep(
+        gpu_specs(c.plan),
+        c.store_path,
+        run_budget=c.budget.left(),
+        sweep_budget=c.budget.left() - 60,
+        runner=run_and_release,
+    )
+    return all(r["status"] == "ok" for r in c.state["gpu_rows"])
+
+
+def graph(c: Check) -> bool:
+    plan = c.plan
+    if c.cupy is None:
+        c.state["graph"] = [
+            {"dx": dx, "precision": p, "error": "needs a real GPU (no streams in the simulator)"}
+            for dx in plan.graph_dx
+            for p in PRECISIONS
+        ]
+        return True
+    c.state["graph"] = []
+    for dx in plan.graph_dx:
+        for precision in PRECISIONS:
+            if c.budget.left() < 30:
+                break
+            try:
+                row = graph_vs_plain(dx, precision, plan.graph_steps, plan.graph_rounds, plan.scene)
+            except Exception as exc:  # noqa: BLE001
+                row = {"dx": dx, "precision": precision, "error": f"{type(exc).__name__}: {str(exc)[:300]}"}
+            c.state["graph"].append(row)
+            c.budget.say(f"graph dx {dx} {precision}: {row}")
+            c.cupy.get_default_memory_pool().free_all_blocks()
+    return all("error" not in r for r in c.state["graph"])
+
+
+def cpu_peers(c: Check) -> bool:
+    from .sweep import sweep
+
+    c.state["cpu_rows"] = sweep(
+        cpu_peer_specs(c.plan),
+        c.store_path,
+        run_budget=c.budget.left(),
+        sweep_budget=c.budget.left() - 30,
+        runner=run_and_release,
+    )
+    return all(r["status"] == "ok" for r in c.state["cpu_rows"])
+
+
+def asv(c: Check) -> bool:
+    from .device_payload import run_asv_gpu
+
+    c.state["asv"] = run_asv_gpu(
+        c.out / "asv",
+        commits=("HEAD", H100_COMMIT),
+        budget_s=min(150, c.budget.left()),
+        bench=c.plan.asv_bench,
+        asv_args=("--quick",),
+    )
+    return all(r.get("returncode") == 0 for r in c.state["asv"])
+
+
+def bench(c: Check) -> bool:
+    json_path = c.out / f"pytest-benchmark_{c.profile['id']}.json"
+    cmd = [
+        sys.executable,
+        "-m",
+        "pytest",
+        "-o",
+        "addopts=",
+        "-p",
+        "no:cacheprovider",
+        "tests/benchmarks",
+        "--benchmark-only",
+        f"--benchmark-json={json_path}",
+        "-q",
+    ]
+    if c.rehearse:
+        cmd += ["-k", "linkedlist and step"]
+    c.state["bench"] = run_logged(cmd, c.out / "pytest_benchmark.log", min(120, c.budget.left()), c.env)
+    return c.state["bench"]["exit"] == 0
+
+
+def pytest_gpu(c: Check) -> bool:
+    c.state["pytest_gpu"] = run_logged(
+        [sys.executable, "-m", "pytest", "-m", "gpu", "-q", "-p", "no:cacheprovider", "tests"],
+        c.out / "pytest_gpu.log",
+        min(150, c.budget.left()),
+        c.env,
+    )
+    return c.state["pytest_gpu"]["exit"] in (0, 5)  # 5: every GPU test deselected or skipped (rehearsal)
+
+
+def ncu(c: Check) -> bool:
+    if shutil.which("ncu") is None or c.cupy is None:
+        c.state["ncu"] = {"status": "no ncu or no GPU here"}
+        return True
+    c.state["ncu"] = run_logged(ncu_command(c.plan, c.out), c.out / "ncu.log", min(90, c.budget.left()), c.env)
+    return c.state["ncu"]["exit"] == 0
+
+
+# In order: each one's seconds to start (what it needs at the least), its work.
+STAGES = (
+    Stage("profile", 0, measure),
+    Stage("compare", 40, compare),
+    Stage("sweep", 60, gpu_sweep),
+    Stage("graph", 40, graph),
+    Stage("cpu", 40, cpu_peers),
+    Stage("asv", 60, asv),
+    Stage("bench", 60, bench),
+    Stage("pytest-gpu", 40, pytest_gpu),
+    Stage("ncu", 45, ncu),
+)
+
+
+def run_stage(stage: Stage, c: Check) -> None:
+    """Run ``stage`` if its seconds are left; record its status and keep going on failure."""
+    t0 = time.perf_counter()
+    if c.budget.left() < stage.need_s:
+        status = f"not run: {c.budget.left():.0f} s left, needs about {stage.need_s:.0f}"
+    else:
+        c.budget.say(f"{stage.name} ...")
+        try:
+            value = stage.work(c)
+            status = "ok" if value is not False else "failed"
+        except Exception as exc:  # noqa: BLE001 - one stage's failure must not lose the others' results
+            status = f"failed: {type(exc).__name__}: {str(exc)[:300]}"
+    c.state["stages"].append({"stage": stage.name, "status": status, "seconds": time.perf_counter() - t0})
+    c.budget.say(f"{stage.name}: {status}")
+
+
 # ---------------------------------------------------------------- the check
 def gpu_check(
     out: Path, results: Path, reports: Path, budget_s: float = 480.0, rehearse: bool = False, plan: Plan | None = None
 ) -> int:
-    """Every stage within ``budget_s`` seconds; 0 when every stage that ran passed, else 1.
+    """Every stage of :data:`STAGES` within ``budget_s`` seconds; 0 when every stage that ran passed, else 1.
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
@@ -528,143 +706,24 @@ def gpu_check(
     from . import profiles
     from .provenance import git_commit
     from .reports import write_reports
-    from .sweep import sweep
 
     budget = Budget(budget_s)
     _cuda, cupy = device_backend()  # raises SolverUnavailable with a clear message (no GPU, no simulator)
     state = {"budget_s": budget_s, "commit": git_commit(), "rehearsal": rehearse or simulated(), "stages": []}
     profile = profiles.capture()
-    store_path = Path(results) / store_name(profile["id"])
-
-    def stage(name: str, need_s: float, work):
-        """Run one stage if ``need_s`` seconds are left; record its status and keep going on failure."""
-        t0 = time.perf_counter()
-        if budget.left() < need_s:
-            status = f"not run: {budget.left():.0f} s left, needs about {need_s:.0f}"
-        else:
-            budget.say(f"{name} ...")
-            try:
-                value = work()
-                status = "ok" if value is not False else "failed"
-            except Exception as exc:  # noqa: BLE001 - one stage's failure must not lose the others' results
-                status = f"failed: {type(exc).__name__}: {str(exc)[:300]}"
-        state["stages"].append({"stage": name, "status": status, "seconds": time.perf_counter() - t0})
-        budget.say(f"{name}: {status}")
-
-    def ceilings():
-        if cupy is None:
-            profile["measured"] = {"note": "rehearsal: no GPU, no ceilings"}
-        else:
-            profile["measured"] = measure_ceilings(cupy)
-        profiles.save(profile)
-        write_file(out / "profile.json", json.dumps(profile, indent=2) + "\n")
-
-    def compare():
-        state["compare"] = compare_with_cpu(plan, out)
-        tol = {"float64": 1e-12, "float32": 1e-4}
-        return all(r["max_rel_diff_u"] < tol[r["precision"]] for r in state["compare"])
-
-    def gpu_sweep():
-        state["gpu_rows"] = sweep(
-            gpu_specs(plan),
-            store_path,
-            run_budget=budget.left(),
-            sweep_budget=budget.left() - 60,
-            runner=run_and_release,
-        )
-        return all(r["status"] == "ok" for r in state["gpu_rows"])
-
-    def graph():
-        if cupy is None:
-            state["graph"] = [
-                {"dx": dx, "precision": p, "error": "needs a real GPU (no streams in the simulator)"}
-                for dx in plan.graph_dx
-                for p in PRECISIONS
-            ]
-            return True
-        state["graph"] = []
-        for dx in plan.graph_dx:
-            for precision in PRECISIONS:
-                if budget.left() < 30:
-                    break
-                try:
-                    row = graph_vs_plain(dx, precision, plan.graph_steps, plan.graph_rounds, plan.scene)
-                except Exception as exc:  # noqa: BLE001
-                    row = {"dx": dx, "precision": precision, "error": f"{type(exc).__name__}: {str(exc)[:300]}"}
-                state["graph"].append(row)
-                budget.say(f"graph dx {dx} {precision}: {row}")
-                cupy.get_default_memory_pool().free_all_blocks()
-        return all("error" not in r for r in state["graph"])
-
-    def cpu_peers():
-        state["cpu_rows"] = sweep(
-            cpu_peer_specs(plan),
-            store_path,
-            run_budget=budget.left(),
-            sweep_budget=budget.left() - 30,
-            runner=run_and_release,
-        )
-        return all(r["status"] == "ok" for r in state["cpu_rows"])
-
-    env = dict(os.environ, PCABENCH_COMMIT=state["commit"])
-
-    def pytest_gpu():
-        state["pytest_gpu"] = run_logged(
-            [sys.executable, "-m", "pytest", "-m", "gpu", "-q", "-p", "no:cacheprovider", "tests"],
-            out / "pytest_gpu.log",
-            min(150, budget.left()),
-            env,
-        )
-        return state["pytest_gpu"]["exit"] in (0, 5)  # 5: every GPU test deselected or skipped (rehearsal)
-
-    def bench():
-        json_path = out / f"pytest-benchmark_{profile['id']}.json"
-        cmd = [
-            sys.executable,
-            "-m",
-            "pytest",
-            "-o",
-            "addopts=",
-            "-p",
-            "no:cacheprovider",
-            "tests/benchmarks",
-            "--benchmark-only",
-            f"--benchmark-json={json_path}",
-            "-q",
-        ]
-        if rehearse:
-            cmd += ["-k", "linkedlist and step"]
-        state["bench"] = run_logged(cmd, out / "pytest_benchmark.log", min(120, budget.left()), env)
-        return state["bench"]["exit"] == 0
-
-    def asv():
-        from .device_payload import run_asv_gpu
-
-        state["asv"] = run_asv_gpu(
-            out / "asv",
-            commits=("HEAD", H100_COMMIT),
-            budget_s=min(150, budget.left()),
-            bench=plan.asv_bench,
-            asv_args=("--quick",),
-        )
-        return all(r.get("returncode") == 0 for r in state["asv"])
-
-    def ncu():
-        if shutil.which("ncu") is None or cupy is None:
-            state["ncu"] = {"status": "no ncu or no GPU here"}
-            return True
-        state["ncu"] = run_logged(ncu_command(plan, out), out / "ncu.log", min(90, budget.left()), env)
-        return state["ncu"]["exit"] == 0
-
-    stage("profile", 0, ceilings)
-    stage("compare", 40, compare)
-    stage("sweep", 60, gpu_sweep)
-    stage("graph", 40, graph)
-    stage("cpu", 40, cpu_peers)
-    stage("asv", 60, asv)
-    stage("bench", 60, bench)
-    stage("pytest-gpu", 40, pytest_gpu)
-    stage("ncu", 45, ncu)
+    c = Check(
+        plan,
+        out,
+        budget,
+        state,
+        profile,
+        cupy,
+        Path(results) / store_name(profile["id"]),
+        rehearse,
+        dict(os.environ, PCABENCH_COMMIT=state["commit"]),
+    )
+    for stage in STAGES:
+        run_stage(stage, c)
 
     state["elapsed_s"] = budget.elapsed()
     text = markdown(profile, state)

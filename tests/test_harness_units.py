@@ -112,3 +112,29 @@ def test_step_seconds_is_the_step_stages_per_step():
     assert STEP_STAGES == ("snp", "pi", "su")
     assert step_seconds(stages, 3) == pytest.approx(2.0)
     assert math.isfinite(step_seconds(stages, 0))  # a run that failed before its first step
+
+
+def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
+    """The GPU check's stages (pcabench/gpu_check.py STAGES): a stage that raises is recorded as failed, one
+    the budget cannot start is recorded as not run, and the stages after them still run."""
+    from pathlib import Path
+
+    from pcabench import gpu_check as G
+
+    ran = []
+
+    def broken(c):
+        raise RuntimeError("no card")
+
+    def fine(c):
+        ran.append("fine")
+
+    budget = G.Budget(100.0)
+    budget.say = lambda *a, **k: None  # quiet
+    check = G.Check(G.REHEARSAL, Path("."), budget, {"stages": []}, {"id": "m"}, None, Path("s.jsonl"), True, {})
+    for stage in (G.Stage("broken", 0, broken), G.Stage("greedy", 1e9, fine), G.Stage("fine", 0, fine)):
+        G.run_stage(stage, check)
+    status = {s["stage"]: s["status"] for s in check.state["stages"]}
+    assert status["broken"].startswith("failed: RuntimeError: no card")
+    assert status["greedy"].startswith("not run:") and status["fine"] == "ok" and ran == ["fine"]
+    assert [s.name for s in G.STAGES][:3] == ["profile", "compare", "sweep"]  # the order of value
