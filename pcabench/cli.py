@@ -760,7 +760,14 @@ OPTION_NAMES = {
     "pair_loop": "--pair-loop",
     **{par.field: par.option for par in PARAMETERS if par.option[2:] != par.field and par.field != "name"},
 }
-LEADING_OPTIONS = ("dx", "cfl", "steps", "threads", "kernel", "integrator", "precision", "model", "solver")
+# a message that starts with a field an option of the same word sets ("mach must be ...") names the option
+LEADING_OPTIONS = (
+    "dx",
+    "steps",
+    "threads",
+    "solver",
+    *(par.field for par in PARAMETERS if par.option[2:] == par.field),
+)
 
 
 def option_words(message: str) -> str:
