@@ -16,16 +16,13 @@ name keeps one class for the life of the process.
 
 from __future__ import annotations
 
-import importlib
 import inspect
 import math
-import pkgutil
 import re
-import warnings
 from functools import lru_cache
-from importlib import metadata
 from pathlib import Path
 
+from ..plugins import builtin_classes, entry_point_classes
 from .base import Kernel
 
 ENTRY_POINT_GROUP = "pcabench.kernels"
@@ -41,17 +38,7 @@ class KernelPluginWarning(UserWarning):
 
 
 def _builtin() -> list[type[Kernel]]:
-    found = []
-    for info in sorted(pkgutil.iter_modules([str(Path(__file__).parent)]), key=lambda m: m.name):
-        if info.name in ("base", "registry"):
-            continue
-        module = importlib.import_module(f"{__package__}.{info.name}")
-        found += [
-            cls
-            for _, cls in inspect.getmembers(module, inspect.isclass)
-            if issubclass(cls, Kernel) and cls.__module__ == module.__name__ and cls.__dict__.get("name")
-        ]
-    return found
+    return builtin_classes(__package__, Path(__file__).parent, Kernel)
 
 
 def _problem(cls, taken) -> str | None:
@@ -76,23 +63,7 @@ def _problem(cls, taken) -> str | None:
 
 
 def _plugins(taken: set) -> list[type[Kernel]]:
-    found = []
-    for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
-        where = f"entry point {entry.name!r} of group {ENTRY_POINT_GROUP} ({entry.value})"
-        try:
-            cls = entry.load()
-        except Exception as exc:  # noqa: BLE001 - a broken plug-in must not take pcabench down
-            warnings.warn(
-                f"{where} left out: it does not load ({type(exc).__name__}: {exc})", KernelPluginWarning, stacklevel=2
-            )
-            continue
-        why = _problem(cls, taken)
-        if why:
-            warnings.warn(f"{where} left out: {why}", KernelPluginWarning, stacklevel=2)
-        else:
-            found.append(cls)
-            taken.add(cls.name)
-    return found
+    return entry_point_classes(ENTRY_POINT_GROUP, _problem, taken, KernelPluginWarning)
 
 
 @lru_cache(maxsize=None)

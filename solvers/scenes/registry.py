@@ -9,14 +9,11 @@ left out with one :class:`~solvers.registry.PluginWarning`.
 
 from __future__ import annotations
 
-import importlib
 import inspect
-import pkgutil
-import warnings
 from functools import lru_cache
-from importlib import metadata
 from pathlib import Path
 
+from ..plugins import builtin_classes, entry_point_classes
 from .base import SceneKind
 
 ENTRY_POINT_GROUP = "pcabench.scenes"
@@ -28,40 +25,20 @@ class ScenePluginWarning(UserWarning):
 
 
 def _builtin() -> list[type[SceneKind]]:
-    found = []
-    for info in sorted(pkgutil.iter_modules([str(Path(__file__).parent)]), key=lambda m: m.name):
-        if info.name in ("base", "registry"):
-            continue
-        module = importlib.import_module(f"{__package__}.{info.name}")
-        found += [
-            cls
-            for _, cls in inspect.getmembers(module, inspect.isclass)
-            if issubclass(cls, SceneKind) and cls.__module__ == module.__name__ and cls.__dict__.get("name")
-        ]
-    return found
+    return builtin_classes(__package__, Path(__file__).parent, SceneKind)
+
+
+def _problem(cls, taken) -> str | None:
+    """Why ``cls`` cannot be a scene under its name (None: it can)."""
+    if not (inspect.isclass(cls) and issubclass(cls, SceneKind)) or not cls.__dict__.get("name"):
+        return "not a SceneKind subclass with a name of its own"
+    if cls.name in taken:
+        return f"the scene name {cls.name!r} is taken"
+    return None
 
 
 def _plugins(taken: set) -> list[type[SceneKind]]:
-    found = []
-    for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
-        where = f"entry point {entry.name!r} of group {ENTRY_POINT_GROUP} ({entry.value})"
-        try:
-            cls = entry.load()
-        except Exception as exc:  # noqa: BLE001 - a broken plug-in must not take pcabench down
-            warnings.warn(
-                f"{where} left out: it does not load ({type(exc).__name__}: {exc})", ScenePluginWarning, stacklevel=2
-            )
-            continue
-        if not (inspect.isclass(cls) and issubclass(cls, SceneKind)) or not cls.__dict__.get("name"):
-            warnings.warn(
-                f"{where} left out: not a SceneKind subclass with a name of its own", ScenePluginWarning, stacklevel=2
-            )
-        elif cls.name in taken:
-            warnings.warn(f"{where} left out: the scene name {cls.name!r} is taken", ScenePluginWarning, stacklevel=2)
-        else:
-            found.append(cls)
-            taken.add(cls.name)
-    return found
+    return entry_point_classes(ENTRY_POINT_GROUP, _problem, taken, ScenePluginWarning)
 
 
 @lru_cache(maxsize=None)
