@@ -32,6 +32,7 @@ from solvers import (
     registry,
     scene_kind,
     scene_names,
+    scenes,
 )
 
 from . import __version__, jsonout, memory, paths
@@ -205,6 +206,11 @@ def domain_of(args) -> dict:
 def scene_from_args(args) -> Scene:
     """The scene of the options, bounded by the memory this process may use (one line if it does not fit)."""
     given = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt) is not None}
+    if "x_max" in given and not scene_kind(given.get("name", DEFAULT_SCENE)).walls:
+        walled = ", ".join(name for name, kind in scenes().items() if kind.walls)
+        raise OptionError(
+            f"--wall-x applies to the scenes with a wall ({walled}), not to {given.get('name', DEFAULT_SCENE)}"
+        )
     return Scene(
         dx=args.dx,
         steps=args.steps,
@@ -758,7 +764,11 @@ OPTION_NAMES = {
     "t_end": "--t-end",
     "strip_height": "--strip-height",
     "pair_loop": "--pair-loop",
-    **{par.field: par.option for par in PARAMETERS if par.option[2:] != par.field and par.field != "name"},
+    **{
+        par.field: par.option
+        for par in PARAMETERS
+        if par.option[2:] != par.field and par.field not in ("name", "x_max")  # x_max: a wall only in some scenes
+    },
 }
 # a message that starts with a field an option of the same word sets ("mach must be ...") names the option
 LEADING_OPTIONS = (

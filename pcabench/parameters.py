@@ -28,6 +28,7 @@ class Parameter:
     help: str | Callable[[], str]  # without the default, which Scene states
     choices: Callable[[], tuple] | None = None  # the allowed values (read at call: the registries grow)
     numeric: bool = False  # a number checked by Scene (its range there)
+    per_scene: bool = False  # its default is the scene kind's (solvers/scenes/), stated in ``help``
 
     @property
     def dest(self) -> str:
@@ -40,6 +41,8 @@ class Parameter:
     def describe(self) -> str:
         """The option's help: what it is and its default."""
         text = self.help() if callable(self.help) else self.help
+        if self.per_scene:
+            return text
         value = self.default()
         return f"{text} (default {value:g})" if isinstance(value, float) else f"{text} (default {value})"
 
@@ -57,6 +60,15 @@ def _kernel_help() -> str:
     return "SPH kernel, truncated at --cutoff" + (f" ({compact})" if compact else "")
 
 
+def _wall_help() -> str:
+    walled = [
+        f"{name} {kind.domain.get('x_max', Scene.default('x_max')):g}" for name, kind in scenes().items() if kind.walls
+    ]
+    return (
+        "the rigid wall's x, m: the domain's right edge, in the scenes with walls (default " + ", ".join(walled) + ")"
+    )
+
+
 def _scene_help() -> str:
     return "the problem: " + "; ".join(f"{name}: {kind.summary}" for name, kind in scenes().items())
 
@@ -65,6 +77,8 @@ PROBLEM = (
     Parameter("name", "--scene", _scene_help, scene_names),
     Parameter("mach", "--mach", "the pulse's amplitude as a Mach number", numeric=True),
     Parameter("pulse_width", "--pulse-width", "the pulse's width, m", numeric=True),
+    Parameter("pulse_center", "--pulse-center", "the pulse's centre x at t = 0, m", numeric=True),
+    Parameter("x_max", "--wall-x", _wall_help, numeric=True, per_scene=True),
 )
 NUMERICS = (
     Parameter("precision", "--precision", "floating-point precision", lambda: PRECISIONS),

@@ -32,7 +32,6 @@ from functools import lru_cache
 
 import numpy as np
 
-from .analytic import errors as analytic_errors
 from .integrators import step_program
 
 STABLE_GROWTH = 1e-9  # spectral radius above 1 + this is unstable
@@ -146,16 +145,16 @@ def evolve(solver: ModeSolver, integrator: str, steps: int) -> ModeSolver:
 
 
 def predicted_velocity(scene) -> tuple[np.ndarray, np.ndarray, float]:
-    """(x, u, t): u on one lattice row at the run's final time, predicted mode by mode."""
-    nx = scene.nx
-    x = scene.x_lo + (np.arange(nx) + 0.5) * scene.dx
-    xi = (x - scene.pulse_center) / scene.pulse_width
-    u0 = scene.c0 * scene.mach * np.exp(-xi * xi)
-    k = 2.0 * math.pi * np.fft.fftfreq(nx, d=scene.dx)
+    """(x, u, t): u on one lattice row at the run's final time, predicted mode by mode from the scene kind's
+    initial row (with walls, on its mirror extension: solvers/scenes/base.py)."""
+    x = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx
+    u0, v0, drho0 = scene.kind.initial_fields(scene, x, np.zeros_like(x), np)
+    u0, _, drho0, keep = scene.kind.mirror_extension(scene, u0, v0, drho0)
+    k = 2.0 * math.pi * np.fft.fftfreq(u0.size, d=scene.dx)
     d, _ = symbol(scene, k)
-    modes = ModeSolver(d, np.fft.fft(scene.rho0 * u0 / scene.c0), np.fft.fft(u0), scene.rho0, scene.c0, scene.dt)
+    modes = ModeSolver(d, np.fft.fft(drho0), np.fft.fft(u0), scene.rho0, scene.c0, scene.dt)
     evolve(modes, scene.integrator, scene.n_steps)
-    return x, np.fft.ifft(modes.u).real, modes.t
+    return x, np.fft.ifft(modes.u).real[keep], modes.t
 
 
 def amplification_radius(integrator: str, z) -> np.ndarray:
@@ -221,18 +220,23 @@ def predict(scene) -> Prediction:
 
 
 def predict_plane(scene) -> Prediction:
-    """The plane pulse's prediction: the lattice row's spectrum evolved mode by mode (waves along x)."""
+    """A plane scene's prediction: the lattice row's spectrum evolved mode by mode (waves along x), scored with
+    the scene kind's own measures."""
+    from .interface import Fields
+
     x, u, t = predicted_velocity(scene)
-    err = analytic_errors(scene, x, u, t)
+    zero = np.zeros_like(x)
+    measures = scene.kind.errors(scene, Fields(x=x, y=zero, u=u, v=zero, drho=zero, t=t))
     k = 1.0 / scene.pulse_width
     d = float(symbol(scene, np.array([k]))[0][0])
     return Prediction(
-        predicted_error=err.mse,
-        predicted_me=err.me,
+        predicted_error=measures.pop("mse"),
+        predicted_me=measures.pop("me"),
         stable_cfl=stable_cfl(scene),
         t_end=t,
         lattice_phase_error=d / k - 1.0,
         step_phase_error=step_phase_angle(scene.integrator, scene.c0 * d * scene.dt) / (scene.c0 * k * scene.dt) - 1.0,
+        measures=measures or None,
     )
 
 
@@ -262,8 +266,9 @@ def predicted_fields_2d(scene) -> tuple:
     ys = scene.y_lo + (np.arange(scene.ny) + 0.5) * scene.dx
     x, y = np.meshgrid(xs, ys)
     u0, v0, drho0 = scene.kind.initial_fields(scene, x, y, np)
+    u0, v0, drho0, keep = scene.kind.mirror_extension(scene, u0, v0, drho0)  # walls: the periodic extension
     kx, ky = np.meshgrid(
-        2.0 * math.pi * np.fft.fftfreq(scene.nx, d=scene.dx), 2.0 * math.pi * np.fft.fftfreq(scene.ny, d=scene.dx)
+        2.0 * math.pi * np.fft.fftfreq(u0.shape[1], d=scene.dx), 2.0 * math.pi * np.fft.fftfreq(scene.ny, d=scene.dx)
     )
     dx_, dy_ = symbol(scene, kx, ky)
     d = np.hypot(dx_, dy_)
@@ -274,9 +279,9 @@ def predicted_fields_2d(scene) -> tuple:
     modes = ModeSolver(d.ravel(), np.fft.fft2(drho0).ravel(), along.ravel(), scene.rho0, scene.c0, scene.dt)
     evolve(modes, scene.integrator, scene.n_steps)
     along = modes.u.reshape(d.shape)
-    u = np.fft.ifft2(ex * along - ey * across).real
-    v = np.fft.ifft2(ey * along + ex * across).real
-    return x, y, np.fft.ifft2(modes.drho.reshape(d.shape)).real, u, v, modes.t
+    u = np.fft.ifft2(ex * along - ey * across).real[:, keep]
+    v = np.fft.ifft2(ey * along + ex * across).real[:, keep]
+    return x, y, np.fft.ifft2(modes.drho.reshape(d.shape)).real[:, keep], u, v, modes.t
 
 
 def predict_2d(scene, kind) -> Prediction:

@@ -295,7 +295,9 @@ def cell_grid(scene: Scene) -> tuple:
     """(cw, ch, ncx, ncy, x_grid, width): cells at least one cutoff tall, filling the periodic height, and in
     x either one cutoff wide with one spare each side for particles drifting past free edges (the grid's
     left edge ``x_grid`` one cell left of the lattice, ``width`` 0), or at least one cutoff wide filling
-    the periodic width (``x_grid`` 0, ``width`` the period, m)."""
+    the periodic width (``x_grid`` 0, ``width`` the period, m), or, with a rigid wall, at least one cutoff
+    wide filling the lattice's width, a wall being the grid's edge (its column holds every particle with
+    mirror neighbours, and they are in it) and a free edge opposite keeping its spare cell."""
     ncy = max(int(math.floor(scene.height / scene.cutoff + 1e-9)), 1)
     if scene.periodic_x:
         ncx = int(math.floor(scene.width / scene.cutoff + 1e-9))
@@ -305,6 +307,16 @@ def cell_grid(scene: Scene) -> tuple:
                 f"x-periodic {scene.name} scene (got {scene.width:.6g} m)"
             )
         return scene.width / ncx, scene.height / ncy, ncx, ncy, 0.0, scene.width
+    if scene.walls:
+        inside = int(math.floor(scene.width / scene.cutoff + 1e-9))
+        if inside < 3:
+            raise SceneError(
+                f"x_max - x_min must hold 3 cells of one cutoff ({3 * scene.cutoff:.6g} m) for the "
+                f"walled {scene.name} scene (got {scene.width:.6g} m)"
+            )
+        cw = scene.width / inside
+        spare_left, spare_right = "x_min" not in scene.walls, "x_max" not in scene.walls
+        return cw, scene.height / ncy, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0
     ncx = int(math.ceil((scene.x_max - scene.x_min) / scene.cutoff)) + 2
     return scene.cutoff, scene.height / ncy, ncx, ncy, -scene.cutoff, 0.0
 

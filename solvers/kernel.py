@@ -27,7 +27,10 @@ C0SQ = 6  # c0^2, m^2/s^2
 NONLIN = 7  # 1 where rho = rho0 + drho in the coefficients, 0 in the linear model
 ZERO = 8  # 0 in the solver's float type (accumulators start from it)
 NX = 9  # lattice columns in the periodic width, 0 where the x edges are free
-SLOTS = 10
+WALL_LO = 10  # 1 where a rigid wall is the lattice's left edge (mirror particles across it), else 0
+WALL_HI = 11  # 1 where a rigid wall is the lattice's right edge, else 0
+MIRROR_HI = 12  # 2 nx - 1: the right wall mirrors lattice column lx onto column MIRROR_HI - lx (the left: -1 - lx)
+SLOTS = 13
 
 
 def constants(scene, dtype) -> tuple:
@@ -45,6 +48,9 @@ def constants(scene, dtype) -> tuple:
         NONLIN: nonlin,
         ZERO: 0.0,
         NX: float(scene.nx) if scene.periodic_x else 0.0,
+        WALL_LO: 1.0 if "x_min" in scene.kind.walls else 0.0,
+        WALL_HI: 1.0 if "x_max" in scene.kind.walls else 0.0,
+        MIRROR_HI: float(2 * scene.nx - 1),
     }
     t = np.dtype(dtype).type
     return tuple(t(values[i]) for i in range(SLOTS))

@@ -29,6 +29,7 @@ import numpy as np
 from . import pairlist
 from .backend import cpu_pairs, cpu_updates, use_threads
 from .celllist import CellListSolver
+from .kernel import NONLIN, RHO0
 from .scene import SceneError
 
 
@@ -61,6 +62,24 @@ def sweeps(precision: str, kernel: str, parallel: bool) -> dict:
         for i in prange(lx.shape[0]):
             ax[i], ay[i] = P.momentum_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
 
+    def wall_continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
+        """out += the mirror particles' part of d(drho)/dt, over the particles of the grid's edge columns only
+        (the pair list holds the real pairs; at a wall the mirrors are the pairs across it)."""
+        for cy in prange(ncy):
+            for c in (cy * ncx, cy * ncx + ncx - 1):
+                for i in range(begin[c], begin[c + 1]):
+                    rho = k[RHO0] + k[NONLIN] * drho[i]
+                    out[i] += rho * P.continuity_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, k)
+
+    def wall_momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
+        """ax, ay -= the mirror particles' part of the momentum sums, over the grid's edge columns only."""
+        for cy in prange(ncy):
+            for c in (cy * ncx, cy * ncx + ncx - 1):
+                for i in range(begin[c], begin[c + 1]):
+                    bx, by = P.momentum_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
+                    ax[i] -= bx
+                    ay[i] -= by
+
     def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, k):
         total = 0
         for i in prange(lx.shape[0]):
@@ -77,6 +96,8 @@ def sweeps(precision: str, kernel: str, parallel: bool) -> dict:
         "continuity": jit(continuity),
         "momentum": jit(momentum),
         "neighbours": jit(neighbours),
+        "wall_continuity": jit(wall_continuity),
+        "wall_momentum": jit(wall_momentum),
         "cell_ids": jit(cell_ids),
         **cpu_updates(precision, parallel),
     }
@@ -95,7 +116,7 @@ class LinkedListCPU(CellListSolver):
     )
     pair_loops = ("list", "gather")
     threaded = True
-    boundaries = ("free-x", "periodic-x", "periodic-y")
+    boundaries = ("free-x", "periodic-x", "periodic-y", "wall-x")
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         super().__init__(threads=threads or 1, pair_loop=pair_loop)
@@ -204,10 +225,15 @@ class LinkedListCPU(CellListSolver):
         if self.threads > 1:
             use_threads(self.threads)
         a = self.arrays
+        walls = bool(self.scene.walls)  # the list holds the real pairs; the mirrors' part is added at the walls
         if continuity:
             self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+            if walls:
+                self.launch("wall_continuity", *self.geometry(), a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
         if momentum:
             self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
+            if walls:
+                self.launch("wall_momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
 
     def count_neighbours(self) -> int:
         """On a cell list of its own, over copies of the positions in its cell order (the state untouched)."""

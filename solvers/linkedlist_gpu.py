@@ -43,7 +43,7 @@ class LinkedListGPU(CellListSolver):
     device = "gpu"
     serial_why = "one GPU thread per particle"
     resources = {"timing": 1, "GPU": 1}
-    boundaries = ("free-x", "periodic-x", "periodic-y")
+    boundaries = ("free-x", "periodic-x", "periodic-y", "wall-x")
 
     @classmethod
     def available(cls) -> None:

@@ -12,7 +12,12 @@ float type) plus a displacement (sx, sy, m): r_ij = (lx_i - lx_j) dx +
 (sx_i - sx_j). The large part is exact, so float32 keeps its accuracy at
 small dx (absolute float32 coordinates lose up to 2 % of the momentum term at
 dx = 0.004 m). Periodicity in y is an exact shift by ny rows, in x (scenes
-periodic in x: ``k[NX]`` columns, 0 for free edges) by nx columns. A moving
+periodic in x: ``k[NX]`` columns, 0 for free edges) by nx columns. A rigid
+wall at an x edge (``k[WALL_LO]``, ``k[WALL_HI]``) acts through mirror
+particles computed where they are needed, never stored: the image of
+particle j across the wall, at the mirrored position with the normal velocity
+reversed and everything else j's (:func:`ranges` with ``mirror``), so that
+the mirrors of moving particles follow them at every sweep. A moving
 particle that crosses a periodic seam has its lattice coordinate moved by a
 whole period at the next search (:func:`wrap_at`), so that its cell and its
 coordinates agree.
@@ -29,7 +34,7 @@ of :func:`solvers.kernel.constants`, read by its named slots.
 import math
 from types import ModuleType
 
-from .kernel import C0SQ, NONLIN, NX, NY, RC2, RHO0, SPACING, ZERO
+from .kernel import C0SQ, MIRROR_HI, NONLIN, NX, NY, RC2, RHO0, SPACING, WALL_HI, WALL_LO, ZERO
 from .kernels import kernel_named
 
 
@@ -42,44 +47,68 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
     """
     gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg)))
 
-    @jit
-    def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):
-        """sum_j vol_j u_ij . r_ij G_ij over the particles j0..j1-1 (lyi already shifted)."""
-        acc = k[ZERO]
-        for j in range(j0, j1):
-            rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-            r2 = rx * rx + ry * ry
-            if r2 < k[RC2]:
-                g = gradient(r2, k)
-                acc += vol[j] * g * ((ui - u[j]) * rx + (vi - v[j]) * ry)
-        return acc
+    def ranges(mirror: bool) -> tuple:
+        """The three pair sums over the particles j0..j1-1: of the particles themselves, or (``mirror``) of their
+        mirror images across a rigid wall, x_j' = 2 x_w - x_j with the normal velocity reversed (u_j' = -u_j) and
+        the same v, drho, mass and coefficients. For mirrors ``lxi`` is i's column minus the wall's mirror sum M
+        (the image of column lx_j is column M - lx_j, its displacement -sx_j), so that
+        r_ij' = (lxi + lx_j) dx + (sx_i + sx_j), exact like every separation. ``mirror`` is a compile-time
+        constant: each variant has its own loop."""
 
-    @jit
-    def momentum_range(j0, j1, lxi, lyi, sxi, syi, pri, lx, ly, sx, sy, mass, pr, k):
-        """sum_j m_j (pr_i + pr_j) G_ij r_ij over j0..j1-1, as (x, y) components."""
-        ax = k[ZERO]
-        ay = k[ZERO]
-        for j in range(j0, j1):
-            rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-            r2 = rx * rx + ry * ry
-            if r2 < k[RC2]:
-                w = mass[j] * (pri + pr[j]) * gradient(r2, k)
-                ax += w * rx
-                ay += w * ry
-        return ax, ay
+        @jit
+        def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):
+            """sum_j vol_j u_ij . r_ij G_ij over the particles j0..j1-1 (lyi already shifted)."""
+            acc = k[ZERO]
+            for j in range(j0, j1):
+                if mirror:
+                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+                    uij = ui + u[j]
+                else:
+                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+                    uij = ui - u[j]
+                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+                r2 = rx * rx + ry * ry
+                if r2 < k[RC2]:
+                    g = gradient(r2, k)
+                    acc += vol[j] * g * (uij * rx + (vi - v[j]) * ry)
+            return acc
 
-    @jit
-    def neighbours_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, k):
-        """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
-        count = 0
-        for j in range(j0, j1):
-            rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-            if rx * rx + ry * ry < k[RC2]:
-                count += 1
-        return count
+        @jit
+        def momentum_range(j0, j1, lxi, lyi, sxi, syi, pri, lx, ly, sx, sy, mass, pr, k):
+            """sum_j m_j (pr_i + pr_j) G_ij r_ij over j0..j1-1, as (x, y) components."""
+            ax = k[ZERO]
+            ay = k[ZERO]
+            for j in range(j0, j1):
+                if mirror:
+                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+                else:
+                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+                r2 = rx * rx + ry * ry
+                if r2 < k[RC2]:
+                    w = mass[j] * (pri + pr[j]) * gradient(r2, k)
+                    ax += w * rx
+                    ay += w * ry
+            return ax, ay
+
+        @jit
+        def neighbours_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, k):
+            """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
+            count = 0
+            for j in range(j0, j1):
+                if mirror:
+                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+                else:
+                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+                if rx * rx + ry * ry < k[RC2]:
+                    count += 1
+            return count
+
+        return continuity_range, momentum_range, neighbours_range
+
+    continuity_range, momentum_range, neighbours_range = ranges(mirror=False)
+    continuity_mirror, momentum_mirror, neighbours_mirror = ranges(mirror=True)
 
     # ---------------------------------------------------------------- cell list
     @jit
@@ -119,14 +148,19 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
     @jit
     def stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k):
         """Row ``dcy`` (-1, 0, 1) of particle i's 3x3 cell stencil as two ranges of particles:
-        (j0, j1, lyi, q0, q1, lxq), lyi being i's row shifted across the y seam and lxq i's column shifted
-        across the x seam for the second range (empty unless the row wraps in x).
+        (j0, j1, lyi, q0, q1, lxq), lyi being i's row shifted across the y seam and lxq i's column for the
+        second range, the one across the x boundary (empty unless i's cell is at a periodic seam or a wall).
 
         Cells are numbered cy * ncx + cx and particles are sorted by cell, so the
         three cells of a stencil row are one contiguous range [j0, j1), or, where a
         periodic x seam cuts the row, two: [j0, j1) and the cell beyond the seam
         [q0, q1). Crossing a periodic boundary shifts particle i by a whole period
-        instead of wrapping every pair.
+        instead of wrapping every pair. At a rigid wall the second range is the
+        wall's own column of cells, whose mirror images are i's neighbours across
+        the wall (lxq: i's column minus the wall's mirror sum, for the ``mirror``
+        sums); the cells are at least a cutoff wide and the wall is the grid's
+        edge, so only particles in a wall's column have mirror neighbours, and
+        only in that column.
         """
         c = cell[i]
         cx = c % ncx
@@ -151,39 +185,96 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
             elif cx == ncx - 1:  # the first cell, across the seam on the right
                 q0, q1 = begin[row], begin[row + 1]
                 lxq = lx[i] - k[NX]
+        elif cx == 0 and k[WALL_LO] > 0:  # the left wall's column, mirrored onto columns -1 - lx
+            q0, q1 = begin[row], begin[row + 1]
+            lxq = lx[i] + k[WALL_LO]
+        elif cx == ncx - 1 and k[WALL_HI] > 0:  # the right wall's column, mirrored onto columns 2 nx - 1 - lx
+            q0, q1 = begin[row + ncx - 1], begin[row + ncx]
+            lxq = lx[i] - k[MIRROR_HI]
         return begin[row + x0], begin[row + x1 + 1], lyi, q0, q1, lxq
 
     @jit
+    def on_x_boundary(i, cell, ncx):
+        """Whether particle i's cell is in the grid's first or last column (a seam or a wall may be there)."""
+        cx = cell[i] % ncx
+        return cx == 0 or cx == ncx - 1
+
+    @jit
+    def continuity_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, k):
+        """The part of sum_j vol_j u_ij . r_ij G_ij from across particle i's x boundary: the periodic images
+        beyond a seam, or the mirror particles beyond a wall (0 inside the grid)."""
+        acc = k[ZERO]
+        if not on_x_boundary(i, cell, ncx):
+            return acc
+        for dcy in range(-1, 2):
+            _, _, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
+            if k[NX] > 0:
+                acc += continuity_range(q0, q1, lxq, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
+            else:
+                acc += continuity_mirror(q0, q1, lxq, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
+        return acc
+
+    @jit
+    def momentum_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k):
+        """The part of sum_j m_j (pr_i + pr_j) G_ij r_ij from across i's x boundary, as (x, y)."""
+        ax = k[ZERO]
+        ay = k[ZERO]
+        if not on_x_boundary(i, cell, ncx):
+            return ax, ay
+        for dcy in range(-1, 2):
+            _, _, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
+            if k[NX] > 0:
+                bx, by = momentum_range(q0, q1, lxq, lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
+            else:
+                bx, by = momentum_mirror(q0, q1, lxq, lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
+            ax += bx
+            ay += by
+        return ax, ay
+
+    @jit
+    def neighbours_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k):
+        """Neighbours of particle i across its x boundary (periodic images or mirrors)."""
+        count = 0
+        if not on_x_boundary(i, cell, ncx):
+            return count
+        for dcy in range(-1, 2):
+            _, _, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
+            if k[NX] > 0:
+                count += neighbours_range(q0, q1, lxq, lyi, sx[i], sy[i], lx, ly, sx, sy, k)
+            else:
+                count += neighbours_mirror(q0, q1, lxq, lyi, sx[i], sy[i], lx, ly, sx, sy, k)
+        return count
+
+    @jit
     def continuity_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, k):
-        """d(drho_i)/dt from the 3x3 cells around particle i, kg/m^3/s."""
+        """d(drho_i)/dt from the 3x3 cells around particle i and across its x boundary, kg/m^3/s."""
         acc = k[ZERO]
         for dcy in range(-1, 2):
-            j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
+            j0, j1, lyi, _, _, _ = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
             acc += continuity_range(j0, j1, lx[i], lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
-            acc += continuity_range(q0, q1, lxq, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
+        acc += continuity_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, k)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
     @jit
     def momentum_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k):
-        """du_i/dt from the 3x3 cells around particle i, m/s^2, as (x, y)."""
+        """du_i/dt from the 3x3 cells around particle i and across its x boundary, m/s^2, as (x, y)."""
         ax = k[ZERO]
         ay = k[ZERO]
         for dcy in range(-1, 2):
-            j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
+            j0, j1, lyi, _, _, _ = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
             bx, by = momentum_range(j0, j1, lx[i], lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
-            cx_, cy_ = momentum_range(q0, q1, lxq, lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
-            ax += bx + cx_
-            ay += by + cy_
-        return -ax, -ay
+            ax += bx
+            ay += by
+        bx, by = momentum_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
+        return -(ax + bx), -(ay + by)
 
     @jit
     def neighbours_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k):
-        """Neighbours of particle i within the cutoff, itself excluded."""
-        count = 0
+        """Neighbours of particle i within the cutoff, itself excluded (mirror particles counted)."""
+        count = neighbours_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k)
         for dcy in range(-1, 2):
-            j0, j1, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
+            j0, j1, lyi, _, _, _ = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
             count += neighbours_range(j0, j1, lx[i], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
-            count += neighbours_range(q0, q1, lxq, lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
     # ---------------------------------------------------------------- all pairs
@@ -216,6 +307,12 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
             lyi = minimum_image_row(ly[i], ly[j], k)
             lxi = minimum_image_column(lx[i], lx[j], k)
             acc += continuity_range(j, j + 1, lxi, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
+            if k[WALL_LO] > 0:  # j's mirror across each wall, tested like every other pair
+                lxm = lx[i] + k[WALL_LO]
+                acc += continuity_mirror(j, j + 1, lxm, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
+            if k[WALL_HI] > 0:
+                lxm = lx[i] - k[MIRROR_HI]
+                acc += continuity_mirror(j, j + 1, lxm, lyi, sx[i], sy[i], u[i], v[i], lx, ly, sx, sy, u, v, vol, k)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
     @jit
@@ -229,6 +326,18 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
             bx, by = momentum_range(j, j + 1, lxi, lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k)
             ax += bx
             ay += by
+            if k[WALL_LO] > 0:
+                bx, by = momentum_mirror(
+                    j, j + 1, lx[i] + k[WALL_LO], lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k
+                )
+                ax += bx
+                ay += by
+            if k[WALL_HI] > 0:
+                bx, by = momentum_mirror(
+                    j, j + 1, lx[i] - k[MIRROR_HI], lyi, sx[i], sy[i], pr[i], lx, ly, sx, sy, mass, pr, k
+                )
+                ax += bx
+                ay += by
         return -ax, -ay
 
     @jit
@@ -238,6 +347,10 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
             lyi = minimum_image_row(ly[i], ly[j], k)
             lxi = minimum_image_column(lx[i], lx[j], k)
             count += neighbours_range(j, j + 1, lxi, lyi, sx[i], sy[i], lx, ly, sx, sy, k)
+            if k[WALL_LO] > 0:
+                count += neighbours_mirror(j, j + 1, lx[i] + k[WALL_LO], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
+            if k[WALL_HI] > 0:
+                count += neighbours_mirror(j, j + 1, lx[i] - k[MIRROR_HI], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
     # ---- per particle: the sweeps' coefficients (PI) and the system update (SU), one particle each, so that a
@@ -271,6 +384,13 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str) -> ModuleType:
         continuity_range=continuity_range,
         momentum_range=momentum_range,
         neighbours_range=neighbours_range,
+        continuity_mirror=continuity_mirror,
+        momentum_mirror=momentum_mirror,
+        neighbours_mirror=neighbours_mirror,
+        on_x_boundary=on_x_boundary,
+        continuity_across=continuity_across,
+        momentum_across=momentum_across,
+        neighbours_across=neighbours_across,
         cell_index=cell_index,
         stencil_row=stencil_row,
         continuity_cells=continuity_cells,

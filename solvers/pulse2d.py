@@ -111,6 +111,7 @@ def periodic_linear(
     rho0: float,
     c0: float,
     t: float,
+    images: tuple = (),
 ) -> PeriodicPulse:
     """Exact solution of the linear equations at time ``t`` (s) on the periodic box
     [x_lo, x_lo + nx dx) x [y_lo, y_lo + ny dx) (m), sampled at x = x_lo + (i+0.5) dx, y = y_lo + (j+0.5) dx.
@@ -121,13 +122,18 @@ def periodic_linear(
     (w = c0 |k|): drho_hat(t) = drho_hat(0) cos(w t), u_hat(t) = -i (c0/rho0) (k/|k|) drho_hat(0) sin(w t);
     the k = 0 mode keeps its constant drho and zero velocity. The fields are the real parts of the
     inverse FFT (the imaginary parts only come from the Nyquist modes, which a resolved pulse leaves empty).
+    ``images``: x centres (m) of further pulses at the same height, summed with the first at t = 0 (a wall's
+    mirror image: the even extension of a walled box is periodic, solvers/scenes/pulse_wall.py).
     Returns a `PeriodicPulse` (drho kg/m^3, u and v m/s, shape (ny, nx), and ``at`` for displaced points).
     """
     x = x_lo + (np.arange(nx) + 0.5) * dx
     y = y_lo + (np.arange(ny) + 0.5) * dx
-    ddx = _wrap(x - xc, nx * dx)[None, :]
     ddy = _wrap(y - yc, ny * dx)[:, None]
-    d0 = np.fft.fft2(gaussian_pulse(ddx**2 + ddy**2, b, mach, rho0))
+    sampled = 0.0
+    for centre in (xc, *images):
+        ddx = _wrap(x - centre, nx * dx)[None, :]
+        sampled = sampled + gaussian_pulse(ddx**2 + ddy**2, b, mach, rho0)
+    d0 = np.fft.fft2(sampled)
     kx = 2.0 * np.pi * np.fft.fftfreq(nx, dx)[None, :]
     ky = 2.0 * np.pi * np.fft.fftfreq(ny, dx)[:, None]
     kk = np.sqrt(kx**2 + ky**2)

@@ -129,6 +129,11 @@ class Scene:
         ):
             finite(name)
         need(self.dx > 0, f"dx must be > 0 m (got {self.dx})")
+        if "x_max" in self.kind.walls:
+            need(
+                self.x_max > self.x_min,
+                f"--wall-x must be right of the domain's left edge x_min = {self.x_min:g} m (got {self.x_max:g})",
+            )
         need(self.x_max > self.x_min, f"x_max must be > x_min (got {self.x_min}..{self.x_max})")
         need(self.y_max > self.y_min, f"y_max must be > y_min (got {self.y_min}..{self.y_max})")
         if self.strip_height is not None:
@@ -212,11 +217,11 @@ class Scene:
             f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)",
         )
         need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
-        if self.periodic_x:
+        if self.periodic_x or self.kind.walls:
             need(
                 self.width >= least * (1 - 1e-9),
-                f"x_max - x_min must be at least 3 cutoffs = {least:.6g} m at dx = {self.dx} for the x-periodic "
-                f"{self.name} scene (got {self.width:.6g} m)",
+                f"x_max - x_min must be at least 3 cutoffs = {least:.6g} m at dx = {self.dx} for the "
+                f"{'x-periodic' if self.periodic_x else 'walled'} {self.name} scene (got {self.width:.6g} m)",
             )
         breaking = self.kind.breaking_time(self)
         need(
@@ -295,7 +300,19 @@ class Scene:
 
     @property
     def x_lo(self) -> float:
+        """Left edge of the lattice, m: x_min, or where the only wall is the right edge, x_max - nx dx (the
+        lattice flush with the wall, its last column half a spacing from it)."""
+        if self.kind.walls == ("x_max",):
+            return self.x_max - self.width
         return self.x_min
+
+    @property
+    def walls(self) -> dict:
+        """{edge: x of the rigid wall there, m} for the scene kind's walls ("x_min", "x_max"): the lattice's
+        edges, half a spacing from its first and last columns (with two walls the right one is at
+        x_min + nx dx, within dx/2 of x_max)."""
+        edges = {"x_min": self.x_lo, "x_max": self.x_lo + self.width}
+        return {edge: edges[edge] for edge in self.kind.walls}
 
     @property
     def n_particles(self) -> int:

@@ -5,8 +5,10 @@ the entry-point group ``pcabench.scenes``) with a ``name``. It states
 
 * ``summary``: one line for --help;
 * ``periodic``: the axes that are periodic ("x", "y"); the others have free
-  edges. :meth:`boundaries` turns them into the boundary kinds a solver must
-  support (``free-x``, ``periodic-x``, ``periodic-y``);
+  edges, except the x edges named in ``walls`` ("x_min", "x_max"), which are
+  rigid walls (mirror particles, solvers/pairs.py). :meth:`boundaries` turns
+  them into the boundary kinds a solver must support (``free-x``,
+  ``periodic-x``, ``periodic-y``, ``wall-x``);
 * ``domain``: its default domain (x_min, x_max, y_min, y_max, m), where it
   differs from the paper's;
 * ``fields``: the fields its error measures name; ``primary`` the one the
@@ -24,9 +26,28 @@ from __future__ import annotations
 
 import math
 
-BOUNDARY_KINDS = ("free-x", "periodic-x", "periodic-y")
+BOUNDARY_KINDS = ("free-x", "periodic-x", "periodic-y", "wall-x")
 MACH_RANGE = (1e-6, 0.3)  # amplitudes a scene accepts: acoustic (linear) to weakly nonlinear
 PULSE_WIDTH_RANGE = (0.1, 20.0)  # m
+
+
+def wall_measures(scene, x, diff, ref) -> dict:
+    """The error near the walls apart from the error in the bulk: ``wall_rms`` over the particles within a
+    cutoff of a wall (those with mirror neighbours), ``bulk_rms`` over the others, each the RMS of ``diff``
+    there over the RMS of ``ref`` over the whole domain (so that the two add up in quadrature to the whole)."""
+    import numpy as np
+
+    x, diff, ref = (np.asarray(a, dtype=np.float64) for a in (x, diff, ref))
+    gap = np.min([np.abs(x - xw) for xw in scene.walls.values()], axis=0)
+    band = gap < scene.cutoff
+    scale = float(np.mean(ref**2))
+    if not (scale > 0 and np.all(np.isfinite(diff))):
+        return {"wall_rms": float("nan"), "bulk_rms": float("nan")}
+    n = diff.size
+    return {
+        "wall_rms": float(np.sqrt(np.sum(diff[band] ** 2) / max(band.sum(), 1) / scale)),
+        "bulk_rms": float(np.sqrt(np.sum(diff[~band] ** 2) / max(n - band.sum(), 1) / scale)),
+    }
 
 
 class SceneKind:
@@ -35,6 +56,7 @@ class SceneKind:
     name: str = ""
     summary: str = ""
     periodic: tuple = ("y",)
+    walls: tuple = ()  # the x edges that are rigid walls: "x_min", "x_max" (the others free, or periodic)
     domain: dict = {}  # {x_min, x_max, y_min, y_max}: where the kind's default domain differs from Scene's
     fields: tuple = ("u",)
     primary: str = "u"
@@ -43,9 +65,13 @@ class SceneKind:
 
     def boundaries(self, scene=None) -> frozenset:
         """The boundary kinds this scene needs of a solver."""
-        return frozenset(
-            ("periodic-x" if "x" in self.periodic else "free-x", "periodic-y" if "y" in self.periodic else "free-y")
-        )
+        if "x" in self.periodic:
+            x = {"periodic-x"}
+        else:
+            x = {"wall-x"} if self.walls else set()
+            if len(self.walls) < 2:
+                x.add("free-x")
+        return frozenset(x | {"periodic-y" if "y" in self.periodic else "free-y"})
 
     def check(self, scene) -> list[str]:
         """Problems with ``scene``'s parameters for this kind, one line each naming the option and range."""
@@ -88,6 +114,24 @@ class SceneKind:
     def predict(self, scene):
         """The linear model's predicted errors from the dispersion relation (solvers/dispersion.py)."""
         raise NotImplementedError
+
+    def mirror_extension(self, scene, u, v, drho) -> tuple:
+        """(u, v, drho, keep): the initial fields (arrays with x the last axis) on the lattice whose periodic
+        solution is this scene's, and the slice of its columns that is the scene's lattice. With rigid walls,
+        the even extension across them: the mirror image beside the fields, the normal velocity reversed (with
+        walls at both x edges the doubled lattice is periodic: its seam is the other wall); without, the
+        fields themselves (the prediction's lattice, solvers/dispersion.py)."""
+        import numpy as np
+
+        nx = u.shape[-1]
+        if not self.walls:
+            return u, v, drho, slice(0, nx)
+        images = (-u[..., ::-1], v[..., ::-1], drho[..., ::-1])
+        if "x_max" in self.walls:
+            out = [np.concatenate((a, b), axis=-1) for a, b in zip((u, v, drho), images)]
+            return (*out, slice(0, nx))
+        out = [np.concatenate((b, a), axis=-1) for a, b in zip((u, v, drho), images)]
+        return (*out, slice(nx, 2 * nx))
 
     def sized_domain(self, size: float) -> dict:
         """The domain of side ``size`` (m) for ``--domain-size``; ValueError where the kind's domain is fixed."""
