@@ -5,7 +5,7 @@ Compilation and the first step happen in ``setup``, outside the timed region
 particles; ``PCABENCH_BENCH_LARGE=1`` adds 100K and 400K for the linked list.
 """
 
-from .common import Prepared, StageBenchmarks, Unsupported, cpu_dx, solver_names
+from .common import Prepared, StageBenchmarks, Unsupported, cpu_dx, solver_names, thinnest_strip
 
 
 class TimeStep(StageBenchmarks):
@@ -32,6 +32,43 @@ class TimeStepThreads:
         import numba
 
         self.p = Prepared("linkedlist-cpu", precision, dx, threads=numba.config.NUMBA_NUM_THREADS)
+
+    def time_step(self, *_):
+        self.p.step()
+
+
+# A walled scene and its free twin on the same lattice (same N, same box): what a step pays for the wall's
+# mirror particles (extra pairs in the wall's column of cells only). The 2D pulse in the 20 x 20 m box of
+# pulse-wall (walls at both x ends) against the x-periodic acoustic-pulse in that box; the plane pulse on
+# plane-wall's x range and strip (a wall at the right end) against plane-pulse's free ends there.
+WALL_DX = 0.25  # 6,400 particles in the box, 1,280 on the strip
+WALL_PAIRS = {
+    "pulse-wall": {"x_min": -14.0, "x_max": 6.0, "y_min": -10.0, "y_max": 10.0},
+    "acoustic-pulse": {"x_min": -14.0, "x_max": 6.0, "y_min": -10.0, "y_max": 10.0},
+    "plane-wall": {"x_min": -10.0, "x_max": 6.0, "strip": True},  # strip: the thinnest strip at WALL_DX
+    "plane-pulse": {"x_min": -10.0, "x_max": 6.0, "strip": True},
+}
+
+
+class TimeWallStep:
+    """One step of linkedlist-cpu (float64, lagrangian, serial) with and without a rigid wall at the same N
+    (:data:`WALL_PAIRS`), by pair loop; commits before the walls skip the walled scenes."""
+
+    params = [list(WALL_PAIRS), ["list", "gather"]]
+    param_names = ["scene", "pair_loop"]
+    timeout = 300
+    min_run_count = 3
+
+    def setup(self, scene, pair_loop):
+        box = dict(WALL_PAIRS[scene])
+        if box.pop("strip", False):
+            box["strip_height"] = thinnest_strip(WALL_DX)
+        try:
+            self.p = Prepared("linkedlist-cpu", "float64", WALL_DX, pair_loop=pair_loop, name=scene, **box)
+        except Unsupported as exc:
+            raise NotImplementedError(str(exc)) from None
+        except (TypeError, ValueError) as exc:  # a commit without the scene (or without scenes)
+            raise NotImplementedError(f"no scene {scene} at this commit: {exc}") from None
 
     def time_step(self, *_):
         self.p.step()

@@ -19,7 +19,7 @@ A check that needs what this machine lacks (no GPU: SolverUnavailable) is
 skipped with the reason, never failed. The GPU solver runs them in numba's
 CUDA simulator when ``NUMBA_ENABLE_CUDASIM=1`` is set.
 
-The scenes are tiny (dx = 1 m: 320 and 400 particles, a few steps), so the
+The scenes are tiny (dx = 1 m: 320, 400 and twice 182 particles, a few steps), so the
 suite's time is numba's compilation of each configuration (``--quick``: the
 defaults and each claimed value once, not the full product).
 """
@@ -54,9 +54,17 @@ from solvers.interface import STAGES, Solver
 
 REFERENCE = "allpair-cpu"  # the all-pair search: every pair tested, no cell list to get wrong
 TOLERANCE = {"float64": 1e-12, "float32": 2e-5}  # relative to the field's max: round-off of a few steps
-SCENES = {  # the two scene kinds at their smallest: a free-x plane pulse and the x-periodic 2D pulse
+# a walled scene at its smallest (182 particles): the narrow kernel (h 1.3 dx) lets a 14 x 13 m box hold the
+# 3 cells of a cutoff across; the pulse is narrow and 4 m from the right wall (clear of its support, 3.9 m), so
+# that its tail is at the wall and every mirror pair counts from the first step
+TINY_WALLED = dict(
+    dx=1.0, x_min=-8.0, x_max=6.0, y_min=-6.5, y_max=6.5, h_factor=1.3, pulse_width=1.5, pulse_center=2.0
+)
+SCENES = {  # the scene kinds at their smallest: free-x, x-periodic, and walled at one and at both x ends
     "plane-pulse": dict(dx=1.0, x_min=-8.0, x_max=8.0),
     "acoustic-pulse": dict(dx=1.0, name="acoustic-pulse", x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0),
+    "plane-wall": dict(name="plane-wall", **TINY_WALLED),
+    "pulse-wall": dict(name="pulse-wall", **TINY_WALLED),
 }
 AXES = ("precision", "model", "integrator", "kernel")  # Scene fields a class claims values of
 ALL_VALUES = {"precision": PRECISIONS, "model": MODELS, "integrator": INTEGRATORS}  # the kernels: all_values
@@ -126,7 +134,8 @@ class Subject:
 
     def configurations(self) -> list[dict]:
         """(scene name, method, pair loop) to check: the full product, or (quick) the defaults and each
-        claimed value once."""
+        claimed value once, and each walled scene with every claimed model (a wall's mirrors are set once for
+        particles that stay on the lattice and follow moving ones every step: two paths)."""
         axes = {axis: tuple(getattr(self.cls, CLAIMS[axis])) for axis in AXES}
         axes["scene"] = tuple(self.claimed_scenes())
         axes["pair_loop"] = tuple(self.cls.pair_loops)
@@ -136,6 +145,13 @@ class Subject:
         out = [base]
         for axis, values in axes.items():
             out += [{**base, axis: value} for value in values if value != base[axis]]
+        walled = [name for name in axes["scene"] if Scene(**SCENES[name]).walls]
+        out += [
+            {**base, "scene": name, "model": model}
+            for name in walled
+            for model in axes["model"]
+            if model != base["model"]
+        ]
         return out
 
     def scene_of(self, config: dict) -> Scene:
@@ -231,16 +247,21 @@ def changed(before: dict, after: dict) -> list[str]:
 
 
 def lattice_neighbours(scene: Scene) -> float:
-    """The mean count of other lattice particles within the cutoff (periodic axes by the nearest image), by
-    brute force in NumPy."""
+    """The mean count of other lattice particles within the cutoff (periodic axes by the nearest image), and
+    of mirror particles across each rigid wall (the wall half a spacing past the edge column: column c's
+    image is column -1 - c across the left wall, 2 nx - 1 - c across the right one), by brute force in NumPy."""
     ids = np.arange(scene.n_particles)
-    x, y = (ids % scene.nx) * scene.dx, (ids // scene.nx) * scene.dx
-    dx, dy = x[:, None] - x[None, :], y[:, None] - y[None, :]
-    if scene.periodic_x:
-        dx -= scene.width * np.rint(dx / scene.width)
+    column, y = ids % scene.nx, (ids // scene.nx) * scene.dx
+    images = {"x_min": -1 - column, "x_max": 2 * scene.nx - 1 - column}
+    dy = y[:, None] - y[None, :]
     dy -= scene.height * np.rint(dy / scene.height)
-    r2 = dx * dx + dy * dy
-    return float(((r2 < scene.cutoff**2).sum() - scene.n_particles) / scene.n_particles)
+    count = -scene.n_particles  # each particle itself
+    for others in (column, *(images[edge] for edge in scene.walls)):
+        dx = (column[:, None] - others[None, :]) * scene.dx
+        if scene.periodic_x:
+            dx -= scene.width * np.rint(dx / scene.width)
+        count += int((dx * dx + dy * dy < scene.cutoff**2).sum())
+    return float(count / scene.n_particles)
 
 
 @contextmanager
@@ -466,9 +487,9 @@ def stages(subject: Subject) -> str:
 @check
 def claims(subject: Subject) -> str:
     """Each claim the class makes is true both ways: every precision, model, integrator and kernel it claims
-    (and every scene whose boundaries it claims) is accepted by ``supports`` and runs, finite; every value it
-    does not claim is refused with SceneError by ``supports`` and by ``input``; its claims name known
-    values, and it has a name, a device and a pair loop."""
+    (and every scene whose boundaries it claims: free-x, periodic-x, wall-x) is accepted by ``supports`` and
+    runs, finite; every value it does not claim is refused with SceneError by ``supports`` (in one line) and
+    by ``input``; its claims name known values, and it has a name, a device and a pair loop."""
     cls, problems = subject.cls, []
     if not cls.name:
         problems.append("the class has no name")
@@ -497,6 +518,8 @@ def claims(subject: Subject) -> str:
         elif not claimed:
             if accepted:
                 problems.append(f"{what} is not claimed but supports() accepts it")
+            elif len(why.strip().splitlines()) != 1:
+                problems.append(f"{what} is refused by supports() in {len(why.strip().splitlines())} lines, not one")
             try:
                 subject.make().input(scene)
                 problems.append(f"{what} is not claimed but input() accepts it")

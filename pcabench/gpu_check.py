@@ -13,6 +13,8 @@ spent, keeping what it has:
 1. ``profile``: the hardware profile, with the card's measured ceilings
    (device copy bandwidth, FP32 and FP64 FMA rates, the SM clock);
 2. ``compare``: linkedlist-gpu against linkedlist-cpu, every model and precision;
+   ``walls``: the same on the scenes with rigid walls (plane-wall, pulse-wall:
+   mirror particles), linear and lagrangian, both precisions;
 3. ``sweep``: linkedlist-gpu, lagrangian Verlet, both precisions, 100K to 62.5M
    particles on the paper's domain, steps sized to the budget; runs go to the
    results store (preset ``gpu``) through the ordinary sweep, in this process
@@ -59,6 +61,7 @@ from solvers import DEFAULT_SOLVER, MODELS, PRECISIONS, Scene, make_solver, solv
 from solvers.gpu_device import device_backend, simulated
 from solvers.integrators import step_program
 
+from .conformance import SCENES
 from .record import STEP_STAGES, step_seconds
 from .run import run
 from .safeio import fresh, own_folder, write_file
@@ -83,6 +86,9 @@ class Plan:
     max_steps: int = 100
     compare_dx: float = 0.5
     compare_steps: int = 20
+    # the walled scenes (Scene fields, name included), run compare_steps steps; their default domains here
+    wall_scenes: tuple = ({"name": "plane-wall", "dx": 0.5}, {"name": "pulse-wall", "dx": 0.5})
+    wall_models: tuple = ("linear", "lagrangian")  # mirrors set once; mirrors following the particles
     graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
     graph_steps: int = 50
     graph_rounds: int = 5
@@ -105,6 +111,10 @@ REHEARSAL = Plan(
     max_steps=2,
     compare_dx=1.0,
     compare_steps=3,
+    # check-solver's 182-particle duct walled at both ends (both mirror branches), its mirrors following the
+    # particles: 2 runs, not 8 (~20 s each in the simulator); check-solver runs every walled case there
+    wall_scenes=(SCENES["pulse-wall"],),
+    wall_models=("lagrangian",),
     graph_dx=(1.0,),
     graph_steps=2,
     graph_rounds=1,
@@ -216,41 +226,68 @@ def _smi_clock():
 
 
 # ---------------------------------------------------------------- 2. GPU against CPU
+AGREEMENT = {"float64": 1e-12, "float32": 1e-4}  # the largest relative difference of u GPU vs CPU that passes
+
+
+def gpu_against_cpu(scene: Scene, out: Path) -> dict:
+    """``scene`` run by linkedlist-gpu and linkedlist-cpu: its row, with the max relative difference of the final
+    u and drho (each over the CPU field's max)."""
+    fields = {}
+    for solver in (DEFAULT_SOLVER, GPU_SOLVER):
+        path = fresh(out / f"compare_{solver}.npz")
+        rec = run(RunSpec(solver, scene), fields_path=path)
+        if rec.status != "ok":
+            raise RuntimeError(f"{solver} {scene.name} {scene.model} {scene.precision}: {rec.status} {rec.message}")
+        fields[solver] = dict(np.load(path))
+        path.unlink()
+    diff = {
+        name: float(
+            np.max(np.abs(fields[GPU_SOLVER][name] - fields[DEFAULT_SOLVER][name]))
+            / np.max(np.abs(fields[DEFAULT_SOLVER][name]))
+        )
+        for name in ("u", "drho")
+    }
+    print(
+        f"compare {scene.name} {scene.precision} {scene.model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}",
+        file=sys.stderr,
+        flush=True,
+    )
+    return {
+        "scene": scene.name,
+        "N": scene.n_particles,
+        "precision": scene.precision,
+        "model": scene.model,
+        "dx": scene.dx,
+        "steps": scene.n_steps,
+        "max_rel_diff_u": diff["u"],
+        "max_rel_diff_drho": diff["drho"],
+    }
+
+
+def agrees(rows: list[dict]) -> bool:
+    """Whether every row's u agrees within its precision's :data:`AGREEMENT` (and there is a row)."""
+    return bool(rows) and all(r["max_rel_diff_u"] < AGREEMENT[r["precision"]] for r in rows)
+
+
 def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
     """Max relative difference GPU vs CPU of the final u and drho, every model and precision."""
-    rows = []
-    for precision in PRECISIONS:
-        for model in MODELS:
-            scene = Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision, **plan.scene)
-            fields = {}
-            for solver in (DEFAULT_SOLVER, GPU_SOLVER):
-                path = fresh(out / f"compare_{solver}.npz")
-                rec = run(RunSpec(solver, scene), fields_path=path)
-                if rec.status != "ok":
-                    raise RuntimeError(f"{solver} {model} {precision}: {rec.status} {rec.message}")
-                fields[solver] = dict(np.load(path))
-                path.unlink()
-            diff = {
-                name: float(
-                    np.max(np.abs(fields[GPU_SOLVER][name] - fields[DEFAULT_SOLVER][name]))
-                    / np.max(np.abs(fields[DEFAULT_SOLVER][name]))
-                )
-                for name in ("u", "drho")
-            }
-            rows.append(
-                {
-                    "precision": precision,
-                    "model": model,
-                    "dx": plan.compare_dx,
-                    "steps": plan.compare_steps,
-                    "max_rel_diff_u": diff["u"],
-                    "max_rel_diff_drho": diff["drho"],
-                }
-            )
-            print(
-                f"compare {precision} {model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}", file=sys.stderr, flush=True
-            )
-    return rows
+    return [
+        gpu_against_cpu(
+            Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision, **plan.scene), out
+        )
+        for precision in PRECISIONS
+        for model in MODELS
+    ]
+
+
+def walls_against_cpu(plan: Plan, out: Path) -> list[dict]:
+    """The same on each walled scene of the plan (mirror particles), each wall model and precision."""
+    return [
+        gpu_against_cpu(Scene(**{**walled, "steps": plan.compare_steps, "model": model, "precision": precision}), out)
+        for walled in plan.wall_scenes
+        for precision in PRECISIONS
+        for model in plan.wall_models
+    ]
 
 
 # ---------------------------------------------------------------- 3 and 5. the sweeps
@@ -461,6 +498,19 @@ def markdown(profile: dict, results: dict) -> str:
             f"{r['max_rel_diff_drho']:.2e} |"
             for r in results["compare"]
         ]
+    if results.get("walls"):
+        lines += [
+            "",
+            "## Rigid walls (mirror particles): GPU vs linkedlist-cpu (max relative difference after the steps shown)",
+            "",
+            "| scene | N | precision | model | dx | steps | u | drho |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {r['scene']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | "
+            f"{r['max_rel_diff_u']:.2e} | {r['max_rel_diff_drho']:.2e} |"
+            for r in results["walls"]
+        ]
     if results.get("gpu_rows"):
         lines += [
             "",
@@ -552,8 +602,12 @@ def measure(c: Check):
 
 def compare(c: Check) -> bool:
     c.state["compare"] = compare_with_cpu(c.plan, c.out)
-    tol = {"float64": 1e-12, "float32": 1e-4}
-    return all(r["max_rel_diff_u"] < tol[r["precision"]] for r in c.state["compare"])
+    return agrees(c.state["compare"])
+
+
+def walls(c: Check) -> bool:
+    c.state["walls"] = walls_against_cpu(c.plan, c.out)
+    return agrees(c.state["walls"])
 
 
 def gpu_sweep(c: Check) -> bool:
@@ -662,6 +716,7 @@ def ncu(c: Check) -> bool:
 STAGES = (
     Stage("profile", 0, measure),
     Stage("compare", 40, compare),
+    Stage("walls", 40, walls),
     Stage("sweep", 60, gpu_sweep),
     Stage("graph", 40, graph),
     Stage("cpu", 40, cpu_peers),

@@ -36,3 +36,31 @@ def test_benchmark_modules_import_without_cuda():
     )
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_every_builtin_scene_is_benchmarked_and_each_walled_one_beside_a_free_twin_of_its_size():
+    """The suites' scene lists (asv's TrackSceneError and TimeWallStep, pytest-benchmark's scene step, the
+    conformance scenes) hold every built-in scene kind; each walled scene in TimeWallStep has a free twin
+    there with the same particle count and box, so that the step's difference is the wall's."""
+    from benchmarks.bench_accuracy import TrackSceneError
+    from benchmarks.bench_step import WALL_DX, WALL_PAIRS, TimeWallStep
+    from pcabench.conformance import SCENES
+    from solvers import Scene
+    from solvers.scenes import scenes
+    from tests.benchmarks.test_stages import SCENE_CASES
+
+    builtin = {name for name, kind in scenes().items() if type(kind).__module__.startswith("solvers.scenes.")}
+    assert builtin <= set(TrackSceneError.params[0]) and builtin <= set(SCENE_CASES) and builtin <= set(SCENES)
+    walled = {name for name in builtin if Scene(**SCENES[name]).walls}
+    assert walled == {"plane-wall", "pulse-wall"} and set(TimeWallStep.params[0]) == set(WALL_PAIRS)
+
+    def lattice(name):
+        box = {k: v for k, v in WALL_PAIRS[name].items() if k != "strip"}
+        strip = Scene.thinnest_strip(WALL_DX) if WALL_PAIRS[name].get("strip") else None
+        s = Scene(name=name, dx=WALL_DX, strip_height=strip, **box)
+        return s.n_particles, s.x_lo, s.y_lo, s.width, s.height, bool(s.walls)
+
+    lattices = [lattice(name) for name in WALL_PAIRS]
+    with_wall = {lat[:-1] for lat in lattices if lat[-1]}
+    without = {lat[:-1] for lat in lattices if not lat[-1]}
+    assert len(with_wall) == len(walled) and with_wall == without, lattices

@@ -15,8 +15,17 @@ from pathlib import Path
 
 import pytest
 
-from pcabench.conformance import CHECK_NAMES, assert_conforms, check_solver
-from solvers import SceneError, registry
+from pcabench.conformance import (
+    CHECK_NAMES,
+    SCENES,
+    TOLERANCE,
+    Subject,
+    assert_conforms,
+    check_solver,
+    compare,
+    lattice_neighbours,
+)
+from solvers import Scene, SceneError, registry
 from solvers.linkedlist_cpu import LinkedListCPU
 
 from .conftest import cli_main
@@ -110,6 +119,66 @@ class ClaimsTooLittle(LinkedListCPU):
     @classmethod
     def supports(cls, scene):
         pass
+
+
+class IgnoresMirrors(LinkedListCPU):
+    """Broken on purpose: it claims wall-x, yet its pair-list sweeps leave out the mirror particles' part."""
+
+    name = "ignores-mirrors"
+    pair_loops = ("list",)
+
+    def launch(self, name, *args):
+        if name in ("wall_continuity", "wall_momentum"):
+            return None
+        return super().launch(name, *args)
+
+
+class NoWalls(LinkedListCPU):
+    """Honest without walls: it claims every boundary but wall-x."""
+
+    name = "no-walls"
+    boundaries = tuple(b for b in LinkedListCPU.boundaries if b != "wall-x")
+
+
+def walled_scenes() -> list[str]:
+    return [name for name, overrides in SCENES.items() if Scene(**overrides).walls]
+
+
+def test_the_suite_checks_both_walled_scenes_with_every_model():
+    assert set(walled_scenes()) == {"plane-wall", "pulse-wall"}
+    configs = Subject(LinkedListCPU, quick=True).configurations()
+    for scene in walled_scenes():
+        assert {c["model"] for c in configs if c["scene"] == scene} == set(LinkedListCPU.models), scene
+
+
+def test_the_lattice_count_includes_the_mirrors():
+    one_wall, two_walls = Scene(**SCENES["plane-wall"]), Scene(**SCENES["pulse-wall"])
+    free = Scene(**{**SCENES["plane-wall"], "name": "plane-pulse"})  # the same lattice, free ends
+    assert lattice_neighbours(free) < lattice_neighbours(one_wall) < lattice_neighbours(two_walls)
+
+
+def test_a_solver_that_ignores_the_mirrors_fails_the_agreement_check_on_the_walled_scenes_only():
+    (result,) = check_solver(IgnoresMirrors, quick=True, only=("agreement",))
+    assert result.failed and "differs" in result.message, result.line()
+    subject, failed = Subject(IgnoresMirrors, quick=True), set()
+    for config in subject.configurations():
+        scene = subject.scene_of(config)
+        got, _ = subject.evolve(scene, pair_loop="list")
+        reference, _ = subject.evolve(scene, reference=True)
+        if compare(got, reference, scene, TOLERANCE[scene.precision]):
+            failed.add(config["scene"])
+    assert failed == set(walled_scenes())
+
+
+def test_a_solver_without_walls_is_refused_a_walled_scene_in_one_line_and_conforms():
+    for scene in walled_scenes():
+        with pytest.raises(SceneError) as refused:
+            NoWalls.supports(Scene(**SCENES[scene]))
+        message = str(refused.value)
+        assert len(message.splitlines()) == 1 and "wall-x" in message and scene in message, message
+    (claims,) = check_solver(NoWalls, quick=True, only=("claims",))
+    assert claims.status == "ok", claims.line()
+    assert Subject(NoWalls, quick=True).claimed_scenes() == ["plane-pulse", "acoustic-pulse"]
 
 
 def test_a_broken_momentum_sweep_fails_the_agreement_check():

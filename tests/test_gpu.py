@@ -218,3 +218,13 @@ def test_gpu_graph_replays_the_plain_step(requires_gpu, precision, tol):
     row = graph_vs_plain(0.25, precision, steps=10, rounds=1, scene_overrides={})
     assert row["max_rel_diff_u"] < tol, row
     assert row["graph_ms"] > 0 and row["plain_ms"] > 0
+
+
+@pytest.mark.gpu
+def test_gpu_walls_match_cpu(requires_gpu, tmp_path):
+    """The GPU check's walls stage on the card: plane-wall and pulse-wall (mirror particles), linear and
+    lagrangian, float64 and float32, against linkedlist-cpu."""
+    from pcabench.gpu_check import FULL, agrees, walls_against_cpu
+
+    rows = walls_against_cpu(FULL, tmp_path)
+    assert len(rows) == len(FULL.wall_scenes) * 2 * len(FULL.wall_models) and agrees(rows), rows

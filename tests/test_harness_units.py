@@ -137,4 +137,31 @@ def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
     status = {s["stage"]: s["status"] for s in check.state["stages"]}
     assert status["broken"].startswith("failed: RuntimeError: no card")
     assert status["greedy"].startswith("not run:") and status["fine"] == "ok" and ran == ["fine"]
-    assert [s.name for s in G.STAGES][:3] == ["profile", "compare", "sweep"]  # the order of value
+    assert [s.name for s in G.STAGES][:4] == ["profile", "compare", "walls", "sweep"]  # the order of value
+
+
+def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows():
+    """The walls stage (GPU against CPU on the walled scenes) fails on a row past its precision's tolerance or
+    on no rows, and the check's tables list its rows; the rehearsal's walled scenes are check-solver's tiny ones."""
+    from pcabench import gpu_check as G
+    from pcabench.conformance import SCENES
+    from solvers import Scene
+
+    row = {"scene": "pulse-wall", "N": 182, "precision": "float32", "model": "lagrangian", "dx": 1.0, "steps": 3}
+    assert G.agrees([{**row, "max_rel_diff_u": 5e-5, "max_rel_diff_drho": 1e-5}])
+    assert not G.agrees([{**row, "max_rel_diff_u": 5e-4, "max_rel_diff_drho": 1e-5}])
+    assert not G.agrees([{**row, "precision": "float64", "max_rel_diff_u": 5e-5, "max_rel_diff_drho": 0.0}])
+    assert not G.agrees([])
+    text = G.markdown(
+        {"id": "m"},
+        {
+            "budget_s": 1,
+            "elapsed_s": 1,
+            "stages": [],
+            "walls": [{**row, "max_rel_diff_u": 5e-5, "max_rel_diff_drho": 0}],
+        },
+    )
+    assert "## Rigid walls" in text and "| pulse-wall | 182 | float32 | lagrangian | 1.0 | 3 | 5.00e-05 |" in text
+    assert {Scene(**w).name for w in G.FULL.wall_scenes} == {"plane-wall", "pulse-wall"}
+    assert set(G.FULL.wall_models) == {"linear", "lagrangian"}
+    assert G.REHEARSAL.wall_scenes and all(w in SCENES.values() and Scene(**w).walls for w in G.REHEARSAL.wall_scenes)
