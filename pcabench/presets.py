@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 
-from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, solver_class
+from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind, solver_class
 
 from .spec import ALL_CORES, SERIAL, RunSpec
 
@@ -167,7 +167,8 @@ WALL_PAPER_CFL = (4.75, 4.9, 5.0)
 # alternate which goes first; each round's runs carry their own preset tag (``walls-cost-<round>``) so that the
 # store keeps every repeat, and the report takes the best of each side. Runs of WALL_COST_TIME of physical time
 # (the pulse still inside the box), as a step count: a timing, not an accuracy run.
-WALL_COST = {"pulse-wall": ("acoustic-pulse", (0.25, 0.125)), "plane-wall": ("plane-pulse", (0.125, 0.0625))}
+FREE_COUNTERPART = {"pulse-wall": "acoustic-pulse", "plane-wall": "plane-pulse"}  # the same pulse without walls
+WALL_COST_DX = {"pulse-wall": (0.25, 0.125), "plane-wall": (0.125, 0.0625)}
 WALL_COST_ROUNDS = 3
 WALL_COST_TIME = 5.0  # s
 WALL_COST_TAG = WALLS + "-cost-"
@@ -200,7 +201,8 @@ def walls() -> list[RunSpec]:
             ]
         runs += [_spec(model=model, cfl=cfl, **base) for model in LONG_MODELS for cfl in WALL_PAPER_CFL]
     for i in range(1, WALL_COST_ROUNDS + 1):
-        for name, (free, dxs) in WALL_COST.items():
+        for name, dxs in WALL_COST_DX.items():
+            free = FREE_COUNTERPART[name]
             for dx in dxs:
                 wall = Scene(dx=dx, name=name)
                 box = dict(x_min=wall.x_min, x_max=wall.x_max, y_min=wall.y_min, y_max=wall.y_max)
@@ -292,40 +294,36 @@ def model_needs(scene: str) -> list[RunSpec]:
 
 
 def front_axes(size: str = "quick", scene: str = DEFAULT_SCENE) -> dict:
-    """The front's axes on ``scene``: every registered kernel (solvers/kernels/), then FRONT's or FRONT_2D's."""
-    return {"kernel": kernel_names(), **(FRONT if scene == DEFAULT_SCENE else FRONT_2D)[size]}
+    """The front's axes on ``scene``: every registered kernel (solvers/kernels/), then FRONT's (a scene a strip
+    serves: the plane pulses) or FRONT_2D's."""
+    return {"kernel": kernel_names(), **(FRONT if scene_kind(scene).strip else FRONT_2D)[size]}
 
 
 def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     """Time to solution against error at t = 10 s: the product of FRONT[size] on the strip, smallest N first;
     then the paper's scene with its method and the predicted fastest ones, serial, in the same sweep. Another
-    scene: its own product (FRONT_2D) on its own domain, the paper's method beside it, and which model it
-    needs at several amplitudes."""
-    if scene != DEFAULT_SCENE:
-        axes = front_axes(size, scene)
-        names = [k for k in axes if k != "dx"]
-        runs = [
-            _spec(name=scene, dx=dx, t_end=FRONT_T_END, **dict(zip(names, values)))
-            for dx in sorted(axes["dx"], reverse=True)
-            for values in itertools.product(*(axes[k] for k in names))
-        ]
+    scene a strip serves (plane-wall): the same product on its strip (the paper's method is in it). Any other:
+    its own product (FRONT_2D) on its own domain and the paper's method beside it. Then, on a scene with an
+    isothermal reference, which model it needs at several amplitudes."""
+    kind = scene_kind(scene)
+    axes = front_axes(size, scene)
+    names = [k for k in axes if k != "dx"]
+    runs = [
+        _spec(name=scene, dx=dx, t_end=FRONT_T_END, strip=kind.strip, **dict(zip(names, values)))
+        for dx in sorted(axes["dx"], reverse=True)
+        for values in itertools.product(*(axes[k] for k in names))
+    ]
+    if scene == DEFAULT_SCENE:
+        for model in ("linear", "lagrangian"):
+            runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in fast_methods(model)]
+            runs.append(_spec(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model=model))
+    elif not kind.strip:
         runs += [
             _spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model)
             for model in ("linear", "lagrangian")
             for dx in PAPER_METHOD_2D_DX
         ]
-        return runs + model_needs(scene)
-    axes = front_axes(size, scene)
-    names = [k for k in axes if k != "dx"]
-    runs = [
-        _spec(dx=dx, t_end=FRONT_T_END, strip=True, **dict(zip(names, values)))
-        for dx in sorted(axes["dx"], reverse=True)
-        for values in itertools.product(*(axes[k] for k in names))
-    ]
-    for model in ("linear", "lagrangian"):
-        runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in fast_methods(model)]
-        runs.append(_spec(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model=model))
-    return runs + model_needs(scene)
+    return runs + (model_needs(scene) if kind.has_isothermal else [])
 
 
 def front_full(scene: str = DEFAULT_SCENE) -> list[RunSpec]:

@@ -24,6 +24,7 @@ from solvers import Scene
 from . import figures as F
 from . import paper as P
 from . import tables as T
+from . import walls as W
 from .md import first_words, fmt, md_table, pct
 
 
@@ -660,4 +661,11 @@ SECTIONS = SECTIONS + (
             (lambda d, ctx: F.scene_fronts(d["points"], ctx.out, ctx.name) if d else None,
              lambda d, ctx: F.phase_direction(d["phase"], d["fronts"], ctx.out, ctx.name) if d else None),
             all_scenes=True),
+)
+
+
+# ---------------------------------------------------------------- sound at a rigid wall (every wall scene's runs)
+SECTIONS = SECTIONS + (
+    Section("walls", lambda ctx: W.rows(ctx.df_scenes if ctx.df_scenes is not None else ctx.df), W.text,
+            (lambda d, ctx: F.wall_errors(d["accuracy"], ctx.out, ctx.name) if d else None,), all_scenes=True),
 )
