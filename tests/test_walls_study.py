@@ -17,10 +17,10 @@ matplotlib.use("Agg")
 import pytest  # noqa: E402
 
 from pcabench import presets, store  # noqa: E402
-from pcabench.reports import frame, sections, write_reports  # noqa: E402
+from pcabench.reports import frame, sections  # noqa: E402
 from pcabench.reports import walls as W  # noqa: E402
 from solvers import Scene, kernel_names, scenes  # noqa: E402
-from solvers.dispersion import stable_cfl  # noqa: E402
+from solvers.dispersion import predict, stable_cfl  # noqa: E402
 
 from .figure_check import record  # noqa: E402
 from .test_study import row  # noqa: E402
@@ -101,13 +101,16 @@ def _store(path):
     def add(rec, **errors):
         recs.append(dataclasses.replace(rec, errors=errors) if errors else rec)
 
-    for name, dx, strip in (("plane-wall", 0.5, True), ("pulse-wall", 0.5, False)):
+    # linear as the prediction has it: plane-wall off by 1e-5 away from the wall (its free end), pulse-wall exactly
+    for name, dx, strip, gap in (("plane-wall", 0.5, True, 1e-5), ("pulse-wall", 0.5, False, 0.0)):
         extra = {"strip_height": Scene.thinnest_strip(dx)} if strip else {}
-        for model, mse in (("linear", 0.3), ("lagrangian", 0.35)):
+        p = predict(Scene(dx=dx, name=name, t_end=10.0, model="linear", **extra))
+        wall, bulk = p.measures["wall_rms"], p.measures["bulk_rms"]
+        for model, mse in (("linear", p.predicted_error * (1 + gap)), ("lagrangian", 0.35)):
             add(
                 row(name=name, dx=dx, t_end=10.0, model=model, mse=mse, preset="walls", **extra),
-                wall_rms=0.2,
-                bulk_rms=0.1,
+                wall_rms=wall,
+                bulk_rms=bulk * (1 + gap),
             )
     limit = stable_cfl(Scene(dx=1.0, h_factor=1.3, model="linear", memory_limit_bytes=2**62))
     for cfl, status, step in ((round(0.9 * limit, 2), "unstable", 31), (round(1.02 * limit, 2), "unstable", 20)):
@@ -139,7 +142,7 @@ def test_the_section_renders_the_stores_numbers_and_findings(tmp_path):
     acc = {(r["scene"], r["model"]): r for r in data["accuracy"]}
     assert set(acc) == {(n, m) for n in ("plane-wall", "pulse-wall") for m in ("linear", "lagrangian")}
     lin = acc[("pulse-wall", "linear")]
-    assert lin["gap"] == pytest.approx(0.3 / lin["predicted"] - 1) and lin["wall_rms"] == 0.2
+    assert abs(lin["gap"]) < 1e-12 and acc[("plane-wall", "linear")]["gap"] == pytest.approx(1e-5)
     (stab,) = data["stability"]
     assert stab["below_prediction"] and stab["free"] is None and stab["bounded_to"] is None
     (cost,) = data["cost"]
@@ -149,23 +152,84 @@ def test_the_section_renders_the_stores_numbers_and_findings(tmp_path):
     assert text.startswith("## Sound at a rigid wall")
     for heading in ("### Accuracy at the wall", "### Stability at the wall", "### What the wall costs"):
         assert heading in text
-    assert "pulse-wall**, linear" in text and "plane-wall**, linear" in text and "its left end is free" in text
+    assert "pulse-wall**, linear: measured and predicted differ by at most" in text and ": round-off;" in text
+    assert "the difference is the free left end's, not the wall's" in text  # plane-wall: equal near the wall
+    assert text.count(", not one the wall adds.") == 2
     assert "blew up below the predicted" in text and "the wall: without a free end" in text
     assert "| pulse-wall / acoustic-pulse | lagrangian | full | 0.5 | 1,600 | 10 x 2 | 1 | 1.1 | 1.100 |" in text
 
 
-def test_the_section_and_its_figure_in_a_written_report(tmp_path):
-    results = _store(tmp_path / "store" / "m.jsonl").parent
-    assert any(s.name == "walls" for s in sections.SECTIONS)
+def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):
+    from types import SimpleNamespace
+
+    (section,) = [s for s in sections.SECTIONS if s.name == "walls"]
+    assert section.all_scenes  # it reads every scene's runs, not the paper's scene's only
+    data = W.rows(frame.load(_store(tmp_path / "store" / "m.jsonl").parent))
     with record() as found:
-        write_reports(results, tmp_path / "reports")
-    report = (tmp_path / "reports" / "machine-a" / "report.md").read_text()
-    assert "## Sound at a rigid wall" in report and "![walls_error](walls_error.png)" in report
-    drawn = [p for name, p in found.items() if "walls_error" in name]
-    assert drawn == [[]]  # drawn once, and it reads right
+        (path,) = [draw(data, SimpleNamespace(out=tmp_path, name="m")) for draw in section.figures]
+    assert path.name == "walls_error.png" and path.exists()
+    assert list(found.values()) == [[]]  # drawn once, and it reads right
 
 
 def test_no_wall_run_no_section(tmp_path):
     path = tmp_path / "s" / "m.jsonl"
     store.append(row(dx=1.0), path)
     assert W.rows(frame.load(path.parent)) is None
+
+
+# ---------------------------------------------------------------- the wall scenes join the front and advise
+@pytest.mark.parametrize("name", ["plane-wall", "pulse-wall"])
+def test_the_front_of_a_wall_scene_is_its_own_product_with_the_papers_method(name):
+    kind = scenes()[name]
+    runs = presets.preset("front", name)
+    assert runs and {s.scene.name for s in runs} == {name}
+    assert all((s.scene.strip_height is not None) == kind.strip for s in runs)  # plane-wall on its strip
+    axes = presets.front_axes("quick", name)
+    assert axes == presets.front_axes("quick", "plane-pulse" if kind.strip else "acoustic-pulse")
+    assert {s.scene.kernel for s in runs} == set(kernel_names())
+    paper = [s.scene for s in runs if s.scene.uses_default_numerics()]
+    assert {s.model for s in paper} == {"linear", "lagrangian"} and len({s.dx for s in paper}) >= 2
+    # no isothermal reference at a wall: no runs of "which model this scene needs" (they score against it)
+    assert not kind.has_isothermal and {s.scene.mach for s in runs} == {Scene.default("mach")}
+
+
+def test_study_list_prints_the_plan_and_runs_nothing(tmp_path, capsys):
+    from pcabench import cli
+
+    code = cli.main(["study", "--walls", "--list", "--results", str(tmp_path / "r")])
+    out = capsys.readouterr().out.splitlines()
+    assert code == 0 and len(out) == len(presets.preset(presets.WALLS)) and not (tmp_path / "r").exists()
+    assert out[0].startswith(f"[1/{len(out)}] walls: ")
+    assert sum("walls-cost-3:" in line for line in out) == 2 * sum(len(d) for d in presets.WALL_COST_DX.values())
+
+
+def test_advise_searches_the_prediction_on_a_wall_scene(tmp_path, capsys):
+    """No stored run of plane-wall reaches the error: the prediction's search runs on plane-wall itself (its strip)
+    and names a study of that scene; the paper's configuration's dx is the coarsest predicted to reach it."""
+    import json
+
+    from pcabench import cli
+
+    path = tmp_path / "r" / "m.jsonl"
+    strip = Scene.thinnest_strip(0.5)
+    store.append(row(name="plane-wall", dx=0.5, t_end=10.0, model="linear", mse=0.33, strip_height=strip), path)
+    code = cli.main(["advise", "--scene", "plane-wall", "--error", "0.2", "--results", str(path.parent), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    s = out["suggestion"]
+    assert code == 1 and not out["found"] and s["predicted_error"] <= 0.2
+    assert "--scene plane-wall --strip" in s["study"]
+    paper = s["paper_dx"]
+
+    def error(dx):
+        return predict(Scene(dx=dx, name="plane-wall", t_end=10.0, model="linear")).predicted_error
+
+    from pcabench.advise import SEARCH_DX
+    from solvers import SceneError
+
+    coarser = []
+    for dx in (d for d in SEARCH_DX if d > paper):
+        try:
+            coarser.append(error(dx))
+        except SceneError:  # too coarse for the wall's support: not searched
+            pass
+    assert error(paper) <= 0.2 and coarser and min(coarser) > 0.2
