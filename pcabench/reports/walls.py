@@ -326,15 +326,20 @@ def _stability_text(rows) -> list[str]:
         ),
         "",
     ]
+    not_the_wall = []  # per run that blew up below the prediction: whether its free counterpart did so too
     for r in rows:
         if not r["below_prediction"]:
             continue
         f, w = r["free"], r["blew_up_from"]
-        if f is not None and f["blew_up_from"] is not None and (f["bounded_to"] is None or w > f["bounded_to"]):
-            cause = (
-                f"as on {r['free_scene']} (blew up from {f['blew_up_from']:g} there): its free "
-                + ("ends" if "free-x" in scenes()[r["free_scene"]].boundaries() else "counterpart's own terms")
-                + " set this limit, not the wall"
+        free_set_it = (
+            f is not None and f["blew_up_from"] is not None and (f["bounded_to"] is None or w > f["bounded_to"])
+        )
+        not_the_wall.append(free_set_it)
+        if free_set_it:
+            cause = f"as on {r['free_scene']}, which blew up from {f['blew_up_from']:g} without a wall: " + (
+                f"the free ends ({r['scene']} keeps one) set this limit, not the wall"
+                if "free-x" in scenes()[r["free_scene"]].boundaries()
+                else "the model's own terms set this limit, not the wall"
             )
         elif f is not None:
             cause = f"{r['free_scene']} stayed bounded to {fmt(f['bounded_to'], 'g')}: the wall destabilises it"
@@ -357,8 +362,13 @@ def _stability_text(rows) -> list[str]:
                 else "; advise still uses the prediction for it (add it to MEASURED_LIMITS)."
             )
         )
-    if not any(r["below_prediction"] for r in rows):
+    if not not_the_wall:
         lines.append("- No run blew up below its predicted stable CFL: the wall destabilises none of these methods.")
+    elif all(not_the_wall):
+        lines.append(
+            "- No wall lowered a limit below its free counterpart's: where a run blew up below the "
+            "prediction, the same model and method blew up as low or lower without the wall."
+        )
     return lines + [""]
 
 
