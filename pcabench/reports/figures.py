@@ -20,7 +20,7 @@ from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
 from pcabench.safeio import save_figure
 from pcabench.stability import UNSTABLE_BY_PREDICTION
-from solvers import kernel_names
+from solvers import kernel_names, scene_kind
 
 from . import paper as P
 from . import tables as T
@@ -515,9 +515,13 @@ def scene_fronts(points, out: Path, pid: str):
         return None
     path = out / "scene_fronts.png"
     past = " x: past the predicted stable CFL," if any(p["past_stable"] for p in points) else ""
+    ncols = min(len(scenes), 2)  # two panels a row: four scenes (the walls too) stay readable
+    nrows = -(-len(scenes) // ncols)
     with figure(path, f"Time to solution against error on each scene, t = 10 s, Mach 0.05 ({pid});{past} "
                       "colour: model", "time to solution, s", "relative RMS error",
-                ncols=len(scenes), logx=True, logy=True) as axes:
+                ncols=ncols, nrows=nrows, logx=True, logy=True, size=(6.5 * ncols + 2.5, 3.9 * nrows)) as axes:
+        for ax in axes[len(scenes):]:
+            ax.set_visible(False)
         for ax, scene in zip(axes, scenes):
             mine = [p for p in points if p["scene"] == scene and np.isclose(p["mach"], 0.05)]
             for model in ("linear", "lagrangian"):
@@ -532,7 +536,8 @@ def scene_fronts(points, out: Path, pid: str):
             errors = [p["error"] for p in mine]
             if errors:
                 nice_log_ticks(ax, errors)
-            ax.set_title(f"{scene} (error of {'u' if scene == 'plane-pulse' else 'drho'})", fontsize=9)
+                nice_log_ticks(ax, [p["seconds"] for p in mine], axis="x")
+            ax.set_title(f"{scene} (error of {scene_kind(scene).primary})", fontsize=9)
     return path
 
 

@@ -421,7 +421,35 @@ def _cost_text(rows) -> list[str]:
             table,
         ),
         "",
+        *_cost_notes(rows),
     ]
+
+
+def _cost_notes(rows) -> list[str]:
+    """Whether each row's rounds agree on which side is faster: where they do not, the machine's noise is as large
+    as the wall's cost and the table resolves neither."""
+    agree = [r for r in rows if min(r["round_ratios"]) > 1 or max(r["round_ratios"]) < 1]
+    spread = [x for r in rows for x in r["round_ratios"]]
+    lines = []
+    noisy = len(agree) < len(rows)
+    for r in agree:
+        side = "more" if r["ratio"] > 1 else "less"
+        lines.append(
+            f"- {r['scene']} at dx = {r['dx']:g}: in all {r['rounds']} rounds the wall's step cost {side}, by "
+            f"{_span([abs(x - 1) * 100 for x in r['round_ratios']])} %"
+            + (
+                f"; with the other rows' noise as large as that, {r['rounds']} rounds do not make it a measurement."
+                if noisy
+                else "."
+            )
+        )
+    if len(agree) < len(rows):
+        lines.append(
+            f"- In {len(rows) - len(agree)} of {len(rows)} rows the rounds disagree on which side is faster (the "
+            f"ratios of all rounds spread {min(spread):.2f}-{max(spread):.2f}): on this shared machine the noise is "
+            "as large as the wall's cost, which these runs do not resolve."
+        )
+    return lines + ([""] if lines else [])
 
 
 def text(data, ctx) -> list[str]:
