@@ -285,6 +285,11 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
             f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL."
         )
         lines += unstable_lines(out["unstable_by_prediction"], "runs that reach it")
+        if out["error_against"] == "the isothermal solution" and not scene_kind(scene).has_isothermal:
+            lines.append(
+                f"the {scene} scene has no isothermal solution to score {model} runs against (none is known there); "
+                "the prediction below is of the linear part"
+            )
         if "study" not in s:
             lines.append("no method of the searched grid is predicted to reach it")
         else:

@@ -181,7 +181,8 @@ def cost_round(preset_name: str) -> int | None:
 
 
 def walls() -> list[RunSpec]:
-    """Accuracy, stability and cost at a rigid wall (WALL_*): 64 runs, about 30 min on one busy core."""
+    """Accuracy, stability and cost at a rigid wall (WALL_*): 64 runs, 34 min on one busy core of the reference
+    machine (about 30 s of each run is its JIT compilation)."""
     from solvers.dispersion import stable_cfl
 
     runs = [

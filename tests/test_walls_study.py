@@ -233,3 +233,8 @@ def test_advise_searches_the_prediction_on_a_wall_scene(tmp_path, capsys):
         except SceneError:  # too coarse for the wall's support: not searched
             pass
     assert error(paper) <= 0.2 and coarser and min(coarser) > 0.2
+    code = cli.main(
+        ["advise", "--scene", "plane-wall", "--error", "0.2", "--model", "lagrangian", "--results", str(path.parent)]
+    )
+    text = capsys.readouterr().out
+    assert code == 1 and "the plane-wall scene has no isothermal solution to score lagrangian runs against" in text
