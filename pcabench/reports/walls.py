@@ -398,10 +398,12 @@ def _cost_text(rows) -> list[str]:
         "Time per step (SNP + PI + SU, ms, serial, the default CPU solver and pair loop) of each wall scene "
         "and its free counterpart on the same box at the same N, the paper's timing model (lagrangian: the "
         "mirrors follow every step). The two ran one after the other in each round, alternating which went "
-        "first, in one sweep; each side's best step time over the rounds and their ratio, and the ratio of "
+        "first, in one sweep (the newest that made both: its commit in the last column); each side's best step "
+        "time over the rounds and their ratio, and the ratio of "
         "each round's pair (a shared machine: the spread is the noise). The mirrors are computed in the pair "
-        "sums, never stored: the wall's cost is the extra pairs near it (the free counterpart's edge "
-        "particles miss them; the periodic square has its images instead).",
+        "sums, never stored: beside the free strip the wall adds the pairs its edge particles would miss; beside "
+        "the periodic square, whose images give the same pairs (the mean neighbours column), it adds only the "
+        "mirrors' own arithmetic.",
         "",
         md_table(
             [
