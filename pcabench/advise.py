@@ -33,6 +33,11 @@ from .stability import assess, e_foldings
 SEARCH_H = (1.3, 1.6, 2.13)
 SEARCH_DX = (1.0, 0.5, 0.4, 0.25, 0.2, 0.125, 0.1, 0.05, 0.025)
 SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
+# A 2D scene's prediction evolves every mode of its lattice (seconds at dx = 0.125): a coarser grid, and the
+# longest step only (the leapfrog's phase lead offsets the lattice's lag: the longest stable step is the most
+# accurate and the cheapest).
+SEARCH_DX_2D = (0.5, 0.25, 0.2, 0.125)
+SEARCH_CFL_SHARE_2D = (0.8,)
 
 
 def scene_of(r) -> dict:
@@ -147,16 +152,7 @@ def advise(
     if hits.empty:
         out["found"] = False
         out["unstable_by_prediction"] = _unstable_rows(unstable, column)
-        out["suggestion"] = (
-            suggest(error, t_end, model)
-            if scene == Scene.default("name")
-            else {
-                "note": f"no prediction search for the {scene} scene yet: run its front",
-                "paper_dx": None,
-                "smallest_dx_searched": None,
-                "front": f"pcabench study --front --scene {scene}",
-            }
-        )
+        out["suggestion"] = suggest(error, t_end, model, scene)
         return out
     best = hits.iloc[0]
     faster = unstable[unstable.t_solution < best.t_solution]
@@ -191,31 +187,50 @@ def advise(
     return out
 
 
-def suggest(error: float, t_end: float, model: str = "linear") -> dict:
+def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFAULT_SCENE) -> dict:
     """From the prediction: the cheapest configuration of a small grid predicted to reach ``error`` at ``t_end``
-    (cost ~ particles x steps x neighbours on the thinnest strip), and the paper configuration's dx."""
+    on ``scene`` (cost ~ particles x steps x neighbours: on the thinnest strip where a strip serves the scene,
+    else on its own domain, with SEARCH_DX_2D and SEARCH_CFL_SHARE_2D), and the paper configuration's dx."""
+    kind = scene_kind(scene)
+    dxs, shares = (SEARCH_DX, SEARCH_CFL_SHARE) if kind.strip else (SEARCH_DX_2D, SEARCH_CFL_SHARE_2D)
     best, paper = None, None
-    for kern, h, dx in itertools.product(kernel_names(), SEARCH_H, SEARCH_DX):
+    for kern, h in itertools.product(kernel_names(), SEARCH_H):
+        for share in shares:
+            for dx in sorted(dxs, reverse=True):  # coarse to fine: the first that reaches is this method's cheapest
+                try:
+                    base = Scene(
+                        dx=dx,
+                        name=scene,
+                        t_end=t_end,
+                        model="linear",
+                        kernel=kern,
+                        h_factor=h,
+                        memory_limit_bytes=2**62,
+                    )
+                except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
+                    continue
+                limit = stable_cfl(base)
+                if not limit > 0:
+                    break
+                trial = base.replace(cfl=round(share * limit, 2))
+                p = predict(trial)
+                if p.predicted_error > error:
+                    continue
+                cost = (1 / dx) ** (1 if kind.strip else 2) * trial.n_steps * (trial.cutoff / dx) ** 2
+                if best is None or cost < best[0]:
+                    best = (cost, trial, p)
+                break
+    for dx in sorted(dxs, reverse=True):  # the coarsest dx at which the paper's configuration reaches the error
         try:
-            base = Scene(dx=dx, t_end=t_end, model="linear", kernel=kern, h_factor=h, memory_limit_bytes=2**62)
-        except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
+            candidate = Scene(dx=dx, name=scene, t_end=t_end, model="linear", memory_limit_bytes=2**62)
+        except Exception:  # noqa: BLE001 - a dx the scene refuses (its wall inside the support) is not searched
             continue
-        limit = stable_cfl(base)
-        for share in SEARCH_CFL_SHARE if limit > 0 else ():
-            scene = base.replace(cfl=round(share * limit, 2))
-            p = predict(scene)
-            if p.predicted_error > error:
-                continue
-            cost = (1 / dx) * scene.n_steps * (scene.cutoff / dx) ** 2
-            if best is None or cost < best[0]:
-                best = (cost, scene, p)
-    for dx in SEARCH_DX:
-        scene = Scene(dx=dx, t_end=t_end, model="linear", memory_limit_bytes=2**62)
-        if predict(scene).predicted_error <= error:
-            paper = scene
+        if predict(candidate).predicted_error <= error:
+            paper = candidate
+            break
     out = {
         "paper_dx": None if paper is None else paper.dx,
-        "smallest_dx_searched": min(SEARCH_DX),
+        "smallest_dx_searched": min(dxs),
         "note": "predicted from the dispersion relation of the linear part",
     }
     if best is not None:
@@ -236,7 +251,8 @@ def suggest(error: float, t_end: float, model: str = "linear") -> dict:
                     model,
                     "--t-end",
                     f"{t_end:g}",
-                    "--strip",
+                    *([] if scene == DEFAULT_SCENE else ["--scene", scene]),
+                    *(["--strip"] if kind.strip else []),
                     "--kernel",
                     s.kernel,
                     "--h-factor",
@@ -269,9 +285,11 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
             f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL."
         )
         lines += unstable_lines(out["unstable_by_prediction"], "runs that reach it")
-        if "front" in s:
-            lines.append(f"{s['note']}:\n  {s['front']}")
-            return "\n".join(lines), False
+        if out["error_against"] == "the isothermal solution" and not scene_kind(scene).has_isothermal:
+            lines.append(
+                f"the {scene} scene has no isothermal solution to score {model} runs against (none is known there); "
+                "the prediction below is of the linear part"
+            )
         if "study" not in s:
             lines.append("no method of the searched grid is predicted to reach it")
         else:

@@ -1,7 +1,7 @@
 """The ``pcabench`` command line: the only module that knows about argparse.
 
     pcabench run --solver linkedlist-cpu --dx 0.1 --t-end 10
-    pcabench study --quick | --paper | --stability [short|long] | --front [quick|full] | --dx 1 0.5 ...
+    pcabench study --quick | --paper | --stability [short|long] | --front [quick|full] | --walls | --dx 1 0.5 ...
     pcabench report [--reference]
     pcabench profile [--save | --asv]
     pcabench gpu-check --out DIR
@@ -328,6 +328,8 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     name = (
         "paper"
         if args.paper
+        else "walls"
+        if args.walls
         else {"short": "stability", "long": "stability-long"}[args.stability]
         if args.stability
         else {None: "quick", "quick": "front", "full": "front-full"}[args.front]
@@ -347,6 +349,10 @@ def cmd_study(args) -> int:
     else:
         specs = check_specs(specs)
     specs = list(dict.fromkeys(specs))  # resolved, two specs may be one run (auto is list here): counted once
+    if args.list:
+        for i, spec in enumerate(specs, 1):
+            print(f"[{i}/{len(specs)}] {spec.preset}: {spec.label}")
+        return EXIT_OK
     run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
@@ -604,6 +610,13 @@ def build_parser() -> argparse.ArgumentParser:
         "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the "
         "predicted fastest, serial (quick: 296 runs; full: 2408)",
     )
+    g.add_argument(
+        "--walls",
+        action="store_true",
+        help="sound at a rigid wall (plane-wall, pulse-wall): accuracy at t = 10 s against the prediction, the "
+        "stable CFL per kernel over long runs, and the time per step with and without the wall (64 runs)",
+    )
+    p.add_argument("--list", action="store_true", help="print the runs the study would make, one a line, and exit")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
     m.add_argument("--solver", nargs="+", choices=registry())
     add_scene_options(m, many=True)
@@ -614,7 +627,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--run-budget",
         type=number("--run-budget"),
         help="seconds per run before it is a timeout "
-        "(default: quick 120, paper 900, stability 120, stability long 300, matrix 900)",
+        "(default: quick 120, paper 900, stability 120, stability long 300, walls 300, matrix 900)",
     )
     p.add_argument(
         "--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0, help="seconds for the whole sweep"

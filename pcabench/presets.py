@@ -8,9 +8,10 @@ rule) come from :class:`solvers.Scene`, never from here.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 
-from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, solver_class
+from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind, solver_class
 
 from .spec import ALL_CORES, SERIAL, RunSpec
 
@@ -23,6 +24,7 @@ RUN_BUDGET = {
     "matrix": 900.0,
     "front": 300.0,
     "front-full": 900.0,
+    "walls": 300.0,
 }
 
 # The stability preset's scene: the design's dx = 0.25 on a strip, the linear model
@@ -145,6 +147,75 @@ def stability_long() -> list[RunSpec]:
     ]
 
 
+# The walls preset (issue 34, ``pcabench study --walls``): sound at a rigid wall, in three parts.
+WALLS = "walls"
+# 1. Accuracy at t = 10 s, the paper's method, linear (where the prediction on the mirror extension holds) and
+# lagrangian; plane-wall on the thinnest strip as the paper's scene's accuracy runs.
+WALL_ACCURACY_DX = {"plane-wall": (0.5, 0.25, 0.125), "pulse-wall": (0.5, 0.25)}
+WALL_STRIP = {"plane-wall": True, "pulse-wall": False}  # the plane scene's fields do not depend on y
+# 2. Stability at the wall, as the long-run preset measures it (LONG_T_END, STABILITY_DX: long enough for round-off
+# to grow): the linear model of every registered kernel at an h the front uses, at CFLs bracketing its predicted
+# limit, and the paper's method in every model at the long runs' CFLs either side of the free ends' limit (4.8 on
+# the plane strip) and the prediction (4.97), so that each compares one to one with the free and periodic long runs.
+# plane-wall at Mach 0.01 (as LONG_SCENES: it must not break before t = 300 s); pulse-wall never breaks.
+WALL_STABILITY_MACH = {"plane-wall": 0.01, "pulse-wall": None}
+WALL_LINEAR_METHODS = (("gaussian", 1.3), ("wendland-c2", 2.13), ("wendland-c4", 2.13))  # (kernel, h/dx)
+WALL_BRACKET = (0.95, 1.02)  # CFLs as fractions of the method's predicted stable CFL, rounded to 0.01
+WALL_PAPER_CFL = (4.75, 4.9, 5.0)
+# 3. Cost: time per step with and without the wall at the same N, the paper's timing model (lagrangian) on the
+# default CPU solver, serially: each wall scene against its free counterpart on the same box, in rounds that
+# alternate which goes first; each round's runs carry their own preset tag (``walls-cost-<round>``) so that the
+# store keeps every repeat, and the report takes the best of each side. Runs of WALL_COST_TIME of physical time
+# (the pulse still inside the box), as a step count: a timing, not an accuracy run.
+FREE_COUNTERPART = {"pulse-wall": "acoustic-pulse", "plane-wall": "plane-pulse"}  # the same pulse without walls
+WALL_COST_DX = {"pulse-wall": (0.25, 0.125), "plane-wall": (0.125, 0.0625)}
+WALL_COST_ROUNDS = 3
+WALL_COST_TIME = 5.0  # s
+WALL_COST_TAG = WALLS + "-cost-"
+
+
+def cost_round(preset_name: str) -> int | None:
+    """The round of a walls cost run from its preset tag (``walls-cost-2`` -> 2), None for any other preset."""
+    tail = str(preset_name).removeprefix(WALL_COST_TAG)
+    return int(tail) if tail != str(preset_name) and tail.isdigit() else None
+
+
+def walls() -> list[RunSpec]:
+    """Accuracy, stability and cost at a rigid wall (WALL_*): 64 runs, 34 min on one busy core of the reference
+    machine (about 30 s of each run is its JIT compilation)."""
+    from solvers.dispersion import stable_cfl
+
+    runs = [
+        _spec(name=name, dx=dx, t_end=FRONT_T_END, model=model, strip=WALL_STRIP[name])
+        for name, dxs in WALL_ACCURACY_DX.items()
+        for model in ("linear", "lagrangian")
+        for dx in dxs
+    ]
+    for name, mach in WALL_STABILITY_MACH.items():
+        base = dict(name=name, dx=STABILITY_DX, t_end=LONG_T_END, strip=WALL_STRIP[name])
+        if mach is not None:
+            base["mach"] = mach
+        for kernel, h in WALL_LINEAR_METHODS:
+            limit = stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear", memory_limit_bytes=2**62))
+            runs += [
+                _spec(kernel=kernel, h_factor=h, model="linear", cfl=round(f * limit, 2), **base) for f in WALL_BRACKET
+            ]
+        runs += [_spec(model=model, cfl=cfl, **base) for model in LONG_MODELS for cfl in WALL_PAPER_CFL]
+    for i in range(1, WALL_COST_ROUNDS + 1):
+        for name, dxs in WALL_COST_DX.items():
+            free = FREE_COUNTERPART[name]
+            for dx in dxs:
+                wall = Scene(dx=dx, name=name)
+                box = dict(x_min=wall.x_min, x_max=wall.x_max, y_min=wall.y_min, y_max=wall.y_max)
+                steps = int(round(WALL_COST_TIME / (Scene.default("cfl") * dx)))
+                pair = [
+                    _spec(name=name, dx=dx, steps=steps, strip=WALL_STRIP[name]),
+                    _spec(name=free, dx=dx, steps=steps, strip=WALL_STRIP[name], **box),
+                ]
+                runs += [dataclasses.replace(s, preset=f"{WALL_COST_TAG}{i}") for s in pair[:: 1 if i % 2 else -1]]
+    return runs
+
+
 # The speed-accuracy front at t = 10 s on the strip, serial: kernel x h/dx x CFL x dx x precision x model, the
 # kernels every registered one (:func:`front_axes`). CFL 6 is past every configuration's predicted stable step:
 # the front shows where methods fail.
@@ -224,40 +295,36 @@ def model_needs(scene: str) -> list[RunSpec]:
 
 
 def front_axes(size: str = "quick", scene: str = DEFAULT_SCENE) -> dict:
-    """The front's axes on ``scene``: every registered kernel (solvers/kernels/), then FRONT's or FRONT_2D's."""
-    return {"kernel": kernel_names(), **(FRONT if scene == DEFAULT_SCENE else FRONT_2D)[size]}
+    """The front's axes on ``scene``: every registered kernel (solvers/kernels/), then FRONT's (a scene a strip
+    serves: the plane pulses) or FRONT_2D's."""
+    return {"kernel": kernel_names(), **(FRONT if scene_kind(scene).strip else FRONT_2D)[size]}
 
 
 def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     """Time to solution against error at t = 10 s: the product of FRONT[size] on the strip, smallest N first;
     then the paper's scene with its method and the predicted fastest ones, serial, in the same sweep. Another
-    scene: its own product (FRONT_2D) on its own domain, the paper's method beside it, and which model it
-    needs at several amplitudes."""
-    if scene != DEFAULT_SCENE:
-        axes = front_axes(size, scene)
-        names = [k for k in axes if k != "dx"]
-        runs = [
-            _spec(name=scene, dx=dx, t_end=FRONT_T_END, **dict(zip(names, values)))
-            for dx in sorted(axes["dx"], reverse=True)
-            for values in itertools.product(*(axes[k] for k in names))
-        ]
+    scene a strip serves (plane-wall): the same product on its strip (the paper's method is in it). Any other:
+    its own product (FRONT_2D) on its own domain and the paper's method beside it. Then, on a scene with an
+    isothermal reference, which model it needs at several amplitudes."""
+    kind = scene_kind(scene)
+    axes = front_axes(size, scene)
+    names = [k for k in axes if k != "dx"]
+    runs = [
+        _spec(name=scene, dx=dx, t_end=FRONT_T_END, strip=kind.strip, **dict(zip(names, values)))
+        for dx in sorted(axes["dx"], reverse=True)
+        for values in itertools.product(*(axes[k] for k in names))
+    ]
+    if scene == DEFAULT_SCENE:
+        for model in ("linear", "lagrangian"):
+            runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in fast_methods(model)]
+            runs.append(_spec(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model=model))
+    elif not kind.strip:
         runs += [
             _spec(name=scene, dx=dx, t_end=FRONT_T_END, model=model)
             for model in ("linear", "lagrangian")
             for dx in PAPER_METHOD_2D_DX
         ]
-        return runs + model_needs(scene)
-    axes = front_axes(size, scene)
-    names = [k for k in axes if k != "dx"]
-    runs = [
-        _spec(dx=dx, t_end=FRONT_T_END, strip=True, **dict(zip(names, values)))
-        for dx in sorted(axes["dx"], reverse=True)
-        for values in itertools.product(*(axes[k] for k in names))
-    ]
-    for model in ("linear", "lagrangian"):
-        runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in fast_methods(model)]
-        runs.append(_spec(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model=model))
-    return runs + model_needs(scene)
+    return runs + (model_needs(scene) if kind.has_isothermal else [])
 
 
 def front_full(scene: str = DEFAULT_SCENE) -> list[RunSpec]:
@@ -271,16 +338,18 @@ PRESETS = {
     "stability-long": stability_long,
     "front": front,
     "front-full": front_full,
+    WALLS: walls,
 }
 
 
 def preset(name: str, scene: str = DEFAULT_SCENE) -> list[RunSpec]:
-    """The run matrix of preset ``name`` (the fronts on ``scene``), each spec carrying the preset's name."""
+    """The run matrix of preset ``name`` (the fronts on ``scene``), each spec carrying the preset's name (or its
+    own tag, where the preset names its repeats: ``walls-cost-<round>``)."""
     if name not in PRESETS:
         raise ValueError(f"preset must be one of {', '.join(PRESETS)} (got {name!r})")
     make = PRESETS[name]
     specs = make(scene=scene) if name.startswith("front") else make()
-    return [RunSpec(s.solver, s.scene, s.threads, name, s.pair_loop) for s in specs]
+    return [RunSpec(s.solver, s.scene, s.threads, s.preset or name, s.pair_loop) for s in specs]
 
 
 def matrix(

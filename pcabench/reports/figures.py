@@ -20,7 +20,7 @@ from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
 from pcabench.safeio import save_figure
 from pcabench.stability import UNSTABLE_BY_PREDICTION
-from solvers import kernel_names
+from solvers import kernel_names, scene_kind
 
 from . import paper as P
 from . import tables as T
@@ -515,9 +515,13 @@ def scene_fronts(points, out: Path, pid: str):
         return None
     path = out / "scene_fronts.png"
     past = " x: past the predicted stable CFL," if any(p["past_stable"] for p in points) else ""
+    ncols = min(len(scenes), 2)  # two panels a row: four scenes (the walls too) stay readable
+    nrows = -(-len(scenes) // ncols)
     with figure(path, f"Time to solution against error on each scene, t = 10 s, Mach 0.05 ({pid});{past} "
                       "colour: model", "time to solution, s", "relative RMS error",
-                ncols=len(scenes), logx=True, logy=True) as axes:
+                ncols=ncols, nrows=nrows, logx=True, logy=True, size=(6.5 * ncols + 2.5, 3.9 * nrows)) as axes:
+        for ax in axes[len(scenes):]:
+            ax.set_visible(False)
         for ax, scene in zip(axes, scenes):
             mine = [p for p in points if p["scene"] == scene and np.isclose(p["mach"], 0.05)]
             for model in ("linear", "lagrangian"):
@@ -532,7 +536,8 @@ def scene_fronts(points, out: Path, pid: str):
             errors = [p["error"] for p in mine]
             if errors:
                 nice_log_ticks(ax, errors)
-            ax.set_title(f"{scene} (error of {'u' if scene == 'plane-pulse' else 'drho'})", fontsize=9)
+                nice_log_ticks(ax, [p["seconds"] for p in mine], axis="x")
+            ax.set_title(f"{scene} (error of {scene_kind(scene).primary})", fontsize=9)
     return path
 
 
@@ -570,4 +575,55 @@ def phase_direction(curves, fronts, out: Path, pid: str):
             lo, hi = min(values), max(values)
             pad = 0.05 * (hi - lo or 1.0)
             ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="0.6", lw=0.8, ls=":")
+    return path
+
+
+def wall_errors(rows, out: Path, pid: str):
+    """The error near the wall and in the bulk against dx at t = 10 s, a panel per wall scene (``rows``: the walls
+    section's accuracy rows): measured as markers (hollow: lagrangian), the linear prediction as lines."""
+    scenes = sorted({r["scene"] for r in rows if r["wall_rms"] is not None})
+    if not scenes:
+        return None
+    where = {
+        "near the wall": ("wall_rms", "predicted_wall", "tab:red"),
+        "bulk": ("bulk_rms", "predicted_bulk", "tab:blue"),
+    }
+    models = {r["model"] for r in rows}
+    path = out / "walls_error.png"
+    with figure(
+        path,
+        f"Error near the wall and in the bulk against dx, t = 10 s, the paper's method ({pid}); "
+        f"colour: where{'; hollow: lagrangian' if len(models) > 1 else ''}; lines: the linear "
+        "prediction on the mirror extension",
+        "dx, m",
+        "RMS error / RMS of the exact field over the domain",
+        ncols=len(scenes),
+        logx=True,
+        logy=True,
+        size=(4.6 * len(scenes) + 3.2, 4.2),
+    ) as axes:
+        for ax, scene in zip(axes, scenes):
+            mine = [r for r in rows if r["scene"] == scene and r["wall_rms"] is not None]
+            values = []
+            for label, (key, pkey, colour) in where.items():
+                for model in ("linear", "lagrangian"):
+                    pts = sorted((r["dx"], r[key]) for r in mine if r["model"] == model)
+                    if pts:
+                        ax.plot(
+                            *zip(*pts),
+                            ls="none",
+                            marker="o",
+                            ms=6,
+                            color=colour,
+                            mfc=colour if model == "linear" else "none",
+                            label=f"{label}, {model} (measured)",
+                        )
+                        values += [v for _, v in pts]
+                pred = sorted((r["dx"], r[pkey]) for r in mine if r["model"] == "linear" and r[pkey] is not None)
+                if pred:
+                    ax.plot(*zip(*pred), ls="-", lw=1.1, color=colour, label=f"{label}, linear (predicted)")
+                    values += [v for _, v in pred]
+            plain_log_ticks(ax, [r["dx"] for r in mine])
+            nice_log_ticks(ax, values)
+            ax.set_title(f"{scene} (error of {'u' if scene == 'plane-wall' else 'drho'})", fontsize=9)
     return path

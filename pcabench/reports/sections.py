@@ -19,11 +19,12 @@ import numpy as np
 import pandas as pd
 
 from pcabench.presets import INACCURATE_ABOVE
-from solvers import Scene
+from solvers import Scene, scene_kind
 
 from . import figures as F
 from . import paper as P
 from . import tables as T
+from . import walls as W
 from .md import first_words, fmt, md_table, pct
 
 
@@ -615,6 +616,8 @@ def _scene_text(data, ctx) -> list[str]:
              if rows else "No run of a scene at t = 10 s reaches 10 %.", ""]
     by_target = {}
     for r in data["fastest"]:
+        if scene_kind(r["scene"]).walls:
+            continue  # the question is the free pulse's, plane against 2D; the walls have a section of their own
         by_target.setdefault((r["model"], r["target"]), {})[r["scene"]] = r["best"]["method"]
     both = {k: v for k, v in by_target.items() if len(v) > 1}
     if both:
@@ -660,4 +663,11 @@ SECTIONS = SECTIONS + (
             (lambda d, ctx: F.scene_fronts(d["points"], ctx.out, ctx.name) if d else None,
              lambda d, ctx: F.phase_direction(d["phase"], d["fronts"], ctx.out, ctx.name) if d else None),
             all_scenes=True),
+)
+
+
+# ---------------------------------------------------------------- sound at a rigid wall (every wall scene's runs)
+SECTIONS = SECTIONS + (
+    Section("walls", lambda ctx: W.rows(ctx.df_scenes if ctx.df_scenes is not None else ctx.df), W.text,
+            (lambda d, ctx: F.wall_errors(d["accuracy"], ctx.out, ctx.name) if d else None,), all_scenes=True),
 )

@@ -590,9 +590,10 @@ def _fold(x: float) -> float:
     return 0.0 if x < 1e-9 else x
 
 
-def long_run_limits(df) -> list[dict]:
-    """Each model's stable CFL measured by the long-run preset (``pcabench study --stability long``) beside the
-    prediction of its linear part and the limit pcabench/stability.py holds for it (what advise uses).
+def long_run_limits(df, preset: str = "stability-long") -> list[dict]:
+    """Each model's stable CFL measured by the long runs of ``preset`` (``pcabench study --stability long``; the
+    walls preset's at the wall) beside the prediction of its linear part and the limit pcabench/stability.py
+    holds for it (what advise uses).
 
     Per model and method: the CFLs run, the largest that ended bounded below the first blow-up, the smallest
     that blew up (and its step), the steps run, and the e-foldings of the most unstable linear mode over the
@@ -600,7 +601,7 @@ def long_run_limits(df) -> list[dict]:
     """
     from pcabench.stability import assess, e_foldings, measured_limit
 
-    runs = latest(df[df.preset == "stability-long"]) if "preset" in df else df.iloc[:0]
+    runs = latest(df[df.preset == preset]) if "preset" in df else df.iloc[:0]
     keys = ["scene", "mach", "model", "kernel", "h_factor", "cutoff_factor", "integrator", "precision", "dx",
             "protocol"]
     out = []

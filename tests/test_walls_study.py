@@ -1,0 +1,240 @@
+"""The walls study (``pcabench study --walls``) and its report section, "Sound at a rigid wall".
+
+The preset's run list is read as a plan: it must cover every wall scene of the registry, bracket each method's
+predicted stable CFL, and pair each wall run of the cost part with its free counterpart at the same N in
+alternating rounds. The section is rendered from a small synthetic store (no simulation): its numbers must be the
+store's, its findings the ones the store implies, and its figure must read right.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import pytest  # noqa: E402
+
+from pcabench import presets, store  # noqa: E402
+from pcabench.reports import frame, sections  # noqa: E402
+from pcabench.reports import walls as W  # noqa: E402
+from solvers import Scene, kernel_names, scenes  # noqa: E402
+from solvers.dispersion import predict, stable_cfl  # noqa: E402
+
+from .figure_check import record  # noqa: E402
+from .test_study import row  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def plan():
+    return presets.preset(presets.WALLS)
+
+
+def test_the_walls_preset_covers_every_wall_scene_of_the_registry(plan):
+    walled = {name for name, kind in scenes().items() if kind.walls}
+    assert walled and walled == set(W.wall_scenes())
+    accuracy = [s for s in plan if s.preset == presets.WALLS and s.scene.t_end == presets.FRONT_T_END]
+    for name in walled:
+        mine = [s.scene for s in accuracy if s.scene.name == name]
+        assert {s.model for s in mine} == {"linear", "lagrangian"}
+        assert len({s.dx for s in mine}) >= 2 and all(s.uses_default_numerics() for s in mine)
+        assert all((s.strip_height is not None) == scenes()[name].strip for s in mine)  # plane-wall on its strip
+    assert all(s.preset == presets.WALLS or presets.cost_round(s.preset) for s in plan)
+    assert len(plan) == len(set(plan))
+
+
+def test_the_stability_runs_bracket_each_methods_predicted_limit(plan):
+    long = [s.scene for s in plan if s.scene.t_end == presets.LONG_T_END]
+    assert long and all(s.dx == presets.STABILITY_DX for s in long)
+    for name in W.wall_scenes():
+        mine = [s for s in long if s.name == name]
+        assert {s.kernel for s in mine if s.model == "linear"} == set(kernel_names())  # every registered kernel
+        assert {s.model for s in mine if s.uses_default_numerics() or s.cfl != Scene.default("cfl")} >= {
+            "linear",
+            "fixed",
+            "lagrangian",
+        }
+        methods = {(s.model, s.kernel, s.h_factor) for s in mine}
+        for model, kernel, h in methods:
+            cfls = [s.cfl for s in mine if (s.model, s.kernel, s.h_factor) == (model, kernel, h)]
+            limit = stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear", memory_limit_bytes=2**62))
+            assert min(cfls) < limit < max(cfls), (name, model, kernel, h, cfls, limit)
+        # long enough for round-off to grow at 2 % past the limit; and the plane scene does not break before it
+        assert all(s.t_final < s.kind.breaking_time(s) for s in mine if s.model != "linear")
+
+
+def test_the_cost_runs_pair_each_wall_with_its_free_counterpart_in_alternating_rounds(plan):
+    cost = [s for s in plan if presets.cost_round(s.preset)]
+    rounds = sorted({presets.cost_round(s.preset) for s in cost})
+    assert rounds == list(range(1, presets.WALL_COST_ROUNDS + 1)) and len(rounds) >= 3
+    firsts = []
+    for i in rounds:
+        mine = [s.scene for s in cost if presets.cost_round(s.preset) == i]
+        pairs = list(zip(mine[::2], mine[1::2]))
+        for a, b in pairs:
+            assert {a.name, b.name} in [{w, f} for w, f in presets.FREE_COUNTERPART.items()]
+            assert (a.n_particles, a.dx, a.n_steps, a.model, a.x_min, a.x_max) == (
+                b.n_particles,
+                b.dx,
+                b.n_steps,
+                b.model,
+                b.x_min,
+                b.x_max,
+            )
+        firsts.append(tuple(a.kind.walls != () for a, _ in pairs))
+        for wall in presets.FREE_COUNTERPART:
+            assert len({s.dx for s in mine if s.name == wall}) >= 2
+    assert firsts[0] != firsts[1]  # which side goes first alternates
+
+
+def test_cost_round_reads_only_its_own_tags():
+    assert presets.cost_round("walls-cost-2") == 2
+    assert [presets.cost_round(p) for p in ("walls", "walls-cost-", "walls-cost-x", "quick", "")] == [None] * 5
+
+
+def _store(path):
+    """A small store: accuracy runs of both wall scenes, pulse-wall linear long runs where h 1.3 blew up below its
+    prediction, and two rounds of cost runs."""
+    recs = []
+
+    def add(rec, **errors):
+        recs.append(dataclasses.replace(rec, errors=errors) if errors else rec)
+
+    # linear as the prediction has it: plane-wall off by 1e-5 away from the wall (its free end), pulse-wall exactly
+    for name, dx, strip, gap in (("plane-wall", 0.5, True, 1e-5), ("pulse-wall", 0.5, False, 0.0)):
+        extra = {"strip_height": Scene.thinnest_strip(dx)} if strip else {}
+        p = predict(Scene(dx=dx, name=name, t_end=10.0, model="linear", **extra))
+        wall, bulk = p.measures["wall_rms"], p.measures["bulk_rms"]
+        for model, mse in (("linear", p.predicted_error * (1 + gap)), ("lagrangian", 0.35)):
+            add(
+                row(name=name, dx=dx, t_end=10.0, model=model, mse=mse, preset="walls", **extra),
+                wall_rms=wall,
+                bulk_rms=bulk * (1 + gap),
+            )
+    limit = stable_cfl(Scene(dx=1.0, h_factor=1.3, model="linear", memory_limit_bytes=2**62))
+    for cfl, status, step in ((round(0.9 * limit, 2), "unstable", 31), (round(1.02 * limit, 2), "unstable", 20)):
+        add(
+            row(
+                name="pulse-wall",
+                dx=0.5,
+                t_end=300.0,
+                model="linear",
+                h_factor=1.3,
+                cfl=cfl,
+                preset="walls",
+                status=status,
+                failed_step=step,
+            )
+        )
+    box = {"x_min": -14.0, "x_max": 6.0, "y_min": -10.0, "y_max": 10.0}
+    for i, (wall_ms, free_ms) in enumerate(((1.2, 1.0), (1.1, 1.05)), 1):
+        add(row(name="pulse-wall", dx=0.5, steps=10, step_ms=(0.0, wall_ms, 0.0), preset=f"walls-cost-{i}", stamp=i))
+        add(row(name="acoustic-pulse", dx=0.5, steps=10, step_ms=(0.0, free_ms, 0.0), preset=f"walls-cost-{i}", **box))
+    for rec in recs:
+        store.append(rec, path)
+    return path
+
+
+def test_the_section_renders_the_stores_numbers_and_findings(tmp_path):
+    df = frame.load(_store(tmp_path / "store" / "m.jsonl").parent)
+    data = W.rows(df)
+    acc = {(r["scene"], r["model"]): r for r in data["accuracy"]}
+    assert set(acc) == {(n, m) for n in ("plane-wall", "pulse-wall") for m in ("linear", "lagrangian")}
+    lin = acc[("pulse-wall", "linear")]
+    assert abs(lin["gap"]) < 1e-12 and acc[("plane-wall", "linear")]["gap"] == pytest.approx(1e-5)
+    (stab,) = data["stability"]
+    assert stab["below_prediction"] and stab["free"] is None and stab["bounded_to"] is None
+    (cost,) = data["cost"]
+    assert cost["rounds"] == 2 and cost["ratio"] == pytest.approx(1.1 / 1.0)  # each side's best round
+    assert cost["round_ratios"] == pytest.approx([1.2, 1.1 / 1.05])
+    text = "\n".join(W.text(data, None))
+    assert text.startswith("## Sound at a rigid wall")
+    for heading in ("### Accuracy at the wall", "### Stability at the wall", "### What the wall costs"):
+        assert heading in text
+    assert "pulse-wall**, linear: measured and predicted differ by at most" in text and ": round-off;" in text
+    assert "the difference is the free left end's, not the wall's" in text  # plane-wall: equal near the wall
+    assert text.count(", not one the wall adds.") == 2
+    assert "blew up below the predicted" in text and "the wall: without a free end" in text
+    assert "| pulse-wall / acoustic-pulse | lagrangian | full | 0.5 | 1,600 | 10 x 2 | 1 | 1.1 | 1.100 |" in text
+
+
+def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):
+    from types import SimpleNamespace
+
+    (section,) = [s for s in sections.SECTIONS if s.name == "walls"]
+    assert section.all_scenes  # it reads every scene's runs, not the paper's scene's only
+    data = W.rows(frame.load(_store(tmp_path / "store" / "m.jsonl").parent))
+    with record() as found:
+        (path,) = [draw(data, SimpleNamespace(out=tmp_path, name="m")) for draw in section.figures]
+    assert path.name == "walls_error.png" and path.exists()
+    assert list(found.values()) == [[]]  # drawn once, and it reads right
+
+
+def test_no_wall_run_no_section(tmp_path):
+    path = tmp_path / "s" / "m.jsonl"
+    store.append(row(dx=1.0), path)
+    assert W.rows(frame.load(path.parent)) is None
+
+
+# ---------------------------------------------------------------- the wall scenes join the front and advise
+@pytest.mark.parametrize("name", ["plane-wall", "pulse-wall"])
+def test_the_front_of_a_wall_scene_is_its_own_product_with_the_papers_method(name):
+    kind = scenes()[name]
+    runs = presets.preset("front", name)
+    assert runs and {s.scene.name for s in runs} == {name}
+    assert all((s.scene.strip_height is not None) == kind.strip for s in runs)  # plane-wall on its strip
+    axes = presets.front_axes("quick", name)
+    assert axes == presets.front_axes("quick", "plane-pulse" if kind.strip else "acoustic-pulse")
+    assert {s.scene.kernel for s in runs} == set(kernel_names())
+    paper = [s.scene for s in runs if s.scene.uses_default_numerics()]
+    assert {s.model for s in paper} == {"linear", "lagrangian"} and len({s.dx for s in paper}) >= 2
+    # no isothermal reference at a wall: no runs of "which model this scene needs" (they score against it)
+    assert not kind.has_isothermal and {s.scene.mach for s in runs} == {Scene.default("mach")}
+
+
+def test_study_list_prints_the_plan_and_runs_nothing(tmp_path, capsys):
+    from pcabench import cli
+
+    code = cli.main(["study", "--walls", "--list", "--results", str(tmp_path / "r")])
+    out = capsys.readouterr().out.splitlines()
+    assert code == 0 and len(out) == len(presets.preset(presets.WALLS)) and not (tmp_path / "r").exists()
+    assert out[0].startswith(f"[1/{len(out)}] walls: ")
+    assert sum("walls-cost-3:" in line for line in out) == 2 * sum(len(d) for d in presets.WALL_COST_DX.values())
+
+
+def test_advise_searches_the_prediction_on_a_wall_scene(tmp_path, capsys):
+    """No stored run of plane-wall reaches the error: the prediction's search runs on plane-wall itself (its strip)
+    and names a study of that scene; the paper's configuration's dx is the coarsest predicted to reach it."""
+    import json
+
+    from pcabench import cli
+
+    path = tmp_path / "r" / "m.jsonl"
+    strip = Scene.thinnest_strip(0.5)
+    store.append(row(name="plane-wall", dx=0.5, t_end=10.0, model="linear", mse=0.33, strip_height=strip), path)
+    code = cli.main(["advise", "--scene", "plane-wall", "--error", "0.2", "--results", str(path.parent), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    s = out["suggestion"]
+    assert code == 1 and not out["found"] and s["predicted_error"] <= 0.2
+    assert "--scene plane-wall --strip" in s["study"]
+    paper = s["paper_dx"]
+
+    def error(dx):
+        return predict(Scene(dx=dx, name="plane-wall", t_end=10.0, model="linear")).predicted_error
+
+    from pcabench.advise import SEARCH_DX
+    from solvers import SceneError
+
+    coarser = []
+    for dx in (d for d in SEARCH_DX if d > paper):
+        try:
+            coarser.append(error(dx))
+        except SceneError:  # too coarse for the wall's support: not searched
+            pass
+    assert error(paper) <= 0.2 and coarser and min(coarser) > 0.2
+    code = cli.main(
+        ["advise", "--scene", "plane-wall", "--error", "0.2", "--model", "lagrangian", "--results", str(path.parent)]
+    )
+    text = capsys.readouterr().out
+    assert code == 1 and "the plane-wall scene has no isothermal solution to score lagrangian runs against" in text
