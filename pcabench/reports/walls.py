@@ -150,7 +150,8 @@ def _gap_words(gap: float) -> str:
 ROUND_OFF_GAP = 1e-9  # |measured / predicted - 1| below this is round-off (the linear runs reach 1e-14)
 # The plane-wall's free left end moved 20 m away (x_min = -30 m, the same lattice otherwise): the largest
 # |measured / predicted - 1| of its linear runs at t = 10 s, dx 0.5 and 0.25 (serial linked list; the runs at
-# x_min = -10 m differed by 1.3e-5 and 8.6e-6). Measured 2026-12-01 with pcabench.run.run, not stored.
+# x_min = -10 m differed by 1.3e-5 and 8.6e-6). Measured 2026-12-01 with pcabench.run.run, not stored;
+# tests/test_walls.py checks it (below 1e-9 at dx 0.5).
 FREE_END_MOVED = (-30.0, 2.04e-14)
 
 
@@ -178,7 +179,7 @@ def _gap_note(scene: str, linear) -> str:
             "while the prediction's even extension across the wall has no edge there; the pulse's tail "
             "(1.5e-5 of its peak at 10 m) is at that end from the start. With the left end moved to "
             f"x = {x_min:g} m the same runs match the prediction to {gap:.1g} (measured once, not in this "
-            "store)."
+            "store; tests/test_walls.py checks it)."
         )
     if "free-x" in scenes()[scene].boundaries():
         return head + ": more than round-off, and not only away from the wall (its free left end is not all of it)."
