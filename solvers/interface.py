@@ -299,22 +299,16 @@ def cell_grid(scene: Scene) -> tuple:
     wide filling the lattice's width, a wall being the grid's edge (its column holds every particle with
     mirror neighbours, and they are in it) and a free edge opposite keeping its spare cell."""
     ncy = max(int(math.floor(scene.height / scene.cutoff + 1e-9)), 1)
-    if scene.periodic_x:
-        ncx = int(math.floor(scene.width / scene.cutoff + 1e-9))
-        if ncx < 3:
-            raise SceneError(
-                f"x_max - x_min must hold 3 cells of one cutoff ({3 * scene.cutoff:.6g} m) for the "
-                f"x-periodic {scene.name} scene (got {scene.width:.6g} m)"
-            )
-        return scene.width / ncx, scene.height / ncy, ncx, ncy, 0.0, scene.width
-    if scene.walls:
+    if scene.periodic_x or scene.walls:
         inside = int(math.floor(scene.width / scene.cutoff + 1e-9))
         if inside < 3:
             raise SceneError(
                 f"x_max - x_min must hold 3 cells of one cutoff ({3 * scene.cutoff:.6g} m) for the "
-                f"walled {scene.name} scene (got {scene.width:.6g} m)"
+                f"{'x-periodic' if scene.periodic_x else 'walled'} {scene.name} scene (got {scene.width:.6g} m)"
             )
         cw = scene.width / inside
+        if scene.periodic_x:
+            return cw, scene.height / ncy, inside, ncy, 0.0, scene.width
         spare_left, spare_right = "x_min" not in scene.walls, "x_max" not in scene.walls
         return cw, scene.height / ncy, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0
     ncx = int(math.ceil((scene.x_max - scene.x_min) / scene.cutoff)) + 2

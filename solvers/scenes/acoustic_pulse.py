@@ -121,13 +121,20 @@ class AcousticPulse(SceneKind):
         zero = xp.zeros_like(drho)
         return zero, zero.copy(), drho
 
+    def reference_lattice(self, scene) -> tuple[int, tuple]:
+        """(columns, image centres): the periodic lattice the exact reference is computed on, from x_lo, and the
+        x of further pulses summed with the first (here the scene's own lattice and none; a walled scene's is
+        its doubled, even-extended lattice with the pulse's mirror image)."""
+        return scene.nx, ()
+
     def reference(self, scene, t: float):
-        """The exact linear solution on the scene's periodic lattice at ``t`` (solvers/pulse2d.py)."""
+        """The exact linear solution on the reference lattice at ``t`` (solvers/pulse2d.py)."""
         from ..pulse2d import periodic_linear
 
         xc, yc = centre(scene)
+        columns, images = self.reference_lattice(scene)
         return periodic_linear(
-            scene.nx,
+            columns,
             scene.ny,
             scene.dx,
             scene.x_lo,
@@ -139,6 +146,7 @@ class AcousticPulse(SceneKind):
             scene.rho0,
             scene.c0,
             t,
+            images=images,
         )
 
     def exact_fields(self, scene, t: float):
