@@ -203,14 +203,18 @@ def domain_of(args) -> dict:
         raise OptionError(str(exc)) from None
 
 
+def check_wall_option(names, wall_given: bool) -> None:
+    """One line unless --wall-x (Scene.x_max, the wall) comes only with scenes that have a wall."""
+    bare = [name for name in names if not scene_kind(name).walls]
+    if wall_given and bare:
+        walled = ", ".join(name for name, kind in scenes().items() if kind.walls)
+        raise OptionError(f"--wall-x applies to the scenes with a wall ({walled}), not to {', '.join(bare)}")
+
+
 def scene_from_args(args) -> Scene:
     """The scene of the options, bounded by the memory this process may use (one line if it does not fit)."""
     given = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt) is not None}
-    if "x_max" in given and not scene_kind(given.get("name", DEFAULT_SCENE)).walls:
-        walled = ", ".join(name for name, kind in scenes().items() if kind.walls)
-        raise OptionError(
-            f"--wall-x applies to the scenes with a wall ({walled}), not to {given.get('name', DEFAULT_SCENE)}"
-        )
+    check_wall_option([given.get("name", DEFAULT_SCENE)], "x_max" in given)
     return Scene(
         dx=args.dx,
         steps=args.steps,
@@ -303,8 +307,14 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     """The preset named by the flags, or the matrix built from the scene options."""
     from .presets import matrix, preset
 
+    presets = [flag for flag in ("quick", "paper", "walls", "stability", "front") if getattr(args, flag, None)]
+    if args.dx and presets:
+        raise OptionError(
+            f"--dx builds a matrix of runs; --{presets[0]} is a preset with its own: give one or the other"
+        )
     if args.dx:
         lists = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt)}
+        check_wall_option(lists.get("name", [DEFAULT_SCENE]), "x_max" in lists)
         return "matrix", matrix(
             args.solver or [DEFAULT_SOLVER],
             args.dx,
@@ -324,7 +334,10 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
         )
         or args.strip
     ):
-        raise OptionError("--dx is needed to build a matrix from the scene options (or use a preset alone)")
+        raise OptionError(
+            "--dx is needed to build a matrix from the scene options; a preset (--quick, --paper, --stability, "
+            "--walls, --front) takes none of them"
+        )
     name = (
         "paper"
         if args.paper
@@ -335,7 +348,7 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
         else {None: "quick", "quick": "front", "full": "front-full"}[args.front]
     )
     if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not name.startswith("front")):
-        raise OptionError("--scene with a preset: one scene, with --front (the other presets are the paper's scene)")
+        raise OptionError("--scene with a preset: one scene, with --front (the other presets choose their own scenes)")
     return name, preset(name, scene[0])
 
 
@@ -428,6 +441,7 @@ def cmd_accuracy(args) -> int:
     from solvers.dispersion import predict
 
     given = {key: getattr(args, opt) for opt, key in ACCURACY_OPTIONS.items() if getattr(args, opt) is not None}
+    check_wall_option([given.get("name", DEFAULT_SCENE)], "x_max" in given)
     scene = Scene(dx=args.dx, t_end=args.t_end, model="linear", memory_limit_bytes=2**62, **given, **domain_of(args))
     p = predict(scene)
     past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/stability.py)
@@ -682,8 +696,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "accuracy",
         help="predict a run's error and largest stable CFL from the dispersion relation",
-        description="The relative RMS error of u at --t-end and the largest stable CFL of the "
-        "`linear` model, from the lattice's SPH operator and the integrator's step, "
+        description="The relative RMS error of the scene's primary field (u; drho in 2D) at --t-end and the "
+        "largest stable CFL of the `linear` model, from the lattice's SPH operator and the integrator's step, "
         "with no simulation (for fixed and lagrangian: their linear part).",
     )
     p.add_argument("--dx", type=number("--dx"), required=True, help="lattice spacing, m")
@@ -697,10 +711,15 @@ def build_parser() -> argparse.ArgumentParser:
         "advise",
         help="the fastest stored run that reaches an error at a physical time",
         description="Among one machine's stored runs at --t-end, the fastest by time to solution "
-        "(init + steps, JIT apart) whose relative RMS error of u is at most --error, "
+        "(init + steps, JIT apart) whose relative RMS error (u, or drho in 2D) is at most --error, "
         "the paper configuration's time to the same error, and the command line.",
     )
-    p.add_argument("--error", type=number("--error"), required=True, help="relative RMS error of u, e.g. 0.01")
+    p.add_argument(
+        "--error",
+        type=number("--error"),
+        required=True,
+        help="relative RMS error of the scene's primary field (u; drho in 2D), e.g. 0.01",
+    )
     p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical time, s (default 10)")
     p.add_argument("--model", choices=MODELS, default="linear", help="default linear")
     p.add_argument("--scene", choices=scene_names(), default=DEFAULT_SCENE, help=f"default {DEFAULT_SCENE}")

@@ -34,7 +34,8 @@ PULSE_WIDTH_RANGE = (0.1, 20.0)  # m
 def wall_measures(scene, x, diff, ref) -> dict:
     """The error near the walls apart from the error in the bulk: ``wall_rms`` over the particles within a
     cutoff of a wall (those with mirror neighbours), ``bulk_rms`` over the others, each the RMS of ``diff``
-    there over the RMS of ``ref`` over the whole domain (so that the two add up in quadrature to the whole)."""
+    there over the RMS of ``ref`` over the whole domain (their squares, weighted by each band's share of the
+    particles, add up to the whole's square)."""
     import numpy as np
 
     x, diff, ref = (np.asarray(a, dtype=np.float64) for a in (x, diff, ref))

@@ -36,11 +36,12 @@ def image_x(scene, x):
 
 
 def wall_check(scene) -> list[str]:
-    """The pulse must start inside the domain, clear of the wall: at least a pulse width and a cutoff from it
+    """The pulse must start inside the domain, clear of every wall: at least a pulse width and a cutoff from it
     (the wall's support: the particles that have mirror neighbours), one line each."""
     out = []
     wall = scene.x_max
     clear = max(scene.pulse_width, scene.cutoff)
+    left = scene.walls.get("x_min")
     if not scene.x_min < scene.pulse_center < wall:
         out.append(
             f"--pulse-center must be inside the domain ({scene.x_min:g}, {wall:g}) m, left of the wall "
@@ -50,6 +51,11 @@ def wall_check(scene) -> list[str]:
         out.append(
             f"--wall-x must be at least max(pulse width, cutoff) = {clear:g} m right of the pulse's centre "
             f"{scene.pulse_center:g} m (got the wall at {wall:g} m): the pulse would start inside the wall's support"
+        )
+    elif left is not None and scene.pulse_center - left < clear:
+        out.append(
+            f"--pulse-center must be at least max(pulse width, cutoff) = {clear:g} m right of the left wall at "
+            f"{left:g} m (got {scene.pulse_center:g}): the pulse would start inside the wall's support"
         )
     return out
 
