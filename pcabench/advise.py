@@ -147,7 +147,11 @@ def advise(
         "t_end": t_end,
         "model": model,
         "runs_considered": int(len(runs)),
-        "error_against": "the isothermal solution" if column == "mse_isothermal" else "the linear pulse",
+        "error_against": "the isothermal solution"
+        if column == "mse_isothermal"
+        else "the linear pulse"
+        if scene == Scene.default("name")
+        else "the exact linear solution",
     }
     if hits.empty:
         out["found"] = False
@@ -248,7 +252,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                     "--solver",
                     DEFAULT_SOLVER,
                     "--model",
-                    model,
+                    model if scene_kind(scene).has_isothermal else "linear",  # else no lagrangian run is scored
                     "--t-end",
                     f"{t_end:g}",
                     *([] if scene == DEFAULT_SCENE else ["--scene", scene]),
@@ -274,9 +278,11 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
     lines = []
     primary = scene_kind(scene).primary
     scene_words = "" if scene == DEFAULT_SCENE else f"{scene}, "
+    no_reference = out["error_against"] == "the isothermal solution" and not scene_kind(scene).has_isothermal
+    against = "the isothermal solution, which this scene does not have" if no_reference else out["error_against"]
     head = (
         f"{scene_words}{model} to a relative RMS error of {primary} <= {error:g} "
-        f"(against {out['error_against']}) at "
+        f"(against {against}) at "
         f"t = {t_end:g} s on {out['machine']}" + (f", {domain} domain" if domain else "")
     )
     if not out["found"]:
@@ -285,10 +291,10 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
             f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL."
         )
         lines += unstable_lines(out["unstable_by_prediction"], "runs that reach it")
-        if out["error_against"] == "the isothermal solution" and not scene_kind(scene).has_isothermal:
+        if no_reference:
             lines.append(
-                f"the {scene} scene has no isothermal solution to score {model} runs against (none is known there); "
-                "the prediction below is of the linear part"
+                f"no {model} run of {scene} can be scored (no isothermal solution is known there); the "
+                "prediction below is of the linear part, the method to try with --model linear"
             )
         if "study" not in s:
             lines.append("no method of the searched grid is predicted to reach it")
@@ -318,7 +324,11 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
         f"commit {out['commit'][:7]})\n  {out['command']}"
     )
     if out["is_paper_configuration"]:
-        lines.append("  this is the paper's configuration: none faster reaches the error")
+        lines.append(
+            f"  this is the paper's configuration: none of the {out['runs_considered']} stored runs reaching t = "
+            f"{t_end:g} s is faster"
+            + ("" if scene == DEFAULT_SCENE else f" (`pcabench study --front --scene {scene}` runs other methods)")
+        )
     elif out["paper_seconds"]:
         lines.append(
             f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
