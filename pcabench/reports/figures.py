@@ -593,8 +593,8 @@ def wall_errors(rows, out: Path, pid: str):
     with figure(
         path,
         f"Error near the wall and in the bulk against dx, t = 10 s, the paper's method ({pid}); "
-        f"colour: where{'; hollow: lagrangian' if len(models) > 1 else ''}; lines: the linear "
-        "prediction on the mirror extension",
+        f"colour: where{'; hollow: lagrangian (against the linear solution)' if len(models) > 1 else ''}; "
+        "lines: the linear prediction on the mirror extension (the linear runs sit on it)",
         "dx, m",
         "RMS error / RMS of the exact field over the domain",
         ncols=len(scenes),
