@@ -237,4 +237,5 @@ def test_advise_searches_the_prediction_on_a_wall_scene(tmp_path, capsys):
         ["advise", "--scene", "plane-wall", "--error", "0.2", "--model", "lagrangian", "--results", str(path.parent)]
     )
     text = capsys.readouterr().out
-    assert code == 1 and "the plane-wall scene has no isothermal solution to score lagrangian runs against" in text
+    assert code == 1 and "no lagrangian run of plane-wall can be scored (no isothermal solution is known there)" in text
+    assert "--model linear" in text  # the suggested study is one whose runs can be scored
