@@ -610,16 +610,17 @@ def walls(c: Check) -> bool:
     return agrees(c.state["walls"])
 
 
-def gpu_sweep(c: Check) -> bool:
+def stored_sweep(c: Check, specs, spare_s: float) -> list[dict]:
+    """``specs`` through the ordinary sweep into the check's store, within what is left of the budget less
+    ``spare_s`` seconds kept for the stages after; the rows."""
     from .sweep import sweep
 
-    c.state["gpu_rows"] = sweep(
-        gpu_specs(c.plan),
-        c.store_path,
-        run_budget=c.budget.left(),
-        sweep_budget=c.budget.left() - 60,
-        runner=run_and_release,
-    )
+    left = c.budget.left()
+    return sweep(specs, c.store_path, run_budget=left, sweep_budget=left - spare_s, runner=run_and_release)
+
+
+def gpu_sweep(c: Check) -> bool:
+    c.state["gpu_rows"] = stored_sweep(c, gpu_specs(c.plan), spare_s=60)
     return all(r["status"] == "ok" for r in c.state["gpu_rows"])
 
 
@@ -648,15 +649,7 @@ def graph(c: Check) -> bool:
 
 
 def cpu_peers(c: Check) -> bool:
-    from .sweep import sweep
-
-    c.state["cpu_rows"] = sweep(
-        cpu_peer_specs(c.plan),
-        c.store_path,
-        run_budget=c.budget.left(),
-        sweep_budget=c.budget.left() - 30,
-        runner=run_and_release,
-    )
+    c.state["cpu_rows"] = stored_sweep(c, cpu_peer_specs(c.plan), spare_s=30)
     return all(r["status"] == "ok" for r in c.state["cpu_rows"])
 
 

@@ -39,7 +39,7 @@ def wall_check(scene) -> list[str]:
     """The pulse must start inside the domain, clear of every wall: at least a pulse width and a cutoff from it
     (the wall's support: the particles that have mirror neighbours), one line each."""
     out = []
-    wall = scene.x_max
+    wall = scene.walls["x_max"]
     clear = max(scene.pulse_width, scene.cutoff)
     left = scene.walls.get("x_min")
     if not scene.x_min < scene.pulse_center < wall:
