@@ -6,6 +6,9 @@ events instead of the host clock. Nothing touches CUDA at import: the check
 runs in ``setup``.
 """
 
+import shutil
+import tempfile
+
 from .common import Prepared, StageBenchmarks, gpu_available, gpu_dx, jit_seconds_in_fresh_process
 
 
@@ -33,14 +36,24 @@ class TimeGPUStep(StageBenchmarks):
 
 
 class TrackGPUJIT:
-    params = [["float32", "float64"]]
-    param_names = ["precision"]
+    """The GPU kernels' compile in a fresh interpreter: cold (an empty JIT cache) and cached (numba-cuda's
+    cache of the kernels, per compute capability, filled by a first process)."""
+
+    params = [["float32", "float64"], ["cold", "cached"]]
+    param_names = ["precision", "cache"]
     unit = "s"
     timeout = 600
 
-    def setup(self, precision):
+    def setup(self, precision, cache):
         if not gpu_available():
             raise NotImplementedError("no CUDA GPU on this machine")
+        self.folder = tempfile.mkdtemp(prefix="pcabench-jit-")
+        if cache == "cached":
+            jit_seconds_in_fresh_process("linkedlist-gpu", precision, self.folder)
 
-    def track_jit_seconds(self, precision):
-        return jit_seconds_in_fresh_process("linkedlist-gpu", precision)
+    def teardown(self, *_):
+        if hasattr(self, "folder"):
+            shutil.rmtree(self.folder, ignore_errors=True)
+
+    def track_jit_seconds(self, precision, cache):
+        return jit_seconds_in_fresh_process("linkedlist-gpu", precision, self.folder)

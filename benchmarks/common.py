@@ -185,14 +185,17 @@ class StageBenchmarks(abc.ABC):
         self.p.stage("su")
 
 
-def jit_seconds_in_fresh_process(solver: str, precision: str) -> float:
-    """Compilation time of ``solver`` as a new user meets it: a fresh interpreter, s."""
+def jit_seconds_in_fresh_process(solver: str, precision: str, cache: str | None = None) -> float:
+    """Compilation time of ``solver`` in a fresh interpreter, s, with the JIT cache (solvers/jitcache.py) in
+    the folder ``cache`` (None: the user's): an empty folder times a cold compile, as a new user's first
+    run meets it; a folder a run has filled times the load from the cache, as every later run meets it."""
     code = (
         f"from {solvers.__name__} import Scene, make_solver\n"
         f"s = make_solver({solver!r}); s.input(Scene(dx=1.0, precision={precision!r}))\n"
         "print(s.warmup())"
     )
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    env = dict(os.environ, **({"PCABENCH_CACHE": cache} if cache else {}))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, env=env)
     if proc.returncode != 0:
         raise RuntimeError(proc.stderr.strip()[-400:])
     return float(proc.stdout.strip().splitlines()[-1])

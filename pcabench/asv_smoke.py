@@ -27,7 +27,7 @@ SCRATCH = Path(".asv") / "smoke" / "results"  # under the ignored .asv/
 SELECTION = (
     r"TimeStep\.time_step\('(allpair|linkedlist)-cpu', 'float64', 1\.0\)",
     r"TrackStageShare\.track_share\('float64', 'pi'\)",
-    r"TrackJIT\.track_jit_seconds\('linkedlist-cpu', 'float64'\)",
+    r"TrackJIT\.track_jit_seconds\('linkedlist-cpu', 'float64', 'cached'\)",
     r"TimeGPUStep\.time_step\('float32', 0\.1\)",
 )
 

@@ -564,6 +564,32 @@ def cmd_check_solver(args) -> int:
     return check_solver(args.name, quick=args.quick, as_json=args.json)
 
 
+def cmd_cache(args) -> int:
+    from solvers import jitcache
+
+    root = jitcache.cache_root()
+    if args.clear:
+        freed = jitcache.clear()
+        print(f"cleared {root / 'jit'} ({freed / 2**20:.1f} MiB); the next run of each configuration compiles again")
+        return 0
+    entries = jitcache.entries()
+    if args.json:
+        print(jsonout.dumps({"root": str(root), "target": jitcache.target(), "entries": entries}, indent=2))
+        return 0
+    size = sum(e["bytes"] for e in entries)
+    print(f"JIT cache  {root / 'jit'}  (${jitcache.ENV} moves it)")
+    print(f"this machine's target  {jitcache.target()}")
+    print(
+        f"{len(entries)} specialised modules, {sum(e['functions'] for e in entries)} compiled functions, "
+        f"{size / 2**20:.1f} MiB"
+    )
+    for e in entries:
+        here = "" if e["target"] == jitcache.target() else f"  ({e['target']})"
+        print(f"  {e['module']:<34} {e['functions']:>2} functions {e['bytes'] / 2**10:>6.0f} KiB{here}")
+        print(f"      {e['specialisation']}")
+    return 0
+
+
 # ---------------------------------------------------------------- the parser
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(
@@ -788,6 +814,17 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--json", action="store_true", help="one JSON object: solver, ok, checks")
     p.set_defaults(func=cmd_check_solver)
+
+    p = sub.add_parser(
+        "cache",
+        help="show or clear the on-disk cache of compiled loops",
+        description="The compiled loops (solvers/loops/) are cached on disk once per machine and configuration "
+        "(solvers/jitcache.py), in $PCABENCH_CACHE, else $XDG_CACHE_HOME/pcabench, else ~/.cache/pcabench. "
+        "Clearing it is always safe: a run using it keeps its loops, and later runs compile again.",
+    )
+    p.add_argument("--clear", action="store_true", help="remove every compiled loop (all targets)")
+    p.add_argument("--json", action="store_true", help="one JSON object: root, target, entries")
+    p.set_defaults(func=cmd_cache)
     return parser
 
 

@@ -5,9 +5,14 @@ of the same solver, precision, model and threads (any protocol), per
 neighbour for the cell lists: their step time is taken proportional to the
 neighbours per particle, (cutoff / dx)^2, so runs of another kernel or h/dx
 inform the fit. With two or more sizes ``b`` is fitted; with one, ``b`` is
-the solver's ``order`` (2 for all-pair, 1 for a cell list). A run whose predicted time, steps times step
-plus JIT and start-up, exceeds the run budget is recorded as ``skipped`` with
-the prediction, instead of being run into the wall.
+the solver's ``order`` (2 for all-pair, 1 for a cell list). A run's time is
+its steps times the step, plus the child process's start-up, plus its JIT:
+a cold compile for the first run of a compiled configuration (solver,
+precision, kernel, threaded or not) this host has not run before, a load
+from the JIT cache (solvers/jitcache.py) otherwise, each the median of this
+host's stored runs that did so. A run whose predicted time exceeds the run
+budget is recorded as ``skipped`` with the prediction, instead of being run
+into the wall.
 """
 
 from __future__ import annotations
@@ -20,7 +25,35 @@ from solvers import solver_class
 
 from .record import step_seconds
 
-START_UP = 5.0  # s: a child process, imports and JIT on a tiny scene (measured 3-7 s on a laptop CPU)
+START_UP = 2.0  # s: a child process's start, imports, scoring and hand-back, JIT aside (1.9 s measured here)
+COLD_JIT = 6.0  # s: compiling a configuration's loops, where no stored run says (5-12 s measured here)
+CACHED_JIT = 0.5  # s: loading them from the JIT cache, where no stored run says (0.3-0.4 s measured here)
+
+
+def variant(solver: str, threads, scene: dict) -> tuple:
+    """What decides which loops a run compiles: solver, precision, kernel, and whether it runs threads."""
+    return solver, scene.get("precision"), scene.get("kernel") or "gaussian", int(threads or 1) > 1
+
+
+def spec_variant(spec) -> tuple:
+    return variant(spec.solver, spec.threads, spec.scene.as_dict())
+
+
+def row_variant(row: dict) -> tuple:
+    return variant(row.get("solver"), row.get("threads"), row.get("scene") or {})
+
+
+def jit_seconds(spec, rows: list[dict], cached: bool) -> float:
+    """The JIT a run of ``spec`` pays, s: the median of this host's stored runs of its solver that compiled
+    (``cached`` False) or loaded from the cache (True), else :data:`COLD_JIT` / :data:`CACHED_JIT`."""
+    seen = [
+        float(r["jit_seconds"])
+        for r in rows
+        if r.get("solver") == spec.solver and r.get("jit_cached") is cached and r.get("jit_seconds") is not None
+    ]
+    if seen:
+        return float(np.median(seen))
+    return CACHED_JIT if cached else COLD_JIT
 
 
 def _same_config(row: dict, spec) -> bool:
@@ -65,18 +98,22 @@ def step_model(spec, rows: list[dict]):
     return a, b, [int(k) for k in n]
 
 
-def predicted_seconds(spec, rows: list[dict]):
-    """``(seconds, why)`` for the RunSpec ``spec`` from ``rows`` of this host, or ``(None, "")`` without data."""
+def predicted_seconds(spec, rows: list[dict], cached: bool | None = None):
+    """``(seconds, why)`` for the RunSpec ``spec`` from ``rows`` of this host, or ``(None, "")`` without data.
+    ``cached``: whether its loops are in the JIT cache (None: where a stored row ran its configuration)."""
     scene = spec.scene
     model = step_model(spec, rows)
     if model is None:
         return None, ""
+    if cached is None:
+        cached = spec_variant(spec) in {row_variant(r) for r in rows}
     a, b, sizes = model
     step = a * scene.n_particles**b
-    seconds = START_UP + scene.n_steps * step
+    jit = jit_seconds(spec, rows, cached)
+    seconds = START_UP + jit + scene.n_steps * step
     sizes_txt = ", ".join(f"{n:,}" for n in sizes[-3:])
     why = (
-        f"predicted {seconds:.3g} s ({scene.n_steps} steps x {1e3 * step:.3g} ms; step time "
-        f"~ N^{b:.2f} fitted to N = {sizes_txt} on this host)"
+        f"predicted {seconds:.3g} s ({scene.n_steps} steps x {1e3 * step:.3g} ms, {jit:.2g} s of JIT "
+        f"{'cached' if cached else 'compiling'}; step time ~ N^{b:.2f} fitted to N = {sizes_txt} on this host)"
     )
     return (seconds if math.isfinite(seconds) else None), why

@@ -49,6 +49,9 @@ class RunRecord:
     versions: dict = field(default_factory=dict)
     preset: str = ""  # the study preset that asked for the run (quick, paper, stability, matrix), if any
     host: str = ""  # provenance.host_id(): which computer of this hardware profile made the run
+    # True: no loop was compiled for this run (each loaded from the on-disk JIT cache, solvers/jitcache.py, or
+    # already in the process); False: at least one was compiled; None in rows older than the cache
+    jit_cached: bool | None = None
     timestamp: str = field(default_factory=lambda: _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
     run_id: str = field(default_factory=lambda: uuid.uuid4().hex[:16])  # this record, wherever it is copied
 
@@ -125,7 +128,8 @@ class RunRecord:
             share = f"{100 * self.stages[s] / step_total:13.1f} %" if s in STEP_STAGES else ""
             per_txt = f"{per:16.3f}" if s in STEP_STAGES else f"{'':16}"
             lines.append(f"{s:<8}{self.stages[s]:12.4f}{per_txt}{share:>15}")
-        lines.append(f"{'jit':<8}{self.jit_seconds:12.4f}   (compilation, outside the timed stages)")
+        how = {True: "loaded from the JIT cache", False: "compiled"}.get(self.jit_cached, "compilation")
+        lines.append(f"{'jit':<8}{self.jit_seconds:12.4f}   ({how}, outside the timed stages)")
         return "\n".join(lines)
 
     def text(self, scene) -> str:

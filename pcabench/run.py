@@ -13,7 +13,7 @@ import os
 import signal
 import sys
 
-from solvers import SceneError, make_solver
+from solvers import SceneError, jitcache, make_solver
 from solvers.integrators import step_program
 
 from .clock import clock_for
@@ -36,7 +36,9 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> Ru
         clock = None
         # JIT compilation and the first launch, on a tiny scene, outside the timed region.
         solver.input(scene)
+        before = jitcache.counts()["compiled"]
         record.jit_seconds = solver.warmup()
+        record.jit_cached = jitcache.counts()["compiled"] == before
         solver = make_solver(spec.solver, threads=spec.threads, pair_loop=spec.pair_loop)
         clock = clock_for(solver)
         clock.time("input", solver.input, scene)

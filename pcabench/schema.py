@@ -50,7 +50,7 @@ RESERVED_SUFFIXES = (".md", ".png", ".json", ".jsonl", ".lock", ".torn", ".reser
 class Field:
     """One key of a record: its JSON types, range, allowed characters and length."""
 
-    types: tuple  # of "str", "int", "number", "dict", "null"
+    types: tuple  # of "str", "int", "number", "bool", "dict", "null"
     required: bool = False
     low: float | None = None
     high: float | None = None
@@ -87,6 +87,7 @@ FIELDS: dict[str, Field] = {
     "t_end": Field(("number", "null"), low=0, high=1e12),
     "stages": Field(("dict",), True),
     "jit_seconds": _time(null=True),
+    "jit_cached": Field(("bool", "null")),
     "mse": _ERROR,
     "me": _ERROR,
     "mean_neighbours": Field(("number", "null"), low=0, high=2**31),

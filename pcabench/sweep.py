@@ -30,7 +30,7 @@ from pathlib import Path
 
 from . import store
 from .memory import cgroup_memory_folders
-from .predict import predicted_seconds
+from .predict import predicted_seconds, row_variant, spec_variant
 from .profiles import MACHINE_ID_ENV, machine_id
 from .provenance import git_commit, host_id
 from .record import RunRecord, step_seconds
@@ -206,7 +206,11 @@ def eta_text(
     """The sweep's ETA and how sure it is: runs predicted from ``whose`` timings, the rest at the mean so far."""
     if not remaining:
         return "done"
-    predicted = [predicted_seconds(s, mine)[0] for s in remaining]
+    compiled = {row_variant(r) for r in mine}  # configurations whose loops the cache holds by then
+    predicted = []
+    for s in remaining:
+        predicted.append(predicted_seconds(s, mine, cached=spec_variant(s) in compiled)[0])
+        compiled.add(spec_variant(s))
     known = [p for p in predicted if p is not None]
     unknown = len(predicted) - len(known)
     if unknown and seconds_per_run is None:

@@ -10,41 +10,16 @@ from __future__ import annotations
 import time
 from functools import lru_cache
 
-import numba
-
-from .backend import cpu_pairs, cpu_updates
+from .backend import COMPILED, cpu_loops, cpu_updates
 from .interface import Solver, tiny_scene
 
 
 @lru_cache(maxsize=None)
 def sweeps(precision: str, kernel: str) -> dict:
-    """The all-pair interaction loops for ``precision`` and ``kernel`` (serial, as in the paper)."""
-    P = cpu_pairs(precision, kernel)
-
-    def continuity(lx, ly, sx, sy, u, v, vol, drho, out, k):
-        n = lx.shape[0]
-        for i in range(n):
-            out[i] = P.continuity_allpair(i, n, lx, ly, sx, sy, u, v, vol, drho, k)
-
-    def momentum(lx, ly, sx, sy, mass, pr, ax, ay, k):
-        n = lx.shape[0]
-        for i in range(n):
-            ax[i], ay[i] = P.momentum_allpair(i, n, lx, ly, sx, sy, mass, pr, k)
-
-    def neighbours(lx, ly, sx, sy, k):
-        n = lx.shape[0]
-        total = 0
-        for i in range(n):
-            total += P.neighbours_allpair(i, n, lx, ly, sx, sy, k)
-        return total
-
-    jit = numba.njit(nogil=True)
-    return {
-        "continuity": jit(continuity),
-        "momentum": jit(momentum),
-        "neighbours": jit(neighbours),
-        **cpu_updates(precision, False),
-    }
+    """The all-pair interaction loops for ``precision`` and ``kernel`` (serial, as in the paper;
+    solvers/loops/allpair.py, compiled once per machine), and the per-particle updates."""
+    loops = cpu_loops("allpair", precision, kernel, False)
+    return {**{name: getattr(loops, name) for name in COMPILED["allpair"]}, **cpu_updates(precision, False)}
 
 
 class AllPairCPU(Solver):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import threading
 from functools import lru_cache
+from types import ModuleType
 
 from .kernels import DEFAULT_KERNEL
 
@@ -34,39 +35,62 @@ def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL):
     return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision)
 
 
-def _gather_range(src, order, out, lo, hi):
-    """out[i] = src[order[i]] for lo <= i < hi. Compiled on its own: written inline in a parallel loop's
-    body, numba compiled this loop 2.5 times slower (measured here)."""
-    for i in range(lo, hi):
-        out[i] = src[order[i]]
+def pair_sources(kernel: str = DEFAULT_KERNEL) -> tuple:
+    """What the compiled pair functions are made of, for the cache's key (solvers/jitcache.py): the pair
+    physics, the constant tuple and exp(-x), this module, and the kernel's own file (a plug-in's too)."""
+    from .kernels import kernel_named
+
+    return ("solvers.pairs", "solvers.kernel", "solvers.backend", type(kernel_named(kernel)))
+
+
+def cpu_loops(template: str, precision: str, kernel: str, parallel: bool | None, **bind) -> ModuleType:
+    """The loops of ``template`` (solvers/loops/) over :func:`cpu_pairs` for ``precision`` and ``kernel``,
+    compiled with numba's CPU target (on its threads where ``parallel``; every function the template lists in
+    ``COMPILED``) and cached on disk once per machine (solvers/jitcache.py). ``bind``: more free names, as values."""
+    from . import jitcache
+
+    module = f"solvers.loops.{template}"
+    options = {"nogil": True} if parallel is None else {"nogil": True, "parallel": parallel}
+    options.update(LOOP_OPTIONS.get(template, {}))
+    names = COMPILED[template]
+    return jitcache.specialise(
+        module,
+        bind={"P": f"cpu_pairs({precision!r}, {kernel!r})", **{k: repr(v) for k, v in bind.items()}},
+        functions={name: ("numba.njit", options) for name in names},
+        imports=("import numba", "from solvers.backend import cpu_pairs"),
+        depends=pair_sources(kernel),
+    )
+
+
+# The functions each CPU template compiles (the rest of a template is inlined helpers and constants), and
+# the options a template adds to nogil (and parallel where a solver runs threads).
+COMPILED = {
+    "updates": ("coefficients", "kick", "advance", "gather"),
+    "sorting": ("counting_sort", "sort_cells_by_x"),
+    "cells": ("continuity", "momentum", "neighbours", "wall_continuity", "wall_momentum", "cell_ids"),
+    "allpair": ("continuity", "momentum", "neighbours"),
+    "pairlist": ("build", "continuity", "momentum"),
+}
+LOOP_OPTIONS = {"pairlist": {"error_model": "numpy"}}
 
 
 @lru_cache(maxsize=None)
 def cpu_updates(precision: str, parallel: bool) -> dict:
     """The per-particle loops of a CPU solver, serial or on numba's threads: the sweeps' coefficients,
     the system update (kick, advance) and the gather that reorders an array (``parts`` ranges)."""
-    import numba
+    loops = cpu_loops("updates", precision, DEFAULT_KERNEL, parallel)  # they do not depend on the kernel
+    return {name: getattr(loops, name) for name in COMPILED["updates"]}
 
-    P = cpu_pairs(precision)  # the per-particle functions only: they do not depend on the kernel
-    prange = numba.prange
-    gather_range = numba.njit(nogil=True)(_gather_range)
 
-    def coefficients(drho, mass, vol, pr, continuity, momentum, k):
-        for i in prange(drho.shape[0]):
-            P.coefficients_at(i, drho, mass, vol, pr, continuity, momentum, k)
+@lru_cache(maxsize=None)
+def cpu_sorting() -> ModuleType:
+    """The serial cell sort (solvers/loops/sorting.py): ``counting_sort``, ``sort_cells_by_x``, compiled once."""
+    from . import jitcache
 
-    def kick(u, v, ax, ay, c):
-        for i in prange(u.shape[0]):
-            P.kick_at(i, u, v, ax, ay, c)
-
-    def advance(drho, dd, sx, sy, u, v, c, moving):
-        for i in prange(drho.shape[0]):
-            P.advance_at(i, drho, dd, sx, sy, u, v, c, moving)
-
-    def gather(src, order, out, parts):
-        n = order.shape[0]
-        for t in prange(parts):
-            gather_range(src, order, out, t * n // parts, (t + 1) * n // parts)
-
-    jit = numba.njit(nogil=True, parallel=parallel)
-    return {"coefficients": jit(coefficients), "kick": jit(kick), "advance": jit(advance), "gather": jit(gather)}
+    compiled = ("numba.njit", {"nogil": True})
+    return jitcache.specialise(
+        "solvers.loops.sorting",
+        bind={},
+        functions=dict.fromkeys(COMPILED["sorting"], compiled),
+        imports=("import numba",),
+    )

@@ -1,24 +1,21 @@
 """The GPU solver's device kernels (numba-cuda), from the shared pair physics.
 
 Imported only once the GPU solver has a device (or numba's simulator), so
-that nothing touches CUDA at the import of ``solvers``. ``cuda`` is this
-module's global on purpose: numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1)
-runs the kernels as Python and swaps the module global named ``cuda`` for its
-own, which a closure variable would hide from it.
+that nothing touches CUDA at the import of ``solvers``. The kernels
+themselves are the template solvers/loops/gpu.py, specialised here.
 """
 
 from __future__ import annotations
 
 from functools import lru_cache
 
-from numba import cuda, int32
+from numba import cuda
 
+from .backend import pair_sources
 from .gpu_device import device_backend, simulated
 from .kernel import exp_neg_math
 from .kernels import DEFAULT_KERNEL
 from .pairs import make_pairs
-
-SCAN_ITEMS = 4  # cells per thread in one pass of the cellBegin scan
 
 
 def _device_function(fastmath: bool):
@@ -32,134 +29,46 @@ def _device_function(fastmath: bool):
     return cuda.jit(device=True, fastmath=fastmath)
 
 
+KERNELS = (
+    "cell_count",
+    "cell_begin",
+    "scatter",
+    "continuity",
+    "momentum",
+    "neighbours",
+    "coefficients",
+    "kick",
+    "advance",
+)
+
+
 @lru_cache(maxsize=None)
-def kernels(precision: str, kernel: str = DEFAULT_KERNEL):
-    """The device kernels for ``precision`` and ``kernel`` (compiled by numba-cuda on first launch).
+def device_pairs(precision: str, kernel: str = DEFAULT_KERNEL):
+    """The pair functions as device functions (plain Python in the simulator) for ``precision`` and ``kernel``."""
+    return make_pairs(_device_function(precision == "float32"), exp_neg_math, kernel, precision)
+
+
+@lru_cache(maxsize=None)
+def kernels(precision: str, kernel: str = DEFAULT_KERNEL) -> dict:
+    """The device kernels for ``precision`` and ``kernel`` (solvers/loops/gpu.py): on a GPU compiled by
+    numba-cuda on first launch and cached on disk once per machine and compute capability
+    (solvers/jitcache.py); in the simulator run as Python, so nothing is cached.
 
     float32 kernels use fastmath (the hardware's approximate expf, ~2 ulp);
     float64 kernels use the accurate libdevice exp.
     """
     device_backend()  # the device is usable (or simulated), numba-cuda patched for this NumPy
-    fast = precision == "float32"
-    P = make_pairs(_device_function(fast), exp_neg_math, kernel, precision)
-    jit = cuda.jit(fastmath=fast)
-    scan_threads = scan_block()  # a compile-time constant of cell_begin (its shared-memory tile)
+    from . import jitcache
 
-    # ---- SNP as three launches and no host round trip: a counting sort by cell (DualSPHysics' cell list
-    # without the radix sort). cell_count: particleIndex and each particle's rank in its cell (atomics);
-    # cell_begin: cellBegin by an exclusive scan of the counts (one block), which also zeroes the counts for
-    # the next search; scatter: every per-particle array into cell order in one pass.
-    @jit
-    def cell_count(lx, ly, sx, sy, cell, rank, counts, dx, x_grid, width, height, cw, ch, ncx, ncy):
-        i = cuda.grid(1)
-        if i < lx.shape[0]:
-            P.wrap_at(i, lx, ly, sx, sy, dx, width, height)
-            c = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, width, height, cw, ch, ncx, ncy)
-            cell[i] = c
-            rank[i] = cuda.atomic.add(counts, c, 1)
-
-    @jit
-    def cell_begin(counts, begin):
-        """begin[c] = counts[0] + ... + counts[c-1], begin[ncells] = N; counts set back to 0. One block."""
-        tid = cuda.threadIdx.x
-        tile = cuda.shared.array(scan_threads, int32)
-        carry = cuda.shared.array(1, int32)
-        ncells = counts.shape[0]
-        if tid == 0:
-            carry[0] = 0
-        cuda.syncthreads()
-        for base in range(0, ncells, scan_threads * SCAN_ITEMS):
-            first = base + tid * SCAN_ITEMS
-            own = 0
-            for q in range(SCAN_ITEMS):
-                if first + q < ncells:
-                    own += counts[first + q]
-            tile[tid] = own
-            cuda.syncthreads()
-            offset = 1
-            while offset < scan_threads:  # Hillis-Steele inclusive scan of the threads' sums
-                before = tile[tid - offset] if tid >= offset else 0
-                cuda.syncthreads()
-                tile[tid] += before
-                cuda.syncthreads()
-                offset *= 2
-            start = carry[0] + tile[tid] - own
-            for q in range(SCAN_ITEMS):
-                if first + q < ncells:
-                    begin[first + q] = start
-                    start += counts[first + q]
-                    counts[first + q] = 0
-            cuda.syncthreads()
-            if tid == scan_threads - 1:
-                carry[0] += tile[tid]
-            cuda.syncthreads()
-        if tid == 0:
-            begin[ncells] = carry[0]
-
-    @jit
-    def scatter(cell, rank, begin, src, dst, cell_out, order):
-        """Row r of ``src`` (one per-particle array per row) into cell order in ``dst``; order[d] = i."""
-        i = cuda.grid(1)
-        if i < cell.shape[0]:
-            c = cell[i]
-            d = begin[c] + rank[i]
-            cell_out[d] = c
-            order[d] = i
-            for r in range(src.shape[0]):
-                dst[r, d] = src[r, i]
-
-    @jit
-    def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
-        i = cuda.grid(1)
-        if i < lx.shape[0]:
-            out[i] = P.continuity_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, k)
-
-    @jit
-    def momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
-        i = cuda.grid(1)
-        if i < lx.shape[0]:
-            bx, by = P.momentum_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
-            ax[i] = bx
-            ay[i] = by
-
-    @jit
-    def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, counts, k):
-        i = cuda.grid(1)
-        if i < lx.shape[0]:
-            counts[i] = P.neighbours_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k)
-
-    # the system update and the coefficients, each one launch instead of a chain of array operations
-    @jit
-    def coefficients(drho, mass, vol, pr, continuity, momentum, k):
-        i = cuda.grid(1)
-        if i < drho.shape[0]:
-            P.coefficients_at(i, drho, mass, vol, pr, continuity, momentum, k)
-
-    @jit
-    def kick(u, v, ax, ay, c):
-        i = cuda.grid(1)
-        if i < u.shape[0]:
-            P.kick_at(i, u, v, ax, ay, c)
-
-    @jit
-    def advance(drho, dd, sx, sy, u, v, c, moving, mass, vol, pr, k):
-        """The update, then both coefficients from the new drho: no coefficients launch before a sweep."""
-        i = cuda.grid(1)
-        if i < drho.shape[0]:
-            P.advance_at(i, drho, dd, sx, sy, u, v, c, moving)
-            P.coefficients_at(i, drho, mass, vol, pr, True, True, k)
-
-    return {
-        "cell_count": cell_count,
-        "cell_begin": cell_begin,
-        "scatter": scatter,
-        "continuity": continuity,
-        "momentum": momentum,
-        "neighbours": neighbours,
-        "coefficients": coefficients,
-        "kick": kick,
-        "advance": advance,
-    }
+    loops = jitcache.specialise(
+        "solvers.loops.gpu",
+        bind={"P": f"device_pairs({precision!r}, {kernel!r})", "scan_threads": repr(scan_block())},
+        functions=dict.fromkeys(KERNELS, ("cuda.jit", {"fastmath": precision == "float32"})),
+        imports=("from solvers.gpu_kernels import device_pairs",),
+        depends=(*pair_sources(kernel), "solvers.gpu_kernels"),
+        cache=not simulated(),
+    )
+    return {name: getattr(loops, name) for name in KERNELS}
 
 
 def scan_block() -> int:

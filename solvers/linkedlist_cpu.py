@@ -27,83 +27,22 @@ import numba
 import numpy as np
 
 from . import pairlist
-from .backend import cpu_pairs, cpu_updates, use_threads
+from .backend import COMPILED, cpu_loops, cpu_sorting, cpu_updates, use_threads
 from .celllist import CellListSolver
-from .kernel import NONLIN, RHO0
 from .scene import SceneError
 
 
-def _counting_sort(cell, ncells, begin, order, sorted_cell):
-    """cellBegin and cellParticleOrder by a stable counting sort of ``cell``."""
-    begin[:] = 0
-    for i in range(cell.shape[0]):  # particleCellNum, shifted by one
-        begin[cell[i] + 1] += 1
-    for c in range(ncells):  # exclusive prefix sum: cellBegin
-        begin[c + 1] += begin[c]
-    fill = begin[:-1].copy()
-    for i in range(cell.shape[0]):
-        c = cell[i]
-        order[fill[c]] = i
-        sorted_cell[fill[c]] = c
-        fill[c] += 1
+def counting_sort(cell, ncells, begin, order, sorted_cell) -> None:
+    """cellBegin and cellParticleOrder by a stable counting sort of ``cell`` (solvers/loops/sorting.py)."""
+    cpu_sorting().counting_sort(cell, ncells, begin, order, sorted_cell)
 
 
 @lru_cache(maxsize=None)
 def sweeps(precision: str, kernel: str, parallel: bool) -> dict:
-    """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool."""
-    P = cpu_pairs(precision, kernel)
-    prange = numba.prange
-
-    def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
-        for i in prange(lx.shape[0]):
-            out[i] = P.continuity_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, k)
-
-    def momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
-        for i in prange(lx.shape[0]):
-            ax[i], ay[i] = P.momentum_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
-
-    def wall_continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
-        """out += the mirror particles' part of d(drho)/dt, over the particles of the grid's edge columns only
-        (the pair list holds the real pairs; at a wall the mirrors are the pairs across it)."""
-        for cy in prange(ncy):
-            for c in (cy * ncx, cy * ncx + ncx - 1):
-                for i in range(begin[c], begin[c + 1]):
-                    rho = k[RHO0] + k[NONLIN] * drho[i]
-                    out[i] += rho * P.continuity_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, k)
-
-    def wall_momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
-        """ax, ay -= the mirror particles' part of the momentum sums, over the grid's edge columns only."""
-        for cy in prange(ncy):
-            for c in (cy * ncx, cy * ncx + ncx - 1):
-                for i in range(begin[c], begin[c + 1]):
-                    bx, by = P.momentum_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
-                    ax[i] -= bx
-                    ay[i] -= by
-
-    def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, k):
-        total = 0
-        for i in prange(lx.shape[0]):
-            total += P.neighbours_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k)
-        return total
-
-    def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, width, height, cw, ch, ncx, ncy):
-        for i in prange(lx.shape[0]):
-            P.wrap_at(i, lx, ly, sx, sy, dx, width, height)
-            cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, width, height, cw, ch, ncx, ncy)
-
-    jit = numba.njit(nogil=True, parallel=parallel)
-    return {
-        "continuity": jit(continuity),
-        "momentum": jit(momentum),
-        "neighbours": jit(neighbours),
-        "wall_continuity": jit(wall_continuity),
-        "wall_momentum": jit(wall_momentum),
-        "cell_ids": jit(cell_ids),
-        **cpu_updates(precision, parallel),
-    }
-
-
-counting_sort = numba.njit(cache=True, nogil=True)(_counting_sort)
+    """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool
+    (solvers/loops/cells.py, compiled once per machine), and the per-particle updates."""
+    loops = cpu_loops("cells", precision, kernel, parallel)
+    return {**{name: getattr(loops, name) for name in COMPILED["cells"]}, **cpu_updates(precision, parallel)}
 
 
 class LinkedListCPU(CellListSolver):
@@ -193,7 +132,7 @@ class LinkedListCPU(CellListSolver):
             self.order = np.ascontiguousarray(order, dtype=np.int64)
             np.take(self.cell, self.order, out=self.sorted_cell)
         if self.pairs is not None:
-            pairlist.sort_cells_by_x(self.order, self.begin, a["lx"], a["sx"], self.scene.dx)
+            cpu_sorting().sort_cells_by_x(self.order, self.begin, a["lx"], a["sx"], self.scene.dx)
         self.permute(self.order)
         self.cell, self.sorted_cell = self.sorted_cell, self.cell
         if self.pairs is not None:

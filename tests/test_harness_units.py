@@ -10,7 +10,7 @@ import pytest
 
 from pcabench import store
 from pcabench.clock import HostClock
-from pcabench.predict import predicted_seconds, step_model
+from pcabench.predict import CACHED_JIT, COLD_JIT, START_UP, jit_seconds, predicted_seconds, step_model
 from pcabench.record import STEP_STAGES, RunRecord, step_seconds
 from pcabench.spec import ALL_CORES, OptionError, RunSpec, identity, resolve_threads, row_identity, usable_cores
 from solvers import STAGES, Scene
@@ -84,13 +84,20 @@ def test_predictor_fits_the_power_law_and_extrapolates():
     a, b, sizes = step_model(spec, rows)
     assert b == pytest.approx(2.0) and sizes == [1000, 4000, 16000]
     seconds, why = predicted_seconds(spec, rows)
-    assert seconds == pytest.approx(5.0 + 10 * 1e-3 * 8.0**4)  # start-up + steps x step at 64K
+    # start-up + a load from the JIT cache (the configuration ran before) + steps x step at 64K
+    assert seconds == pytest.approx(START_UP + CACHED_JIT + 10 * 1e-3 * 8.0**4)
     assert "N^2.00" in why
     # one size only: the algorithm's order; other solvers, threads or failed runs are not used
     one = [_ok_row("linkedlist-cpu", 1.0, 2e-3)]
     ll = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=10))
     assert step_model(ll, one)[1] == 1.0
-    assert predicted_seconds(ll, one)[0] == pytest.approx(5.0 + 10 * 2e-3 * 4)
+    assert predicted_seconds(ll, one)[0] == pytest.approx(START_UP + CACHED_JIT + 10 * 2e-3 * 4)
+    # a configuration not run before pays a compile: the median of the host's cold compiles, else COLD_JIT
+    f32 = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=10, precision="float32"))
+    f32_rows = [dict(one[0], scene=dict(one[0]["scene"], precision="float32"))]  # the step model's data
+    assert predicted_seconds(f32, f32_rows, cached=False)[0] == pytest.approx(START_UP + COLD_JIT + 10 * 2e-3 * 4)
+    measured = [dict(one[0], jit_cached=False, jit_seconds=9.0), dict(one[0], jit_cached=True, jit_seconds=0.25)]
+    assert jit_seconds(ll, measured, cached=False) == 9.0 and jit_seconds(ll, measured, cached=True) == 0.25
     assert predicted_seconds(RunSpec("linkedlist-cpu", Scene(dx=0.5), 2), one) == (None, "")
     assert predicted_seconds(ll, [dict(one[0], status="error")]) == (None, "")
 

@@ -1,0 +1,312 @@
+"""Compile once per machine: the compiled loops specialised from templates and cached on disk by the hash
+of their source (as PySPH's compyle does).
+
+numba caches a function on disk (``cache=True``) only if it is a module-level function of a real file: it
+cannot cache the closures a factory makes per kernel and precision, and it does not notice an edit to a
+function it inlines from another file. So each specialisation is written out as a module of its own: the
+text of a template (``solvers/loops/*.py``: the loops as plain module-level Python over a few free names,
+such as the pair functions ``P``), then a footer that binds those names (``P = cpu_pairs('float64',
+'gaussian')``) and compiles the loops with ``cache=True``. numba keeps the machine code beside that file
+(``__pycache__``). The file is named by the SHA-256 of everything that decides the machine code:
+
+* the generated text (the template's source, the bindings, the compile options);
+* the source of every first-party module the template imports and of every module the bindings compile
+  (``depends``: the pair physics, the kernel's own file, a plug-in kernel's file too);
+* numba's, llvmlite's and Python's versions and the CPU target (the folder: :func:`target`).
+
+An edit to any of them makes another name, hence another compile; undoing the edit finds the earlier file
+and its machine code again, bit for bit. Files are created once (written aside, then linked into place), so
+two processes filling the cache at once agree, and a process killed mid-write leaves no partial file.
+
+Where: ``$PCABENCH_CACHE``, else ``$XDG_CACHE_HOME/pcabench``, else ``~/.cache/pcabench`` (:func:`cache_root`);
+``pcabench cache`` shows and clears it. Faults end in a correct run with one :class:`JitCacheWarning`: an
+unwritable or full cache folder (the loops are compiled in memory), a corrupt cache file (dropped and
+rebuilt), a cache cleared under a running process (that process keeps its loops; later ones rebuild).
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import importlib.util
+import inspect
+import os
+import shutil
+import sys
+import threading
+import warnings
+from pathlib import Path
+from types import ModuleType
+
+ENV = "PCABENCH_CACHE"  # the cache root, if set
+FIRST_PARTY = ("solvers",)  # a template's imports of these packages are part of its key
+_lock = threading.Lock()
+_modules: dict[str, ModuleType] = {}  # key -> the specialised module, once per process
+_counts = {"loaded": 0, "compiled": 0}  # functions loaded from the disk cache / compiled, in this process
+_uncached: list = []  # dispatchers compiled in memory (no cache): each overload is a compile
+_warned: set = set()
+
+
+class JitCacheWarning(UserWarning):
+    """The on-disk cache could not be used for some loops: they were compiled in memory (the run is correct)."""
+
+
+def cache_root() -> Path:
+    """The cache's root folder: ``$PCABENCH_CACHE``, else ``$XDG_CACHE_HOME/pcabench``, else ``~/.cache/pcabench``."""
+    if os.environ.get(ENV):
+        return Path(os.environ[ENV]).expanduser()
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "pcabench"
+
+
+def target() -> str:
+    """The compile target's name: numba's and Python's versions, the CPU and a digest of its features
+    (numba's ``NUMBA_CPU_NAME`` / ``NUMBA_CPU_FEATURES`` where set, else the host's)."""
+    import llvmlite
+    import numba
+    from llvmlite import binding
+
+    cpu = numba.config.CPU_NAME or binding.get_host_cpu_name()
+    features = numba.config.CPU_FEATURES or binding.get_host_cpu_features().flatten()
+    digest = hashlib.sha256(f"{cpu}|{features}|{llvmlite.__version__}".encode()).hexdigest()[:10]
+    return f"numba{numba.__version__}-py{sys.version_info[0]}{sys.version_info[1]}-{cpu}-{digest}"
+
+
+def jit_folder() -> Path:
+    """Where this machine's specialised modules and their machine code are: ``<root>/jit/<target>``."""
+    return cache_root() / "jit" / target()
+
+
+def _warn(kind: str, what: str, exc: BaseException | None = None) -> None:
+    """One JitCacheWarning per kind of fault (``folder``, ``read``, ``write``) and process."""
+    if kind in _warned:
+        return
+    _warned.add(kind)
+    detail = f" ({type(exc).__name__}: {exc})" if exc is not None else ""
+    warnings.warn(f"{what}{detail}; compiled in memory, the results are unchanged", JitCacheWarning, stacklevel=3)
+
+
+def _source_file(dep) -> Path:
+    """The source file of ``dep``: a module, a module's name, a class or function, or a path."""
+    if isinstance(dep, (str, Path)) and str(dep).endswith(".py"):
+        return Path(dep)
+    if isinstance(dep, str):
+        spec = importlib.util.find_spec(dep)
+        if spec is None or not spec.origin:
+            raise ValueError(f"jitcache: no source for module {dep!r}")
+        return Path(spec.origin)
+    return Path(inspect.getsourcefile(dep))
+
+
+def imports_of(text: str) -> list[str]:
+    """The first-party modules a template imports (absolute imports only: a template is written out
+    beside no package)."""
+    out = []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, ast.ImportFrom) and node.level:
+            raise ValueError("jitcache: a template imports absolutely (it is compiled outside its package)")
+        names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+        if isinstance(node, ast.ImportFrom) and node.module:
+            names = [node.module]
+        out += [n for n in names if n.split(".")[0] in FIRST_PARTY]
+    return sorted(set(out))
+
+
+def render(template: str, bind: dict, functions: dict, imports: tuple = (), cache: bool = True) -> str:
+    """The text of one specialisation: the template module's source, then the footer that binds ``bind``
+    (name -> Python expression) after ``imports`` (import lines) and compiles each of ``functions``
+    (name -> (decorator, options), e.g. ``("numba.njit", {"nogil": True})``) with ``cache``."""
+    source = _source_file(template).read_text()
+    options = {repr(o) for _, o in functions.values()}
+    lines = [
+        f"# Generated by solvers.jitcache from {template}: its file name is the hash of what produced it.",
+        f"# specialisation: {', '.join(f'{k} = {v}' for k, v in bind.items()) or 'none'}; {'; '.join(sorted(options))}",
+        source.rstrip("\n"),
+        "",
+        "",
+        "# ---- the specialisation (solvers.jitcache.render)",
+        *imports,
+        *(f"{name} = {expr}" for name, expr in bind.items()),
+    ]
+    for name, (decorator, options) in functions.items():
+        opts = ", ".join(f"{k}={v!r}" for k, v in {**options, "cache": cache}.items())
+        lines.append(f"{name} = {decorator}({opts})({name})")
+    return "\n".join(lines) + "\n"
+
+
+def key(text: str, depends: tuple = ()) -> str:
+    """SHA-256 of the generated ``text``, the source of the modules it imports and of ``depends``, and the target."""
+    h = hashlib.sha256(text.encode())
+    for dep in sorted({str(_source_file(d)) for d in (*imports_of(text), *depends)}):
+        h.update(dep.encode() + b"\0" + Path(dep).read_bytes() + b"\0")
+    h.update(target().encode())
+    return h.hexdigest()
+
+
+def specialise(
+    template: str, bind: dict, functions: dict, imports: tuple = (), depends: tuple = (), cache: bool = True
+):
+    """The module of ``template`` specialised by ``bind`` with ``functions`` compiled (see
+    :func:`render`), loaded from the disk cache where its key is there, written there where not, or, with
+    ``cache`` False or where the cache folder cannot be used, compiled in memory. Once per process.
+    ``depends``: what the bindings compile besides the template's own imports (modules, names, files)."""
+    text = render(template, bind, functions, imports, cache=True)
+    try:
+        name = key(text, depends)
+    except (OSError, TypeError, ValueError) as exc:  # a source that cannot be read cannot key a cache
+        name, cache = hashlib.sha256(f"{text}{depends!r}".encode()).hexdigest(), False
+        _warn("source", f"the source of what {template} compiles cannot be read, so it is not cached", exc)
+    with _lock:
+        if name in _modules:
+            return _modules[name]
+        module = None
+        if cache:
+            try:
+                module = _load(_written(text, name, template), name, functions)
+            except Exception as exc:  # noqa: BLE001 - unwritable, full, removed: compile in memory
+                _warn("folder", f"the JIT cache folder {jit_folder()} cannot be used", exc)
+        if module is None:
+            module = _in_memory(render(template, bind, functions, imports, cache=False), name, functions)
+        _modules[name] = module
+        return module
+
+
+def _written(text: str, name: str, template: str) -> Path:
+    """The generated file for ``name``, created once: written aside, then linked into place (never replaced,
+    so a file another process is reading never changes; numba's index is stamped by the file's mtime)."""
+    folder = jit_folder()
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{template.rsplit('.', 1)[-1]}_{name[:24]}.py"
+    if path.is_symlink():
+        raise OSError(f"{path} is a link")
+    if path.exists() and path.read_text() == text:
+        return path
+    tmp = folder / f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp"
+    try:
+        with open(tmp, "x") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        if path.exists():  # a torn or foreign file under our name (it cannot be ours: ours are whole): replace
+            os.replace(tmp, path)
+        else:
+            try:
+                os.link(tmp, path)
+            except FileExistsError:  # another process created it first, from the same text
+                pass
+    finally:
+        tmp.unlink(missing_ok=True)
+    if path.read_text() != text:
+        raise OSError(f"{path} does not hold the text it is named for")
+    return path
+
+
+def _module_name(name: str) -> str:
+    return f"_pcabench_jit_{name[:24]}"
+
+
+def _load(path: Path, name: str, functions: dict) -> ModuleType:
+    """Import the generated file as a module of its own (registered in sys.modules: numba rebuilds a cached
+    function's environment from its module's name), its compiled functions guarded against cache faults."""
+    modname = _module_name(name)
+    spec = importlib.util.spec_from_file_location(modname, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = module
+    try:
+        spec.loader.exec_module(module)
+    except Exception:
+        sys.modules.pop(modname, None)
+        raise
+    for fn in functions:
+        _guard(getattr(module, fn))
+    return module
+
+
+def _in_memory(text: str, name: str, functions: dict) -> ModuleType:
+    """The specialisation compiled without a disk cache (the text run as a module with no file)."""
+    modname = _module_name(name) + "_mem"
+    module = ModuleType(modname)
+    module.__file__ = f"<{modname}>"
+    sys.modules[modname] = module
+    exec(compile(text, module.__file__, "exec"), module.__dict__)
+    _uncached.extend(getattr(module, fn) for fn in functions)
+    return module
+
+
+def _guard(dispatcher) -> None:
+    """Count the dispatcher's cache loads and compiles; a cache file that cannot be read is dropped (the
+    function compiled and the entry written again), one that cannot be written is skipped, each with one
+    warning. (numba's ``Dispatcher._cache``: ``load_overload`` and ``save_overload`` are its two doors.)"""
+    cache = getattr(dispatcher, "_cache", None)
+    if cache is None or not hasattr(cache, "load_overload"):
+        _uncached.append(dispatcher)
+        return
+    load, save = cache.load_overload, cache.save_overload
+
+    def load_overload(sig, target_context):
+        try:
+            data = load(sig, target_context)
+        except Exception as exc:  # noqa: BLE001 - corrupt or truncated: rebuild
+            _warn("read", f"a JIT cache file ({dispatcher.__name__}) could not be read: rebuilt", exc)
+            try:
+                cache.flush()  # an empty index in place of the unreadable one
+            except Exception:  # noqa: BLE001
+                pass
+            return None
+        if data is not None:
+            _counts["loaded"] += 1
+        return data
+
+    def save_overload(sig, data):
+        _counts["compiled"] += 1
+        try:
+            save(sig, data)
+        except Exception as exc:  # noqa: BLE001 - full, removed, unwritable: the compiled code is in memory
+            _warn("write", f"a JIT cache file ({dispatcher.__name__}) could not be written", exc)
+
+    cache.load_overload, cache.save_overload = load_overload, save_overload
+
+
+def counts() -> dict:
+    """Functions loaded from the disk cache and compiled in this process so far (a compile in memory counts)."""
+    in_memory = sum(len(getattr(d, "overloads", {}) or {}) for d in _uncached)
+    return {"loaded": _counts["loaded"], "compiled": _counts["compiled"] + in_memory}
+
+
+def entries(root: Path | None = None) -> list[dict]:
+    """Every specialised module under the cache root: its target, file, size with its machine code (B) and
+    how many compiled functions are stored for it."""
+    root = (root or cache_root()) / "jit"
+    out = []
+    for path in sorted(root.glob("*/*.py")):
+        stem = path.stem
+        code = list((path.parent / "__pycache__").glob(f"{stem}.*")) if (path.parent / "__pycache__").is_dir() else []
+        size = path.stat().st_size + sum(p.stat().st_size for p in code)
+        with open(path) as f:
+            f.readline()
+            what = f.readline().removeprefix("# specialisation: ").strip()
+        out.append(
+            {
+                "target": path.parent.name,
+                "module": stem,
+                "specialisation": what,
+                "bytes": size,
+                "functions": sum(1 for p in code if p.suffix == ".nbi"),
+            }
+        )
+    return out
+
+
+def clear(root: Path | None = None) -> int:
+    """Remove the compiled cache (the ``jit`` folder under the root); bytes freed. The folder is renamed away
+    first, so a process using it sees it gone at once and rebuilds (its loops in memory are untouched)."""
+    folder = (root or cache_root()) / "jit"
+    if folder.is_symlink():
+        raise OSError(f"{folder} is a link: not clearing through it")
+    if not folder.exists():
+        return 0
+    size = sum(p.stat().st_size for p in folder.rglob("*") if p.is_file() and not p.is_symlink())
+    doomed = folder.with_name(f".jit-clearing-{os.getpid()}")
+    os.replace(folder, doomed)
+    shutil.rmtree(doomed, ignore_errors=True)
+    return size

@@ -1,0 +1,24 @@
+"""The all-pair CPU solver's interaction loops, serial as in the paper. A template of solvers.jitcache,
+specialised by solvers.allpair_cpu.sweeps."""
+
+P = None  # the pair functions for numba's CPU target (solvers.backend.cpu_pairs), bound by solvers.jitcache
+
+
+def continuity(lx, ly, sx, sy, u, v, vol, drho, out, k):
+    n = lx.shape[0]
+    for i in range(n):
+        out[i] = P.continuity_allpair(i, n, lx, ly, sx, sy, u, v, vol, drho, k)
+
+
+def momentum(lx, ly, sx, sy, mass, pr, ax, ay, k):
+    n = lx.shape[0]
+    for i in range(n):
+        ax[i], ay[i] = P.momentum_allpair(i, n, lx, ly, sx, sy, mass, pr, k)
+
+
+def neighbours(lx, ly, sx, sy, k):
+    n = lx.shape[0]
+    total = 0
+    for i in range(n):
+        total += P.neighbours_allpair(i, n, lx, ly, sx, sy, k)
+    return total

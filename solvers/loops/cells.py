@@ -1,0 +1,51 @@
+"""The linked-list CPU solver's interaction loops over the 3x3 cell stencil, serial or on numba's thread
+pool. A template of solvers.jitcache, specialised by solvers.linkedlist_cpu.sweeps."""
+
+from numba import prange
+
+from solvers.kernel import NONLIN, RHO0
+
+P = None  # the pair functions for numba's CPU target (solvers.backend.cpu_pairs), bound by solvers.jitcache
+
+
+def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
+    for i in prange(lx.shape[0]):
+        out[i] = P.continuity_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, k)
+
+
+def momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
+    for i in prange(lx.shape[0]):
+        ax[i], ay[i] = P.momentum_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
+
+
+def wall_continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):
+    """out += the mirror particles' part of d(drho)/dt, over the particles of the grid's edge columns only
+    (the pair list holds the real pairs; at a wall the mirrors are the pairs across it)."""
+    for cy in prange(ncy):
+        for c in (cy * ncx, cy * ncx + ncx - 1):
+            for i in range(begin[c], begin[c + 1]):
+                rho = k[RHO0] + k[NONLIN] * drho[i]
+                out[i] += rho * P.continuity_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, k)
+
+
+def wall_momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
+    """ax, ay -= the mirror particles' part of the momentum sums, over the grid's edge columns only."""
+    for cy in prange(ncy):
+        for c in (cy * ncx, cy * ncx + ncx - 1):
+            for i in range(begin[c], begin[c + 1]):
+                bx, by = P.momentum_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, k)
+                ax[i] -= bx
+                ay[i] -= by
+
+
+def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, k):
+    total = 0
+    for i in prange(lx.shape[0]):
+        total += P.neighbours_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, k)
+    return total
+
+
+def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, width, height, cw, ch, ncx, ncy):
+    for i in prange(lx.shape[0]):
+        P.wrap_at(i, lx, ly, sx, sy, dx, width, height)
+        cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, width, height, cw, ch, ncx, ncy)

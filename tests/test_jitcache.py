@@ -1,0 +1,233 @@
+"""The on-disk JIT cache (solvers/jitcache.py): a second process loads instead of compiling and gets the same
+numbers bit for bit; an edit to the code a loop is made of recompiles it and undoing the edit brings the
+earlier machine code back; races, torn and corrupt files and an unusable folder end in a correct run."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from solvers import jitcache
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# One tiny lagrangian run in a fresh process: the fields' bytes as a digest, and what the cache did.
+# A kernel plug-in file may be given (argv[2]): registered, then used (its source is part of the key).
+PROBE = textwrap.dedent(
+    """
+    import hashlib, json, sys, warnings
+    warnings.simplefilter("always")
+    caught = []
+    warnings.showwarning = lambda message, category, *a, **k: caught.append(f"{category.__name__}: {message}")
+    from solvers import Scene, jitcache, make_solver
+    from solvers.interface import tiny_scene
+    kernel = "gaussian"
+    if len(sys.argv) > 2:
+        import importlib.util
+        spec = importlib.util.spec_from_file_location("plugin_kernel", sys.argv[2])
+        mod = sys.modules["plugin_kernel"] = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        from solvers.kernels import register
+        register(mod.Plugin)
+        kernel = mod.Plugin.name
+    solver = make_solver(sys.argv[1])
+    solver.input(tiny_scene(Scene(dx=1.0, kernel=kernel)).replace(steps=4))
+    solver.init()
+    for _ in range(4):
+        solver.rates(True, True)
+        solver.kick(0.5)
+        solver.advance(1.0)
+    f = solver.output()
+    digest = hashlib.sha256(b"".join(a.tobytes() for a in (f.x, f.y, f.u, f.v, f.drho))).hexdigest()
+    print(json.dumps({"digest": digest, **jitcache.counts(), "warnings": caught}))
+    """
+)
+
+
+def probe(cache: Path, solver: str = "allpair-cpu", kernel_file: Path | None = None, **env) -> dict:
+    """PROBE in a fresh process with the cache at ``cache``."""
+    args = [sys.executable, "-c", PROBE, solver] + ([str(kernel_file)] if kernel_file else [])
+    environ = {**os.environ, "PCABENCH_CACHE": str(cache), **env}
+    out = subprocess.run(args, capture_output=True, text=True, cwd=ROOT, env=environ, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def code_files(cache: Path) -> list[Path]:
+    return sorted(cache.glob("jit/*/__pycache__/*.nb[ic]"))
+
+
+PLUGIN = textwrap.dedent(
+    """
+    import math
+    import numpy as np
+    from solvers.kernel import GRAD0, INV_H2
+    from solvers.kernels import Kernel
+
+    class Plugin(Kernel):
+        name = "plugin-gauss"
+        support = None
+        norm = 1.0 / math.pi
+
+        def value(self, r, h):
+            return np.exp(-((np.asarray(r) / h) ** 2)) / (math.pi * h * h)
+
+        def gradient(self, r, h):
+            return -2.0 * np.exp(-((np.asarray(r) / h) ** 2)) / (math.pi * h**4)
+
+        def compiled_gradient(self, dtype, exp_neg):
+            scale = np.dtype(dtype).type(SCALE)
+
+            def gradient(r2, k):
+                return scale * k[GRAD0] * exp_neg(r2 * k[INV_H2])
+
+            return gradient
+    """
+)
+
+
+def test_a_second_process_loads_every_loop_and_gets_the_same_numbers(tmp_path):
+    cold = probe(tmp_path)
+    assert cold["compiled"] > 0 and cold["loaded"] == 0 and not cold["warnings"]
+    warm = probe(tmp_path)
+    assert warm["compiled"] == 0, "the second process compiled again"
+    assert warm["loaded"] == cold["compiled"]
+    assert warm["digest"] == cold["digest"]  # bit for bit
+    assert not warm["warnings"]
+
+
+def test_an_edit_to_a_plugin_kernel_recompiles_and_undoing_it_restores_the_machine_code(tmp_path):
+    plugin = tmp_path / "plugin_kernel.py"
+    cache = tmp_path / "cache"
+    plugin.write_text(PLUGIN.replace("SCALE", "1.0"))
+    first = probe(cache, kernel_file=plugin)
+    assert first["compiled"] > 0
+    plugin.write_text(PLUGIN.replace("SCALE", "1.25"))  # the kernel's G, edited
+    edited = probe(cache, kernel_file=plugin)
+    assert edited["compiled"] > 0, "an edited kernel was served from the cache"
+    assert edited["digest"] != first["digest"]
+    plugin.write_text(PLUGIN.replace("SCALE", "1.0"))  # the edit undone
+    undone = probe(cache, kernel_file=plugin)
+    assert undone["compiled"] == 0 and undone["loaded"] > 0
+    assert undone["digest"] == first["digest"]
+
+
+def test_the_key_covers_the_pair_physics_numba_and_the_target(monkeypatch):
+    text = jitcache.render("solvers.loops.allpair", {"P": "cpu_pairs('float64', 'gaussian')"}, {})
+    base = jitcache.key(text, ("solvers.pairs",))
+    assert base == jitcache.key(text, ("solvers.pairs",))  # a key is a function of its inputs
+    assert base != jitcache.key(text, ("solvers.pairs", "solvers.kernel"))  # another source
+    other = jitcache.render("solvers.loops.allpair", {"P": "cpu_pairs('float32', 'gaussian')"}, {})
+    assert base != jitcache.key(other, ("solvers.pairs",))  # another precision
+    assert "solvers.kernel" in jitcache.imports_of(jitcache.render("solvers.loops.cells", {}, {}))
+    monkeypatch.setattr(jitcache, "target", lambda: "numba0.0-py0-othercpu-0")
+    assert base != jitcache.key(text, ("solvers.pairs",))  # another numba or CPU
+
+
+def test_two_processes_filling_the_cache_at_once_agree(tmp_path):
+    environ = {**os.environ, "PCABENCH_CACHE": str(tmp_path)}
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-c", PROBE, "allpair-cpu"], cwd=ROOT, env=environ, stdout=subprocess.PIPE, text=True
+        )
+        for _ in range(2)
+    ]
+    outs = [json.loads(p.communicate(timeout=600)[0].strip().splitlines()[-1]) for p in procs]
+    assert all(p.returncode == 0 for p in procs)
+    assert outs[0]["digest"] == outs[1]["digest"]
+    assert not outs[0]["warnings"] and not outs[1]["warnings"]
+    after = probe(tmp_path)
+    assert after["compiled"] == 0 and after["digest"] == outs[0]["digest"]
+
+
+def test_a_process_killed_while_compiling_leaves_a_cache_that_works(tmp_path):
+    reference = probe(tmp_path / "clean")
+    environ = {**os.environ, "PCABENCH_CACHE": str(tmp_path / "cache")}
+    proc = subprocess.Popen([sys.executable, "-c", PROBE, "allpair-cpu"], cwd=ROOT, env=environ)
+    deadline = time.time() + 120
+    while not list((tmp_path / "cache").glob("jit/*/*.py")) and time.time() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.5)  # compiling now
+    proc.kill()
+    proc.wait()
+    after = probe(tmp_path / "cache")
+    assert after["digest"] == reference["digest"]
+    assert not after["warnings"]
+
+
+@pytest.mark.parametrize("damage", ["truncated", "garbage"])
+def test_a_corrupt_cache_file_is_rebuilt_with_one_warning(tmp_path, damage):
+    cold = probe(tmp_path)
+    for path in code_files(tmp_path):
+        data = path.read_bytes()
+        path.write_bytes(data[: len(data) // 3] if damage == "truncated" else os.urandom(len(data)))
+    hurt = probe(tmp_path)
+    assert hurt["digest"] == cold["digest"]
+    assert len(hurt["warnings"]) == 1 and "JitCacheWarning" in hurt["warnings"][0], hurt["warnings"]
+    healed = probe(tmp_path)
+    assert healed["compiled"] == 0 and healed["digest"] == cold["digest"] and not healed["warnings"]
+
+
+def test_a_torn_generated_module_is_replaced(tmp_path):
+    cold = probe(tmp_path)
+    for path in tmp_path.glob("jit/*/*.py"):
+        path.write_text(path.read_text()[:200])  # a writer killed mid-file (not how jitcache writes: the worst case)
+    again = probe(tmp_path)
+    assert again["digest"] == cold["digest"]
+
+
+def test_an_unusable_cache_folder_compiles_in_memory_with_one_warning(tmp_path):
+    reference = probe(tmp_path / "ok")
+    blocker = tmp_path / "a-file"
+    blocker.write_text("not a folder")
+    out = probe(blocker / "cache")  # cannot be created (as root too)
+    assert out["digest"] == reference["digest"]
+    assert out["compiled"] > 0 and out["loaded"] == 0
+    assert len(out["warnings"]) == 1 and "JitCacheWarning" in out["warnings"][0]
+
+
+TEMPLATE = """
+def triple(x):
+    return 3 * x
+"""
+
+
+def test_a_cache_cleared_under_a_running_process_does_not_break_it(tmp_path, monkeypatch):
+    monkeypatch.setenv("PCABENCH_CACHE", str(tmp_path))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    (tmp_path / f"tmpl_{os.getpid()}.py").write_text(TEMPLATE + f"\nSALT = {time.time_ns()}\n")  # a key of its own
+    mod = jitcache.specialise(f"tmpl_{os.getpid()}", {}, {"triple": ("numba.njit", {})}, ("import numba",))
+    assert mod.triple(2) == 6  # compiled and stored
+    assert jitcache.clear() > 0 and not (tmp_path / "jit").exists()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert mod.triple(2.5) == 7.5  # another signature: compiled, its cache folder gone
+        assert mod.triple(np.float32(2)) == 6
+    assert sum(issubclass(w.category, jitcache.JitCacheWarning) for w in caught) <= 1
+
+
+def test_pcabench_cache_shows_and_clears(tmp_path, capsys):
+    from tests.conftest import cli_main
+
+    env = {"PCABENCH_CACHE": str(tmp_path)}
+    probe(tmp_path)
+    os.environ.update(env)
+    try:
+        code, out, _ = cli_main("cache", "--json", capsys=capsys)
+        shown = json.loads(out)
+        assert code == 0 and shown["root"] == str(tmp_path) and shown["entries"]
+        assert all(e["functions"] > 0 for e in shown["entries"])
+        assert any("cpu_pairs('float64', 'gaussian')" in e["specialisation"] for e in shown["entries"])
+        code, out, _ = cli_main("cache", "--clear", capsys=capsys)
+        assert code == 0 and not list(tmp_path.glob("jit/*/*.py"))
+    finally:
+        os.environ.pop("PCABENCH_CACHE")
