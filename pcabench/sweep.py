@@ -1,6 +1,8 @@
 """A sweep: a list of run specs, each run in its own child process, stored as it finishes.
 
-Each run is a child process (``python -m pcabench.child``) with a time budget:
+Each run is a child process with a time budget (forked from a server that has
+imported the harness and the solvers once, pcabench/forkserver.py, or a fresh
+``python -m pcabench.child``):
 a crash, hang or out-of-memory in one run is recorded (status error /
 timeout / out-of-memory, naming the signal or exit code) and the sweep goes
 on. A child dies with its parent (Linux: PR_SET_PDEATHSIG), so a killed sweep
@@ -16,7 +18,6 @@ reruns timeouts, skips and errors. A run predicted to take longer than the run b
 from __future__ import annotations
 
 import abc
-import ctypes
 import json
 import math
 import os
@@ -28,7 +29,7 @@ import threading
 import time
 from pathlib import Path
 
-from . import store
+from . import forkserver, store
 from .memory import cgroup_memory_folders
 from .predict import predicted_seconds, row_variant, spec_variant
 from .profiles import MACHINE_ID_ENV, machine_id
@@ -44,14 +45,6 @@ def failed_record(spec: RunSpec, status: str, message: str, profile: str, second
     if seconds is not None:
         message = f"{message} (after {seconds:.0f} s)"
     return RunRecord.from_spec(spec, profile, status=status, message=message)
-
-
-def _die_with_parent() -> None:
-    """In the child, before exec: receive SIGKILL when the parent dies (Linux only; else nothing)."""
-    try:
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
-    except (OSError, AttributeError):
-        pass
 
 
 def oom_kills() -> int | None:
@@ -104,6 +97,42 @@ def _cut(chunks: list) -> str:
     return text if len(text) <= OUTPUT_KEPT else "..." + text[-OUTPUT_KEPT:]
 
 
+def start_child(spec: RunSpec, env: dict) -> tuple:
+    """Start the child that runs ``spec`` with environment ``env``: forked from the warm server where it can be
+    (pcabench/forkserver.py), else a fresh interpreter (``python -m pcabench.child``). (process, its stdout
+    and stderr as binary streams, the read end of its record's pipe)."""
+    read_end, write_end = os.pipe()
+    if forkserver.usable(env):
+        ends = [os.pipe(), os.pipe()]
+        try:
+            proc = forkserver.ForkedChild(spec.to_json(), ends[0][1], ends[1][1], write_end, env)
+        except BaseException:
+            for fd in (read_end, ends[0][0], ends[1][0]):
+                os.close(fd)
+            raise
+        finally:
+            for fd in (write_end, ends[0][1], ends[1][1]):  # the child holds them now
+                os.close(fd)
+        return proc, os.fdopen(ends[0][0], "rb"), os.fdopen(ends[1][0], "rb"), read_end
+    cmd = [sys.executable, "-m", "pcabench.child", "--record-fd", str(write_end), spec.to_json()]
+    try:
+        proc = subprocess.Popen(
+            cmd,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            env=env,
+            pass_fds=(write_end,),
+            preexec_fn=forkserver.die_with_parent if sys.platform.startswith("linux") else None,
+        )
+    except BaseException:
+        os.close(read_end)
+        raise
+    finally:
+        os.close(write_end)  # the child holds it now: the pipe ends when the child does
+    return proc, proc.stdout, proc.stderr, read_end
+
+
 def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:
     """Run ``spec`` in a child process, relaying its progress to ``stream``; its record as a row.
 
@@ -113,25 +142,9 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
 
     Raises subprocess.TimeoutExpired (the child is killed first) past ``timeout`` seconds.
     """
-    read_end, write_end = os.pipe()
-    cmd = [sys.executable, "-m", "pcabench.child", "--record-fd", str(write_end), spec.to_json()]
     env = {**os.environ, "PCABENCH_COMMIT": commit, MACHINE_ID_ENV: machine}  # every run carries the sweep's
     oom_before = oom_kills()
-    try:
-        proc = subprocess.Popen(
-            cmd,
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            env=env,
-            pass_fds=(write_end,),
-            preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
-        )
-    except BaseException:
-        os.close(read_end)
-        raise
-    finally:
-        os.close(write_end)  # the child holds it now: the pipe ends when the child does
+    proc, stdout, stderr, read_end = start_child(spec, env)
     out, err, record = [], [], []
 
     def relay(text):  # the child's progress lines go on to the user
@@ -147,8 +160,8 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
         record.append(data if len(data) <= RECORD_LIMIT else b"")
 
     readers = [
-        threading.Thread(target=_drain, args=(proc.stdout, out), daemon=True),
-        threading.Thread(target=_drain, args=(proc.stderr, err, relay), daemon=True),
+        threading.Thread(target=_drain, args=(stdout, out), daemon=True),
+        threading.Thread(target=_drain, args=(stderr, err, relay), daemon=True),
         threading.Thread(target=read_record, daemon=True),
     ]
     for reader in readers:
@@ -162,6 +175,8 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
     finally:
         for reader in readers:
             reader.join(timeout=5)
+        for f in (stdout, stderr):
+            f.close()
         if stream is not None and err and not err[-1].endswith("\n"):
             stream.write("\n")  # end the child's last progress line
     said = PROGRESS.sub("", "".join(err)).strip()  # stderr less the child's own progress lines

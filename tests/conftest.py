@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -25,6 +27,24 @@ def run_fields(scene: Scene, solver: str, tmp_path, threads=1):
 def requires_gpu():
     if not gpu_available():
         pytest.skip("no CUDA GPU on this machine (the simulator tests cover the kernels)")
+
+
+def run_children(pid: int) -> list[int]:
+    """The run children among the descendants of ``pid``: forked by the sweep's forkserver (named
+    pcabench-run, pcabench/forkserver.py) or fresh interpreters (``python -m pcabench.child``)."""
+    found, todo = [], [pid]
+    while todo:
+        out = subprocess.run(["pgrep", "-P", str(todo.pop())], capture_output=True, text=True).stdout.split()
+        for child in map(int, out):
+            todo.append(child)
+            try:
+                comm = open(f"/proc/{child}/comm", "rb").read().strip()
+                cmdline = open(f"/proc/{child}/cmdline", "rb").read()
+            except OSError:
+                continue
+            if comm == b"pcabench-run" or b"pcabench.child" in cmdline:
+                found.append(child)
+    return found
 
 
 def cli_main(*args, capsys):

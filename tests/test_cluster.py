@@ -10,6 +10,7 @@ import time
 import pytest
 
 from pcabench import cli, store
+from tests.conftest import run_children
 
 pytest.importorskip("dask.distributed")
 
@@ -57,12 +58,8 @@ def children(pid: int) -> list[int]:
 def run_child_under_a_worker(root: int) -> tuple[int, int] | None:
     """(worker, run child) among the descendants of ``root`` only: a test signals only what it started."""
     for worker in children(root):
-        for child in children(worker):
-            try:
-                if b"pcabench.child" in open(f"/proc/{child}/cmdline", "rb").read():
-                    return worker, child
-            except OSError:
-                continue
+        for child in run_children(worker):
+            return worker, child
     return None
 
 

@@ -21,6 +21,7 @@ from pcabench.record import RunRecord
 from pcabench.spec import RunSpec
 from pcabench.sweep import exit_status, sweep
 from solvers import Scene, SceneError
+from tests.conftest import run_children
 
 
 def record(dx=1.0, status="ok", **kw):
@@ -190,8 +191,8 @@ def test_a_killed_parent_takes_its_running_child_with_it(tmp_path):
     child = None
     deadline = time.time() + 120
     while time.time() < deadline and child is None:
-        out = subprocess.run(["pgrep", "-P", str(proc.pid), "-f", "pcabench.child"], capture_output=True, text=True)
-        child = int(out.stdout.split()[0]) if out.stdout.strip() else None
+        found = run_children(proc.pid)
+        child = found[0] if found else None
         time.sleep(0.1)
     assert child is not None, "the sweep never started its child"
     os.kill(proc.pid, signal.SIGKILL)  # the parent only, as kill -9 <pid> does

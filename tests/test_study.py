@@ -323,6 +323,6 @@ def test_a_run_cut_by_the_sweep_budget_is_not_stored(tmp_path):
     from pcabench.sweep import sweep
 
     path = tmp_path / "s.jsonl"
-    spec = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=50))
-    sweep([spec], path, run_budget=600.0, sweep_budget=0.5)  # the child cannot even compile in 0.5 s
+    spec = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=20000, model="linear"))
+    sweep([spec], path, run_budget=600.0, sweep_budget=0.5)  # 20,000 steps (seconds) do not fit in 0.5 s
     assert not path.exists() or store.read_rows(path) == []  # a rerun must run it, not find a false timeout

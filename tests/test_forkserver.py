@@ -1,0 +1,49 @@
+"""A sweep's runs forked from the warm server (pcabench/forkserver.py): the same record as a fresh
+interpreter's, the same budget, and a fresh interpreter wherever the environment differs."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import time
+
+import pytest
+
+from pcabench import forkserver
+from pcabench.spec import RunSpec
+from pcabench.sweep import run_child
+from solvers import Scene
+from tests.conftest import run_children
+
+
+def test_a_forked_run_makes_the_record_a_fresh_interpreter_makes(monkeypatch):
+    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=6)).resolved()
+    assert forkserver.usable(dict(os.environ))
+    forked = run_child(spec, 300, "abc", "m", stream=None)
+    monkeypatch.setenv(forkserver.ENV, "0")
+    fresh = run_child(spec, 300, "abc", "m", stream=None)
+    assert forked["status"] == fresh["status"] == "ok", (forked["message"], fresh["message"])
+    for key in ("mse", "me", "mean_neighbours", "n_particles", "steps", "profile_id", "commit", "errors"):
+        assert forked[key] == fresh[key], key  # bit for bit, and the sweep's machine and commit
+    assert forked["jit_cached"] is True  # the fresh one filled the cache or found it filled
+
+
+def test_a_forked_run_past_its_budget_is_killed():
+    spec = RunSpec("allpair-cpu", Scene(dx=0.25, steps=100000, model="linear")).resolved()
+    t0 = time.perf_counter()
+    with pytest.raises(subprocess.TimeoutExpired):
+        run_child(spec, 3, "abc", "m", stream=None)
+    assert time.perf_counter() - t0 < 60
+    deadline = time.time() + 10
+    while run_children(os.getpid()) and time.time() < deadline:
+        time.sleep(0.05)
+    assert not run_children(os.getpid()), "the timed-out run outlived its budget"
+
+
+def test_only_the_run_time_variables_may_differ_from_the_servers():
+    env = dict(os.environ)
+    assert forkserver.usable(env)
+    assert forkserver.usable({**env, "PCABENCH_HOME": "/elsewhere", "PCABENCH_CACHE": "/other"})
+    assert not forkserver.usable({**env, "NUMBA_OPT": "0"})  # read by numba at import: a fresh interpreter
+    assert not forkserver.usable({**env, "PYTHONPATH": "/a/plugin"})
+    assert not forkserver.usable({**env, forkserver.ENV: "0"})
