@@ -6,10 +6,10 @@ Each run keeps its own process, its budget and its kill -9 safety: the child is 
 like a fresh one, its stdout, stderr and record come back on pipes of its own (passed to it by the
 forkserver), it dies with the server (PR_SET_PDEATHSIG) and the server ends when the sweep does. What a
 fresh interpreter would read at start-up must agree with what the server read: a run whose environment
-differs from the server's in anything but the variables the harness reads at run time
-(:data:`RUN_TIME`) and those that say nothing of it (:data:`VOLATILE`), or a process that may not fork children (a daemonic one, such as a Dask worker),
-starts a fresh interpreter instead (``python -m pcabench.child``), as does every run with
-``PCABENCH_FORKSERVER=0``.
+differs from the server's in anything but the variables the harness reads at run time (:data:`RUN_TIME`)
+and those that say nothing of it (:data:`VOLATILE`), or a process that may not fork children (a daemonic
+one, such as a Dask worker), starts a fresh interpreter instead (``python -m pcabench.child``), as does
+every run with ``PCABENCH_FORKSERVER=0``.
 """
 
 from __future__ import annotations
