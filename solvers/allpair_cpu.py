@@ -11,14 +11,15 @@ import time
 from functools import lru_cache
 
 from .backend import COMPILED, cpu_loops, cpu_updates
-from .interface import Solver, tiny_scene
+from .interface import Solver, across_x, tiny_scene
 
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str, kernel: str) -> dict:
-    """The all-pair interaction loops for ``precision`` and ``kernel`` (serial, as in the paper;
-    solvers/loops/allpair.py, compiled once per machine), and the per-particle updates."""
-    loops = cpu_loops("allpair", precision, kernel, False)
+def sweeps(precision: str, kernel: str, across: bool = True) -> dict:
+    """The all-pair interaction loops for ``precision`` and ``kernel``, with or without the mirrors across a
+    wall (``across``; serial, as in the paper; solvers/loops/allpair.py, compiled once per machine), and
+    the per-particle updates."""
+    loops = cpu_loops("allpair", precision, kernel, False, across)
     return {**{name: getattr(loops, name) for name in COMPILED["allpair"]}, **cpu_updates(precision, False)}
 
 
@@ -37,7 +38,7 @@ class AllPairCPU(Solver):
         """Nothing to build: the all-pair search happens inside the interaction loop."""
 
     def launch(self, name: str, *args):
-        return sweeps(self.scene.precision, self.scene.kernel)[name](*args)
+        return sweeps(self.scene.precision, self.scene.kernel, across_x(self.scene))[name](*args)
 
     def _sweep(self, continuity: bool, momentum: bool) -> None:
         a = self.arrays

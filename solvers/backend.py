@@ -24,15 +24,15 @@ def use_threads(n: int, decided: bool = False) -> None:
 
 
 @lru_cache(maxsize=None)
-def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL):
+def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True):
     """The pair functions for numba's CPU target in ``precision`` with ``kernel``'s G, inlined into the
-    sweeps that call them."""
+    sweeps that call them; ``across``: with the pairs across an x seam or wall (solvers/pairs.py)."""
     import numba
 
     from .kernel import make_exp_neg_table
     from .pairs import make_pairs
 
-    return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision)
+    return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision, across)
 
 
 def pair_sources(kernel: str = DEFAULT_KERNEL) -> tuple:
@@ -43,8 +43,11 @@ def pair_sources(kernel: str = DEFAULT_KERNEL) -> tuple:
     return ("solvers.pairs", "solvers.kernel", "solvers.backend", type(kernel_named(kernel)))
 
 
-def cpu_loops(template: str, precision: str, kernel: str, parallel: bool | None, **bind) -> ModuleType:
-    """The loops of ``template`` (solvers/loops/) over :func:`cpu_pairs` for ``precision`` and ``kernel``,
+def cpu_loops(
+    template: str, precision: str, kernel: str, parallel: bool | None, across: bool = True, **bind
+) -> ModuleType:
+    """The loops of ``template`` (solvers/loops/) over :func:`cpu_pairs` for ``precision``, ``kernel`` and
+    ``across``,
     compiled with numba's CPU target (on its threads where ``parallel``; every function the template lists in
     ``COMPILED``) and cached on disk once per machine (solvers/jitcache.py). ``bind``: more free names, as values."""
     from . import jitcache
@@ -55,7 +58,7 @@ def cpu_loops(template: str, precision: str, kernel: str, parallel: bool | None,
     names = COMPILED[template]
     return jitcache.specialise(
         module,
-        bind={"P": f"cpu_pairs({precision!r}, {kernel!r})", **{k: repr(v) for k, v in bind.items()}},
+        bind={"P": f"cpu_pairs({precision!r}, {kernel!r}, {across!r})", **{k: repr(v) for k, v in bind.items()}},
         functions={name: ("numba.njit", options) for name in names},
         imports=("import numba", "from solvers.backend import cpu_pairs"),
         depends=pair_sources(kernel),

@@ -315,6 +315,12 @@ def cell_grid(scene: Scene) -> tuple:
     return scene.cutoff, scene.height / ncy, ncx, ncy, -scene.cutoff, 0.0
 
 
+def across_x(scene: Scene) -> bool:
+    """Whether the pair sums of ``scene`` reach across an x edge: a periodic seam or a rigid wall
+    (the pair functions' compile-time ``across``, solvers/pairs.py)."""
+    return bool(scene.periodic_x or scene.walls)
+
+
 def tiny_scene(scene: Scene) -> Scene:
     """A few hundred particles with the same scene kind, model, integrator and precision (for JIT warm-up)."""
     return scene.replace(

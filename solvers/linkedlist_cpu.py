@@ -29,6 +29,7 @@ import numpy as np
 from . import pairlist
 from .backend import COMPILED, cpu_loops, cpu_sorting, cpu_updates, use_threads
 from .celllist import CellListSolver
+from .interface import across_x
 from .scene import SceneError
 
 
@@ -38,10 +39,11 @@ def counting_sort(cell, ncells, begin, order, sorted_cell) -> None:
 
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str, kernel: str, parallel: bool) -> dict:
-    """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool
-    (solvers/loops/cells.py, compiled once per machine), and the per-particle updates."""
-    loops = cpu_loops("cells", precision, kernel, parallel)
+def sweeps(precision: str, kernel: str, parallel: bool, across: bool = True) -> dict:
+    """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool, with or
+    without the pairs across an x seam or wall (``across``; solvers/loops/cells.py, compiled once per
+    machine), and the per-particle updates."""
+    loops = cpu_loops("cells", precision, kernel, parallel, across)
     return {**{name: getattr(loops, name) for name in COMPILED["cells"]}, **cpu_updates(precision, parallel)}
 
 
@@ -117,7 +119,8 @@ class LinkedListCPU(CellListSolver):
     def launch(self, name: str, *args):
         if self.threads > 1:
             use_threads(self.threads)  # a call into numba only if another solver set another count since
-        return sweeps(self.scene.precision, self.scene.kernel, self.threads > 1)[name](*args)
+        s = self.scene
+        return sweeps(s.precision, s.kernel, self.threads > 1, across_x(s))[name](*args)
 
     def sort_cells(self) -> None:
         """SNP in four steps, each its own method: the cell of every particle (:meth:`cell_ids`), the order

