@@ -226,7 +226,7 @@ def test_pcabench_cache_shows_and_clears(tmp_path, capsys):
         shown = json.loads(out)
         assert code == 0 and shown["root"] == str(tmp_path) and shown["entries"]
         assert all(e["functions"] > 0 for e in shown["entries"])
-        assert any("cpu_pairs('float64', 'gaussian')" in e["specialisation"] for e in shown["entries"])
+        assert any("cpu_pairs('float64', 'gaussian'" in e["specialisation"] for e in shown["entries"])
         code, out, _ = cli_main("cache", "--clear", capsys=capsys)
         assert code == 0 and not list(tmp_path.glob("jit/*/*.py"))
     finally:
