@@ -568,6 +568,12 @@ def cmd_cache(args) -> int:
     from solvers import jitcache
 
     root = jitcache.cache_root()
+    blocked = next((p for p in (root, *root.parents) if p.exists() and not p.is_dir()), None)
+    if blocked is not None:  # runs warn and compile in memory; here it is the whole answer
+        raise OptionError(
+            f"the JIT cache root {root} cannot be a folder: {blocked} is a file "
+            f"(set ${jitcache.ENV} or $XDG_CACHE_HOME to a folder)"
+        )
     if args.clear:
         freed = jitcache.clear()
         print(f"cleared {root / 'jit'} ({freed / 2**20:.1f} MiB); the next run of each configuration compiles again")

@@ -35,8 +35,11 @@ _lock = threading.Lock()
 VOLATILE = ("PYTEST_CURRENT_TEST", "PWD", "OLDPWD", "_", "COLUMNS", "LINES")
 
 
+WARM = "PCABENCH_WARM"  # the server's own: the sweep's specs whose compiled loops it loads (pcabench/preload.py)
+
+
 def _fingerprint(env: dict) -> dict:
-    return {k: v for k, v in env.items() if k not in RUN_TIME and k not in VOLATILE and k != ENV}
+    return {k: v for k, v in env.items() if k not in RUN_TIME and k not in VOLATILE and k not in (ENV, WARM)}
 
 
 def usable(env: dict) -> bool:
@@ -54,6 +57,27 @@ def usable(env: dict) -> bool:
             ctx.set_forkserver_preload(["pcabench.preload"])
             _server.update(context=ctx, env=_fingerprint(dict(os.environ)))
     return _fingerprint(env) == _server["env"]
+
+
+def prepare(specs: list) -> None:
+    """Start the server for a sweep of ``specs``, warmed with their compiled loops where the disk cache has
+    them (:func:`pcabench.preload.warm`); a server this process started before stays as it is."""
+    from multiprocessing import forkserver
+
+    if not usable(dict(os.environ)) or _server.get("started"):
+        return
+    variants = {}  # one spec per set of loops: the scene decides seams and walls, the model what moves
+    for spec in specs:
+        sc = spec.scene
+        variants.setdefault(
+            (spec.solver, spec.threads, spec.pair_loop, sc.name, sc.model, sc.precision, sc.kernel), spec
+        )
+    os.environ[WARM] = "[" + ",".join(s.to_json() for s in variants.values()) + "]"
+    try:
+        forkserver.ensure_running()
+        _server["started"] = True
+    finally:
+        del os.environ[WARM]
 
 
 class InheritedFd:
@@ -116,6 +140,7 @@ class ForkedChild:
         sys.modules["__main__"] = types.ModuleType("__main__")  # the child has no main module to import again
         try:
             self.process.start()
+            _server["started"] = True
         finally:
             sys.modules["__main__"] = main
         self.pid = self.process.pid

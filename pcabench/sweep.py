@@ -413,5 +413,7 @@ def sweep(
     with store.SweepLock(store_path):
         store_path = Path(store_path)
         rows = store.read_rows(store_path) if store_path.exists() else []
+        if runner is None:  # the children are forked from a server with the plan's compiled loops loaded
+            forkserver.prepare([s.resolved() for s in specs])
         executor = LocalExecutor(machine_id(), host_id(), git_commit(), runner, stream)
         return run_specs(specs, executor, StoreFile(store_path), rows, run_budget, sweep_budget, stream, retry_failed)

@@ -35,6 +35,7 @@ import shutil
 import sys
 import threading
 import warnings
+from contextlib import contextmanager
 from pathlib import Path
 from types import ModuleType
 
@@ -49,6 +50,27 @@ _warned: set = set()
 
 class JitCacheWarning(UserWarning):
     """The on-disk cache could not be used for some loops: they were compiled in memory (the run is correct)."""
+
+
+class NotCached(RuntimeError):
+    """A compile refused within :func:`loads_only` (the function is not in the disk cache)."""
+
+
+@contextmanager
+def loads_only():
+    """Within: numba may load compiled functions from the disk cache but compiles none (a miss raises
+    :class:`NotCached`; numba's ``numba:compile`` event starts every compile, cached or in memory)."""
+    from numba.core import event
+
+    class Refuse(event.Listener):
+        def on_start(self, ev):
+            raise NotCached(f"{getattr(ev.data.get('dispatcher'), '__name__', 'a function')} is not cached")
+
+        def on_end(self, ev):
+            pass
+
+    with event.install_listener("numba:compile", Refuse()):
+        yield
 
 
 def cache_root() -> Path:
@@ -138,9 +160,22 @@ def key(text: str, depends: tuple = ()) -> str:
     """SHA-256 of the generated ``text``, the source of the modules it imports and of ``depends``, and the target."""
     h = hashlib.sha256(text.encode())
     for dep in sorted({str(_source_file(d)) for d in (*imports_of(text), *depends)}):
-        h.update(dep.encode() + b"\0" + Path(dep).read_bytes() + b"\0")
+        h.update(dep.encode() + b"\0" + _digest(dep) + b"\0")
     h.update(target().encode())
     return h.hexdigest()
+
+
+_digests: dict = {}  # path -> (stat stamp, SHA-256): a source file read once while it is unchanged
+
+
+def _digest(path: str) -> bytes:
+    """The SHA-256 of a source file's bytes (read again when its inode, size, mtime or ctime changes)."""
+    st = os.stat(path)
+    stamp = (st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+    known = _digests.get(path)
+    if known is None or known[0] != stamp:
+        known = _digests[path] = (stamp, hashlib.sha256(Path(path).read_bytes()).digest())
+    return known[1]
 
 
 def specialise(

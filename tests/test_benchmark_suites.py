@@ -5,6 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 from tests.benchmarks.check_ratios import check
 
 
@@ -64,3 +66,43 @@ def test_every_builtin_scene_is_benchmarked_and_each_walled_one_beside_a_free_tw
     with_wall = {lat[:-1] for lat in lattices if lat[-1]}
     without = {lat[:-1] for lat in lattices if not lat[-1]}
     assert len(with_wall) == len(walled) and with_wall == without, lattices
+
+
+def test_the_step_guard_warns_past_its_threshold_and_fails_only_when_asked(monkeypatch, capsys):
+    """tests/benchmarks/step_guard.py's verdict on each side's best run (the runs themselves faked here)."""
+    from tests.benchmarks import step_guard as guard
+
+    if guard.commit_of("HEAD~1") is None:
+        pytest.skip("no earlier commit in this checkout")
+    times = {"then": [530.0, 500.0], "now": [600.0, 640.0]}  # best: then 500, now 600 ns (20 % slower)
+    calls = []
+
+    def step_ns(tree, env, args):
+        side = "now" if tree == guard.ROOT else "then"
+        calls.append(side)
+        return times[side][sum(c == side for c in calls) % 2]
+
+    monkeypatch.setattr(guard, "export", lambda commit, folder: folder)
+    monkeypatch.setattr(guard, "imports_from", lambda tree, env: True)
+    monkeypatch.setattr(guard, "step_ns", step_ns)
+    assert guard.main(["--pairs", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "WARNING" in out and "now/then 1.200" in out
+    assert calls == ["then", "now", "now", "then"]  # alternating, the order flipped each pair
+    assert guard.main(["--pairs", "2", "--fail"]) == 1
+    capsys.readouterr()
+    times["now"] = [540.0, 545.0]  # 8 %: within the 10 %
+    assert guard.main(["--pairs", "2", "--fail"]) == 0 and "WARNING" not in capsys.readouterr().out
+    assert guard.main(["--pairs", "2", "--fail", "--threshold", "0.05"]) == 1
+
+
+def test_the_step_guard_runs_each_side_from_its_own_tree(tmp_path):
+    """End to end at 400 particles against HEAD exported by git archive: each side imports its own tree."""
+    from tests.benchmarks import step_guard as guard
+
+    if guard.commit_of("HEAD") is None:
+        pytest.skip("not a git checkout")
+    cmd = [sys.executable, "tests/benchmarks/step_guard.py", "--against", "HEAD", "--pairs", "1", "--dx", "1"]
+    out = subprocess.run(cmd + ["--steps", "2"], capture_output=True, text=True, cwd=guard.ROOT, timeout=600)
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "pair 1: then" in out.stdout and "now/then" in out.stdout

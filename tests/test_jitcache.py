@@ -231,3 +231,63 @@ def test_pcabench_cache_shows_and_clears(tmp_path, capsys):
         assert code == 0 and not list(tmp_path.glob("jit/*/*.py"))
     finally:
         os.environ.pop("PCABENCH_CACHE")
+
+
+def test_pcabench_cache_on_a_file_is_one_line_naming_it(tmp_path, monkeypatch, capsys):
+    from tests.conftest import cli_main
+
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("x")
+    monkeypatch.setenv("PCABENCH_CACHE", str(blocker / "cache"))
+    code, out, err = cli_main("cache", capsys=capsys)
+    assert code == 2 and str(blocker) in err and len(err.strip().splitlines()) == 1
+    assert "Traceback" not in err and blocker.read_text() == "x"
+
+
+def test_loads_only_loads_what_is_cached_and_compiles_nothing(tmp_path, monkeypatch):
+    monkeypatch.setenv("PCABENCH_CACHE", str(tmp_path))
+    monkeypatch.syspath_prepend(str(tmp_path))
+    name = f"tmpl_lo_{os.getpid()}"
+    (tmp_path / f"{name}.py").write_text(TEMPLATE + f"\nSALT = {time.time_ns()}\n")
+    mod = jitcache.specialise(name, {}, {"triple": ("numba.njit", {})}, ("import numba",))
+    before = jitcache.counts()
+    with jitcache.loads_only(), pytest.raises(jitcache.NotCached, match="triple"):
+        mod.triple(2)  # not in the cache yet: refused, not compiled
+    assert jitcache.counts() == before and not mod.triple.overloads
+    assert mod.triple(2) == 6  # outside, it compiles (and stores)
+    assert jitcache.counts()["compiled"] == before["compiled"] + 1
+
+
+WARM = textwrap.dedent(
+    """
+    import json, sys
+    from pcabench.preload import warm
+    from pcabench.spec import RunSpec
+    from solvers import Scene, jitcache
+    cached = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2)).resolved()
+    other = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2, precision="float32", kernel="wendland-c2")).resolved()
+    threaded = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2), threads=2).resolved()
+    if sys.argv[1:] == ["fill"]:  # a run of ``cached`` before: its loops compiled into the cache
+        from solvers import make_solver
+        from solvers.interface import tiny_scene
+        solver = make_solver("linkedlist-cpu")
+        solver.input(tiny_scene(cached.scene))
+        solver.warmup()
+        sys.exit(0)
+    n = warm([cached, other, threaded])
+    import numba.np.ufunc.parallel as par
+    print(json.dumps({"warmed": n, **jitcache.counts(), "threads_started": bool(par._is_initialized)}))
+    """
+)
+
+
+def test_the_forkservers_warm_loads_the_cached_configurations_and_compiles_none(tmp_path):
+    """pcabench/preload.py: what a sweep's server loads before it forks the runs (a child then loads nothing)."""
+    environ = {**os.environ, "PCABENCH_CACHE": str(tmp_path)}
+    subprocess.run([sys.executable, "-c", WARM, "fill"], check=True, cwd=ROOT, env=environ, capture_output=True)
+    out = subprocess.run([sys.executable, "-c", WARM], capture_output=True, text=True, cwd=ROOT, env=environ)
+    assert out.returncode == 0, out.stderr[-3000:]
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    assert got["warmed"] == 1  # the cached one; float32 wendland is not cached, threads are never warmed
+    assert got["loaded"] > 0 and got["compiled"] == 0
+    assert not got["threads_started"]  # numba's pool does not survive a fork: the server never starts it

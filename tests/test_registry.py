@@ -180,7 +180,7 @@ def test_a_plugin_runs_through_run_a_study_a_report_and_the_benchmarks(tmp_path)
         str(reports),
     )
     assert out.returncode == 0, out.stderr[-2000:]
-    assert out.stderr.count("left out") == 1  # said once, by the sweep, not again by each run's process
+    assert out.stderr.count("left out") == 1, out.stderr  # said once, by the sweep, not again by each run's process
     rows = [json.loads(line) for f in results.glob("*.jsonl") for line in f.read_text().splitlines()]
     assert sorted((r["solver"], r["pair_loop"], r["threads"]) for r in rows) == sorted(
         [(NAME, "gather", 1)] + [("linkedlist-cpu", loop, n) for loop in ("list", "gather") for n in (1, 2)]
