@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import uuid
-from dataclasses import asdict, dataclass, field
+from dataclasses import MISSING, asdict, dataclass, field, fields
 
 from solvers import STAGES
 
@@ -110,6 +110,27 @@ class RunRecord:
             preset=spec.preset,
             host=host_id(),
         )
+
+    @classmethod
+    def from_row(cls, row: dict) -> "RunRecord":
+        """The record of a stored row that passed the schema (:func:`pcabench.store.validate`): its known fields
+        only (a key the schema does not know stays out of every table and report), each one the row predates at
+        its default, the stages as the clock's six (s), the scene's other error measures as numbers."""
+        values = {}
+        for f in fields(cls):
+            value = row.get(f.name)
+            if value is None and f.name in ("timestamp", "run_id"):
+                value = ""  # never this moment's, nor a new id
+            elif value is None and f.default is not MISSING:
+                value = f.default
+            elif value is None and f.default_factory is not MISSING:
+                value = f.default_factory()
+            values[f.name] = value  # a contract field stored as null (an error never measured) stays None
+        values["stages"] = {s: float(row["stages"][s]) for s in STAGES}
+        values["errors"] = {k: v for k, v in (row.get("errors") or {}).items() if isinstance(v, (int, float))}
+        values["scene"] = dict(row["scene"])
+        values["versions"] = dict(row.get("versions") or {})
+        return cls(**values)
 
     def as_dict(self) -> dict:
         return asdict(self)

@@ -21,12 +21,14 @@ import math
 import re
 from dataclasses import dataclass
 
+from solvers.interface import STAGES
 from solvers.kernels.registry import KERNEL_NAME
 from solvers.registry import SOLVER_NAME
 from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, PRECISIONS
 
 STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
 STEP_STAGES = ("snp", "pi", "su")  # the stages of a time step; input, init and output happen once per run
+# a record's ``stages``: the clock's six, each in s (STAGES, solvers/interface.py)
 
 SCHEMA = 2  # version of the row format; rows from before versioning are schema 1
 MAX_SECONDS = 1e9  # a time above this (31 years) is not a measurement
@@ -74,6 +76,7 @@ def _time(required=False, null=False):
 PATH_NAME = _name(empty=False, path=True, max_len=2 * MAX_NAME + 2)  # a file or folder name (profile--host)
 _STEPS = Field(("int",), True, low=0, high=MAX_STEPS)
 _ERROR = Field(("number", "null"), low=0, high=1e300)
+_MEASURE = Field(("number", "null"), low=-1e300, high=1e300)  # a scene's own measure (a plug-in's may be signed)
 
 FIELDS: dict[str, Field] = {
     "schema": Field(("int",), low=1),
@@ -98,6 +101,7 @@ FIELDS: dict[str, Field] = {
     "device": _name(max_len=32),
     "steps_requested": Field(("int",), low=0, high=MAX_STEPS),
     "mse_isothermal": _ERROR,
+    "errors": Field(("dict",)),  # the scene's other error measures, by name: numbers or null
     "scene": Field(("dict",), True),
     "message": Field(("str",), max_len=MAX_MESSAGE),
     "profile_id": _name(required=True, empty=False, path=True),
@@ -291,9 +295,13 @@ def check(row) -> str:
         why = _key(stage) or check_value(f"stage {stage}", Field(("number",), low=0, high=MAX_SECONDS), seconds)
         if why:
             return why
-    missing = [s for s in STEP_STAGES if s not in stages]
+    missing = [s for s in STAGES if s not in stages]
     if missing:
         return f"stages lack {', '.join(missing)}"
+    for name, value in (row.get("errors") or {}).items():
+        why = _key(name) or check_value(f"errors {name}", _MEASURE, value)
+        if why:
+            return why
     for name, version in (row.get("versions") or {}).items():
         why = _key(name) or check_value(f"versions {name}", Field(("str",), max_len=64), version)
         if why:

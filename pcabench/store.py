@@ -28,11 +28,18 @@ writer at a time.
   :data:`MAX_STORE_BYTES` each: a link, a FIFO or a device named ``*.jsonl``
   is skipped with one warning.
 - Stores taken on different machines merge by concatenation: a record keeps
-  its ``run_id`` wherever it is copied, and duplicates are dropped on load.
+  its ``run_id`` wherever it is copied, and copies are one run on load. Two
+  different records under one ``run_id``: the later write wins (the later
+  timestamp; at equal ones the one read later), with one warning naming both
+  files and lines (:func:`read_records`).
+- Readers take the typed record (:meth:`pcabench.record.RunRecord.from_row`):
+  the schema's fields only, so a key the schema does not know never reaches
+  a table.
 """
 
 from __future__ import annotations
 
+import datetime as _dt
 import errno
 import fcntl
 import hashlib
@@ -395,15 +402,34 @@ def read_regular(path, limit: int = MAX_STORE_BYTES, follow: bool = False) -> by
         os.close(fd)
 
 
-def read_rows(paths) -> list[dict]:
-    """Every valid row of the stores ``paths`` (files or folders of *.jsonl), deduplicated.
+def _when(timestamp: str) -> _dt.datetime:
+    """A record's timestamp as a time to compare (one without a zone is UTC; none at all, the earliest)."""
+    try:
+        when = _dt.datetime.fromisoformat(timestamp.replace("Z", "+00:00"))
+    except ValueError:
+        return _dt.datetime.min.replace(tzinfo=_dt.timezone.utc)
+    return when if when.tzinfo else when.replace(tzinfo=_dt.timezone.utc)
 
-    A line that is not valid UTF-8, not JSON, not a record, or fails
-    :func:`validate` is skipped with one StoreWarning naming its file and line.
+
+def _canonical(record) -> str:
+    return json.dumps(_clean(record.as_dict()), sort_keys=True, default=str)
+
+
+def read_records(paths) -> list:
+    """Every valid row of the stores ``paths`` (files or folders of *.jsonl) as a typed record
+    (:meth:`~pcabench.record.RunRecord.from_row`: the schema's fields only), one per run.
+
+    A line that is not valid UTF-8, not JSON, not a record, or fails :func:`validate` is skipped with one
+    StoreWarning naming its file and line. One ``run_id`` read twice with the same record (a store copied
+    into another) is one run. Read twice with different records, the later write wins: the later
+    ``timestamp``, and at equal timestamps the one read later (files in the order given, a folder's by name;
+    lines in their order, which is the order they were appended in); one StoreWarning names both places.
     """
+    from .record import RunRecord
+
     if isinstance(paths, (str, Path)):
         paths = [paths]
-    seen, rows = set(), []
+    kept: dict[str, tuple] = {}  # run_id -> (record, where, canonical form)
     for path in paths:
         path = Path(path)
         folder = path.is_dir()
@@ -438,8 +464,27 @@ def read_rows(paths) -> list[dict]:
                 if why:
                     warnings.warn(f"{file}:{number}: {why}; row skipped", StoreWarning, stacklevel=2)
                     continue
-                rid = row.get("run_id") or run_id(row)
-                if rid not in seen:
-                    seen.add(rid)
-                    rows.append(row)
-    return rows
+                record = RunRecord.from_row(row)
+                record.run_id = row.get("run_id") or run_id(row)
+                where, form = f"{file}:{number}", _canonical(record)
+                if record.run_id not in kept:
+                    kept[record.run_id] = (record, where, form)
+                    continue
+                first, first_where, first_form = kept[record.run_id]
+                if form == first_form:
+                    continue  # the same record, copied
+                later = _when(record.timestamp) >= _when(first.timestamp)
+                warnings.warn(
+                    f"run_id {record.run_id} is stored twice with different records, at {first_where} and "
+                    f"{where}; the later write ({where if later else first_where}) is kept",
+                    StoreWarning,
+                    stacklevel=2,
+                )
+                if later:
+                    kept[record.run_id] = (record, where, form)
+    return [record for record, _, _ in kept.values()]
+
+
+def read_rows(paths) -> list[dict]:
+    """:func:`read_records` as dicts (:meth:`~pcabench.record.RunRecord.as_dict`): what every reader takes."""
+    return [record.as_dict() for record in read_records(paths)]
