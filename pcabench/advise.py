@@ -16,7 +16,7 @@ that would.
 from __future__ import annotations
 
 import itertools
-import math
+import json
 import shlex
 
 import numpy as np
@@ -24,8 +24,8 @@ import numpy as np
 from solvers import DEFAULT_KERNEL, DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind
 from solvers.dispersion import predict, stable_cfl
 
-from .parameters import METHOD, NUMERICS, PROBLEM
 from .reports.tables import comparable, default_numerics, error_column, latest, numerics_label
+from .spec import scene_from_row
 from .stability import assess, e_foldings
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid), for
@@ -53,36 +53,14 @@ def scene_of(r) -> dict:
     }
 
 
-def command(r, t_end: float) -> str:
-    """The ``pcabench run`` command line that reproduces stored run ``r``, every word quoted for the shell
-    (shlex): a stored row from a shared store cannot plant shell syntax in a line the user pastes. The
-    problem's and the method's options away from their defaults, as the parameter table names them."""
-    words = [
-        "pcabench",
-        "run",
-        "--solver",
-        str(r["solver"]),
-        "--dx",
-        f"{float(r['dx']):g}",
-        "--t-end",
-        f"{t_end:g}",
-        "--model",
-        str(r["model"]),
-    ]
-    for par in (*PROBLEM, NUMERICS[0], *METHOD):
-        column = "scene" if par.field == "name" else par.field
-        value = r.get(column) if hasattr(r, "get") else None
-        if value is None or (isinstance(value, float) and math.isnan(value)):
-            continue
-        value = float(value) if par.numeric else str(value)
-        if not (np.isclose(value, par.default()) if par.numeric else value == par.default()):
-            words += par.words(value)
-    height = r.get("strip_height")
-    if height is not None and not (isinstance(height, float) and math.isnan(height)):
-        words += ["--strip-height", f"{float(height):g}"]
-    if int(r["threads"]) > 1:
-        words += ["--threads", str(int(r["threads"]))]
-    return shlex.join(words)
+def command(r, t_end: float | None = None) -> str:
+    """The ``pcabench run`` command line that makes stored run ``r`` (a row of the reports' frame) again, from
+    its whole stored scene (:mod:`pcabench.commands`: every parameter away from its default, quoted for the
+    shell). ``t_end`` is the run's own (kept for callers)."""
+    from .commands import line_of, words_of
+
+    scene = scene_from_row({"scene": json.loads(r["scene_key"])})
+    return line_of(*words_of(str(r["solver"]), scene, int(r["threads"]), str(r.get("pair_loop") or "")))
 
 
 def reaching(df, t_end: float, model: str):

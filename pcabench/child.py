@@ -1,11 +1,15 @@
 """A sweep's child process: run one spec and send its record on a channel of its own.
 
-    python -m pcabench.child --record-fd FD '<RunSpec JSON>'
+    python -m pcabench.child --record-fd FD --fields PATH '<RunSpec JSON>'
 
 The record goes, as one JSON object, to the file descriptor FD (a pipe the
 sweep passes in), never to stdout: what a solver prints on stdout or stderr
 cannot be taken for a record (the sweep keeps it, cut, in the record's
 message). Without ``--record-fd`` the record is printed on stdout (by hand).
+With ``--fields`` the run's final fields go to the .npz PATH (a folder of the
+sweep's own) unscored: the sweep takes from the record only what was measured
+(times, steps, status) and computes the errors from the fields itself
+(:func:`pcabench.sweep.accept`).
 
 The child never writes the store: the sweep (its parent) is the only writer,
 so a progress line always reports the record this child made. Its record
@@ -29,10 +33,12 @@ from .spec import RunSpec
 from .store import to_row
 
 
-def run_spec(spec: RunSpec) -> dict:
-    """Run one resolved spec with step progress on stderr; its record as a store row."""
+def run_spec(spec: RunSpec, fields_path=None) -> dict:
+    """Run one resolved spec with step progress on stderr; its record as a store row (unscored, its fields
+    at ``fields_path``, if that is given)."""
     progress = Progress(f"    {spec.solver} N={spec.scene.n_particles:,}", every=5.0)
-    return to_row(run(spec, machine_id(), progress=progress))
+    record = run(spec, machine_id(), fields_path=fields_path, progress=progress, scored=fields_path is None)
+    return to_row(record)
 
 
 def main(argv=None) -> int:
@@ -42,7 +48,10 @@ def main(argv=None) -> int:
     if argv[:1] == ["--record-fd"]:
         fd, argv = int(argv[1]), argv[2:]
         os.set_inheritable(fd, False)  # the solver's own subprocesses do not get it
-    data = (json.dumps(run_spec(RunSpec.from_json(argv[0])), sort_keys=True) + "\n").encode("utf-8")
+    fields = None
+    if argv[:1] == ["--fields"]:
+        fields, argv = argv[1], argv[2:]
+    data = (json.dumps(run_spec(RunSpec.from_json(argv[0]), fields), sort_keys=True) + "\n").encode("utf-8")
     if fd is None:
         sys.stdout.buffer.write(data)
         sys.stdout.flush()

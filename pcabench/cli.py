@@ -227,20 +227,19 @@ def scene_from_args(args) -> Scene:
 
 
 def check_output_path(path, option: str) -> None:
-    """OptionError naming ``option`` unless a file can be written at ``path`` (tried before any work)."""
+    """OptionError naming ``option`` unless a file can be written at ``path`` (tried before any work, in its
+    folder, leaving nothing behind and following no link: a link at ``path`` is replaced when the file is
+    written, :mod:`pcabench.safeio`)."""
+    text = str(path)
     path = Path(path)
-    if not str(path).strip() or path.is_dir():
-        raise OptionError(f"{option} {str(path)!r} is not a file name")
+    if not text.strip() or text.endswith(("/", os.sep)) or path.stem in ("", ".") or path.is_dir():
+        raise OptionError(f"{option} {text!r} is not a file name")
     if not path.parent.is_dir():
         raise OptionError(f"{option} {path}: the folder {path.parent} does not exist")
-    existed = path.exists()
     try:
-        with open(path, "ab"):
-            pass
+        tempfile.TemporaryFile(dir=path.parent).close()
     except OSError as exc:
         raise OptionError(f"{option} {path} is not writable: {exc.strerror or exc}") from None
-    if not existed:
-        path.unlink()
 
 
 def check_folder(path, option: str) -> Path:
@@ -265,7 +264,7 @@ def home_option() -> str:
 # ---------------------------------------------------------------- commands
 def cmd_run(args) -> int:
     from .profiles import machine_id
-    from .run import RunBudgetSpent, run, run_budget, solver_output_to_stderr
+    from .run import run, solver_output_to_stderr
     from .store import to_row
 
     scene = scene_from_args(args)
@@ -274,33 +273,43 @@ def cmd_run(args) -> int:
     # resolved once, and checked: the solver can run here (a GPU for a GPU solver), before anything is printed
     (spec,) = check_specs([RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto")])
     if args.fields is not None:
-        if args.fields.strip() and not args.fields.endswith(".npz"):
+        if args.fields.strip() and not args.fields.endswith((".npz", "/")):
             args.fields += ".npz"  # as numpy.savez names it
         check_output_path(args.fields, "--fields")
     if args.run_budget is not None and not args.run_budget > 0:
         raise OptionError(f"--run-budget must be > 0 seconds (got {args.run_budget})")
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
-    progress = None if args.quiet else Progress(args.solver)
-    try:
-        with solver_output_to_stderr(args.json), run_budget(args.run_budget):
+    if args.run_budget is not None:  # in a child, as a sweep runs it: the budget holds whatever the solver does
+        record = run_in_child(spec, args)
+    else:
+        progress = None if args.quiet else Progress(args.solver)
+        with solver_output_to_stderr(args.json):
             record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
-    except RunBudgetSpent:
-        from .sweep import failed_record
-
-        record = failed_record(spec, "timeout", f"past the run budget of {args.run_budget:g} s", machine_id())
-    if args.json:
-        out = {key: getattr(record, key) for key in record.CONTRACT}
-        out["threads"] = record.threads
-        out["kernel"] = scene.kernel
-        out["scene"] = scene.name
-        out["errors"] = record.errors
-        out["mse_isothermal"] = record.mse_isothermal
-        out["message"] = record.message
-        print(jsonout.dumps(to_row(out)))  # strict JSON: null, never NaN
+    if args.json:  # the record as a store holds it: the whole scene, so the run can be made again from it
+        print(jsonout.dumps(to_row(record)))  # strict JSON: null, never NaN
     else:
         print(record.text(scene))
     return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
+
+
+def run_in_child(spec: RunSpec, args):
+    """``pcabench run --run-budget S``: the run in a child process of its own group (as a sweep's,
+    :func:`pcabench.sweep.run_child`), killed with all it started at S seconds, whether or not the solver
+    returns to Python (a compiled loop, a solver that ignores signals); its record."""
+    import subprocess
+
+    from .profiles import machine_id
+    from .provenance import git_commit
+    from .record import RunRecord
+    from .sweep import failed_record, run_child
+
+    stream = None if args.quiet else sys.stderr
+    try:
+        row = run_child(spec, args.run_budget, git_commit(), machine_id(), stream=stream, fields_to=args.fields)
+    except subprocess.TimeoutExpired:
+        return failed_record(spec, "timeout", f"past the run budget of {args.run_budget:g} s", machine_id())
+    return RunRecord.from_row(row)
 
 
 def study_specs(args) -> tuple[str, list[RunSpec]]:
@@ -442,7 +451,14 @@ def cmd_accuracy(args) -> int:
 
     given = {key: getattr(args, opt) for opt, key in ACCURACY_OPTIONS.items() if getattr(args, opt) is not None}
     check_wall_option([given.get("name", DEFAULT_SCENE)], "x_max" in given)
-    scene = Scene(dx=args.dx, t_end=args.t_end, model="linear", memory_limit_bytes=2**62, **given, **domain_of(args))
+    scene = Scene(  # the prediction builds the scene's lattice: bounded by this process's memory, as a run is
+        dx=args.dx,
+        t_end=args.t_end,
+        model="linear",
+        memory_limit_bytes=memory.available_memory_bytes(),
+        **given,
+        **domain_of(args),
+    )
     p = predict(scene)
     past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/stability.py)
     if args.json:

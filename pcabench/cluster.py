@@ -200,6 +200,6 @@ class Stores:
         path = self.results / store.store_name(row["profile_id"], row.get("host") or host_id())
         if path not in self.paths:
             store.check_writable(path)
-            self.lock.keep_reserve(path)
+            self.lock.hold(path)
             self.paths.add(path)
-        return store.append(row, path)
+        return store.append(row, path, held=self.lock.held(path))

@@ -109,9 +109,11 @@ def die_with_parent() -> None:
     _prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG = 1
 
 
-def child_main(spec_json: str, stdout: int, stderr: int, record: int, env: dict, cwd: str) -> None:
-    """In the forked child: the pipes as stdout and stderr, the sweep's environment and folder, then one run
-    (:func:`pcabench.child.main`), its record on ``record``."""
+def child_main(args: list, stdout: int, stderr: int, record: int, env: dict, cwd: str) -> None:
+    """In the forked child: a process group of its own (the sweep ends it whole), the pipes as stdout and
+    stderr, the sweep's environment and folder, then one run (:func:`pcabench.child.main` with ``args``), its
+    record on ``record``."""
+    os.setsid()  # its own session and process group: what the run starts, the sweep ends with it
     die_with_parent()  # the forkserver, which ends when the sweep does
     _prctl(15, ctypes.c_char_p(NAME))  # PR_SET_NAME = 15
     sys.stdout.flush()
@@ -125,16 +127,16 @@ def child_main(spec_json: str, stdout: int, stderr: int, record: int, env: dict,
     os.chdir(cwd)
     from .child import main
 
-    sys.exit(main(["--record-fd", str(record), spec_json]))
+    sys.exit(main(["--record-fd", str(record), *args]))
 
 
 class ForkedChild:
     """A run's child forked from the server, with the part of :class:`subprocess.Popen` a sweep uses."""
 
-    def __init__(self, spec_json: str, stdout: int, stderr: int, record: int, env: dict):
+    def __init__(self, args: list, stdout: int, stderr: int, record: int, env: dict):
         fds = (InheritedFd(stdout), InheritedFd(stderr), InheritedFd(record))
         self.process = _server["context"].Process(
-            target=child_main, args=(spec_json, *fds, dict(env), os.getcwd()), name="pcabench-run"
+            target=child_main, args=(list(args), *fds, dict(env), os.getcwd()), name="pcabench-run"
         )
         main = sys.modules["__main__"]
         sys.modules["__main__"] = types.ModuleType("__main__")  # the child has no main module to import again
@@ -144,7 +146,7 @@ class ForkedChild:
         finally:
             sys.modules["__main__"] = main
         self.pid = self.process.pid
-        self.args = ["forkserver", "pcabench.child", spec_json]
+        self.args = ["forkserver", "pcabench.child", *args]
 
     @property
     def returncode(self):

@@ -10,23 +10,83 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import signal
 import sys
+
+import numpy as np
 
 from solvers import SceneError, jitcache, make_solver
 from solvers.integrators import step_program
 
 from .clock import clock_for
+from .errors import StoreError
 from .memory import is_out_of_memory
 from .record import RunRecord
 from .spec import RunSpec
 
+FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.interface.Fields), each one per particle
 
-def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> RunRecord:
+
+def fields_problem(fields, n_particles: int) -> str:
+    """Why ``fields`` (solvers.interface.Fields) are not a run's result for ``n_particles`` ('' if they are): an
+    array of another length, or values that are not finite, or a time that is not."""
+    for name in FIELD_NAMES:
+        values = np.asarray(getattr(fields, name))
+        if values.shape != (n_particles,):
+            return f"its field {name} has shape {values.shape}, not ({n_particles},) (one value per particle)"
+        if not np.issubdtype(values.dtype, np.number) or not np.isfinite(values).all():
+            return f"its field {name} holds values that are not finite numbers"
+    if not math.isfinite(float(fields.t)) or fields.t < 0:
+        return f"its time t = {fields.t!r} is not a finite time >= 0"
+    return ""
+
+
+def score(record: RunRecord, scene, fields) -> RunRecord:
+    """Score a run that finished its steps (``record``, status not ``unstable``) by its final ``fields``
+    against the scene's exact solution: MSE, ME, the scene's other measures and the isothermal MSE, and the
+    status ``ok``; ``error`` naming the field if the fields are not one finite value per particle. The
+    harness does this, never the solver: a run's errors are computed, not reported."""
+    why = fields_problem(fields, scene.n_particles)
+    if why:
+        record.status, record.failed_step = "error", record.steps or None
+        record.message = (record.message + "\n" if record.message else "") + f"the run's result is not usable: {why}"
+        return record
+    record.t_end = float(fields.t)
+    record.status = "ok"
+    measures = dict(scene.kind.errors(scene, fields))  # against the scene's exact linear solution
+    record.mse, record.me = measures.pop("mse"), measures.pop("me")
+    record.errors = measures
+    if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
+        record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
+    return record
+
+
+def save_fields(fields, path) -> None:
+    """Write a run's final fields to the .npz ``path`` (safeio: whole or not at all, no link followed)."""
+    import io
+
+    from .safeio import write_file
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **{name: getattr(fields, name) for name in FIELD_NAMES}, t=fields.t)
+    write_file(path, buffer.getvalue())
+
+
+def load_fields(path):
+    """The fields an .npz of :func:`save_fields` holds (solvers.interface.Fields); OSError or ValueError if it
+    is not one."""
+    from solvers.interface import Fields
+
+    with np.load(path, allow_pickle=False) as data:
+        return Fields(**{name: data[name] for name in FIELD_NAMES}, t=float(data["t"]))
+
+
+def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None, scored: bool = True) -> RunRecord:
     """Run ``spec`` on machine ``machine`` (its :func:`~pcabench.profiles.machine_id`); its record.
 
     ``spec`` is resolved where the command or sweep starts (an unresolved one is resolved here, for
-    scripts). Never raises for a failed run: bad input (SceneError) is the caller's to report."""
+    scripts). The final fields go to the .npz ``fields_path`` if given. Without ``scored`` a run that
+    finished its steps keeps status ``error`` and no errors: a sweep's child, whose parent scores the fields
+    it wrote (:func:`score`). Never raises for a failed run: bad input (SceneError) is the caller's to report."""
     spec = spec.resolved()
     scene = spec.scene
     solver = make_solver(spec.solver, threads=spec.threads, pair_loop=spec.pair_loop)
@@ -58,20 +118,16 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> Ru
                 progress(step, scene.n_steps)
         record.steps = step
         fields = clock.time("output", solver.output)
-        if fields_path is not None:
-            fields.save(fields_path)
         record.stages = clock.totals()
-        record.t_end = fields.t
+        record.t_end = float(fields.t)
+        if fields_path is not None:
+            save_fields(fields, fields_path)
         if record.status != "unstable":
-            record.status = "ok"
-            measures = scene.kind.errors(scene, fields)  # against the scene's exact linear solution
-            record.mse, record.me = measures.pop("mse"), measures.pop("me")
-            record.errors = measures
-            if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
-                record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
             record.mean_neighbours = solver.mean_neighbours()
-    except SceneError:
-        raise  # bad input is the caller's to report, not a run result
+            if scored:
+                score(record, scene, fields)
+    except (SceneError, StoreError):
+        raise  # bad input, or a file that cannot be written (a full disk), is the caller's to report
     except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
         record.steps = step
         record.failed_step = step or None
@@ -87,30 +143,6 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None) -> Ru
 
             record.message += "\n" + traceback.format_exc(limit=8)
     return record
-
-
-class RunBudgetSpent(BaseException):
-    """``pcabench run --run-budget`` ran out (a BaseException: a run records every Exception as its own)."""
-
-
-@contextlib.contextmanager
-def run_budget(seconds: float | None):
-    """RunBudgetSpent in this (main) thread once ``seconds`` have passed (checked between Python steps of
-    the run, so a step of compiled code ends first); nothing if ``seconds`` is None."""
-    if seconds is None:
-        yield
-        return
-
-    def spent(signum, frame):
-        raise RunBudgetSpent()
-
-    before = signal.signal(signal.SIGALRM, spent)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, before)
 
 
 @contextlib.contextmanager

@@ -32,14 +32,23 @@ def _write_all(fd: int, data: bytes) -> None:
         data = data[os.write(fd, data) :]
 
 
-def own_folder(path, what: str = "folder") -> Path:
-    """``path`` made if needed; StoreError naming it if it is a symbolic link (pcabench writes and deletes
-    only in folders of its own, never where a link points)."""
+def own_folder(path, what: str = "folder", within=None) -> Path:
+    """``path`` made if needed; StoreError naming it if it, or a folder between it and ``within`` (a folder
+    pcabench made or was given, itself checked too), is a symbolic link: pcabench writes and deletes only in
+    folders of its own, never where a link points."""
     from .store import StoreError
 
     path = Path(path)
-    if path.is_symlink():
-        raise StoreError(f"{what} {path} is a symbolic link; pcabench writes only into real folders")
+    levels = [path]
+    if within is not None:
+        within = Path(within)
+        here = path
+        while here != within and here != here.parent and within in here.parents:
+            here = here.parent
+            levels.append(here)
+    for level in levels:
+        if level.is_symlink():
+            raise StoreError(f"{what} {level} is a symbolic link; pcabench writes only into real folders")
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

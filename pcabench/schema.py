@@ -80,7 +80,7 @@ _MEASURE = Field(("number", "null"), low=-1e300, high=1e300)  # a scene's own me
 
 FIELDS: dict[str, Field] = {
     "schema": Field(("int",), low=1),
-    "solver": _name(required=True, empty=False, max_len=64, pattern=SOLVER_NAME),  # as the registry checks
+    "solver": _name(required=True, empty=False, max_len=32, pattern=SOLVER_NAME),  # the one name rule (plugins.NAME)
     "precision": Field(("str",), choices=PRECISIONS),
     "model": Field(("str",), choices=MODELS),
     "integrator": Field(("str",), choices=INTEGRATORS),
@@ -148,7 +148,7 @@ SCENE_FIELDS: dict[str, Field] = {
     "model": Field(("str",), choices=MODELS),
     "integrator": Field(("str",), choices=INTEGRATORS),
     "precision": Field(("str",), choices=PRECISIONS),
-    "name": _name(max_len=64),  # a named scene (the scene registry)
+    "name": _name(max_len=32, pattern=SOLVER_NAME),  # a named scene: the one name rule (plugins.NAME)
 }
 
 

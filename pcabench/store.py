@@ -49,6 +49,7 @@ import os
 import shutil
 import stat
 import sys
+import time
 import warnings
 from pathlib import Path
 
@@ -212,6 +213,22 @@ def _repair_tail(fd: int, path: Path) -> None:
     )
 
 
+def _regular_or_refuse(path: Path, what: str) -> None:
+    """StoreError naming ``path`` unless it is absent or a regular file (not a link, a FIFO or a folder)."""
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return
+    if not stat.S_ISREG(st.st_mode):
+        kind = "a symbolic link" if stat.S_ISLNK(st.st_mode) else "not a regular file"
+        raise StoreError(f"{path}, {what}, is {kind}; remove it (pcabench writes only regular files there)")
+
+
+def check_torn(path) -> None:
+    """StoreError before any run unless ``<store>.torn`` (where a torn last line is moved) can be written."""
+    _regular_or_refuse(Path(f"{path}.torn"), "where a torn last line of the store is kept")
+
+
 def reserve_path(path) -> Path:
     """The space a sweep keeps beside its store, given up to store the record that meets a full disk."""
     return Path(f"{path}.reserve")
@@ -223,6 +240,7 @@ def keep_reserve(path) -> Path:
     try:
         fd = _open(reserve, os.O_WRONLY | os.O_CREAT | os.O_EXCL)
     except FileExistsError:
+        _regular_or_refuse(reserve, "the store's reserve (room for the record that meets a full disk)")
         return reserve
     try:
         _write_all(fd, bytes(RESERVE_BYTES))
@@ -231,9 +249,30 @@ def keep_reserve(path) -> Path:
     return reserve
 
 
-def append(record, path) -> dict:
+APPEND_WAIT = 10.0  # s an append waits for a store another writer holds (a sweep holds its store for its life)
+
+
+def _lock_store(fd: int, path: Path) -> None:
+    """Take the store ``fd``'s exclusive lock, waiting up to :data:`APPEND_WAIT` for another writer's append;
+    StoreError if a sweep holds it (what its runs and their processes write is not taken)."""
+    deadline = time.monotonic() + APPEND_WAIT
+    while True:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return
+        except BlockingIOError:
+            if time.monotonic() > deadline:
+                raise StoreError(
+                    f"results store {path} is held by a sweep: only that sweep writes it while it runs"
+                ) from None
+            time.sleep(0.02)
+
+
+def append(record, path, held: int | None = None) -> dict:
     """Append one run record (a RunRecord or dict) to the store at ``path`` safely; returns the row.
 
+    ``held`` is the store's file descriptor, locked, of the sweep that holds it (:meth:`SweepLock.held`);
+    without it the store is locked for this one write, and refused while a sweep holds it.
     A failed write leaves the file as it was. On a full disk the store's reserve (:class:`SweepLock`),
     if any, is given up and the write tried again: the record is then stored, and StoreError says the
     disk is full all the same, so that the sweep stops.
@@ -246,10 +285,14 @@ def append(record, path) -> dict:
     line = (json.dumps(row, sort_keys=True, allow_nan=False) + "\n").encode("utf-8")
     freed = False
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd = _open(path, os.O_RDWR | os.O_APPEND | os.O_CREAT)
+        if held is None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd = _open(path, os.O_RDWR | os.O_APPEND | os.O_CREAT)
+        else:
+            fd = held
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX)
+            if held is None:
+                _lock_store(fd, path)
             while True:
                 _repair_tail(fd, path)
                 before = os.fstat(fd).st_size
@@ -265,7 +308,8 @@ def append(record, path) -> dict:
                     reserve.unlink()
                     freed = True
         finally:
-            os.close(fd)  # and with it the lock
+            if held is None:
+                os.close(fd)  # and with it the lock
     except StoreError:
         raise
     except OSError as exc:
@@ -296,7 +340,7 @@ class SweepLock:
         path = Path(path)
         self.folder = path if whole_folder else path.parent
         self.store = None if whole_folder else path
-        self.fds, self.reserves = [], []
+        self.fds, self.reserves, self.stores = [], [], {}
 
     def _lock(self, path: Path, how: int, what: str, holder_wrote_pid: bool = True) -> int:
         fd = _open(path, os.O_RDWR | os.O_CREAT)
@@ -330,7 +374,7 @@ class SweepLock:
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"pid {os.getpid()}".encode(), 0)
             if self.store is not None:
-                self.reserves.append(keep_reserve(self.store))
+                self.hold(self.store)
         except StoreError:
             self.__exit__()
             raise
@@ -339,16 +383,33 @@ class SweepLock:
             raise StoreError(f"results folder {self.folder} is not writable: {exc.strerror or exc}") from None
         return self
 
-    def keep_reserve(self, store_path) -> None:
-        """Keep a reserve for another store of the locked folder too (a cluster sweep's), while locked."""
-        self.reserves.append(keep_reserve(store_path))
+    def hold(self, store_path) -> int:
+        """Hold the store at ``store_path`` (of the locked folder) until released: its file locked for writing,
+        so that no other process appends to it (a run's own processes included), and its reserve kept; its
+        locked file descriptor, which :func:`append` takes as ``held``."""
+        store_path = Path(store_path)
+        if store_path not in self.stores:
+            check_torn(store_path)
+            fd = _open(store_path, os.O_RDWR | os.O_APPEND | os.O_CREAT)
+            self.fds.append(fd)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise StoreError(f"results store {store_path} is being written by another process") from None
+            self.reserves.append(keep_reserve(store_path))
+            self.stores[store_path] = fd
+        return self.stores[store_path]
+
+    def held(self, store_path) -> int | None:
+        """The held store's locked file descriptor (:meth:`hold`), or None."""
+        return self.stores.get(Path(store_path))
 
     def __exit__(self, *exc):
         for reserve in self.reserves:
             reserve.unlink(missing_ok=True)
         for fd in self.fds:
             os.close(fd)
-        self.fds, self.reserves = [], []
+        self.fds, self.reserves, self.stores = [], [], {}
 
 
 def _no_constant(name):

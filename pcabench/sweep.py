@@ -18,6 +18,7 @@ reruns timeouts, skips and errors. A run predicted to take longer than the run b
 from __future__ import annotations
 
 import abc
+import io
 import json
 import math
 import os
@@ -29,7 +30,9 @@ import threading
 import time
 from pathlib import Path
 
-from . import forkserver, store
+import numpy as np
+
+from . import forkserver, schema, store
 from .memory import cgroup_memory_folders
 from .predict import predicted_seconds, row_variant, spec_variant
 from .profiles import MACHINE_ID_ENV, machine_id
@@ -97,15 +100,17 @@ def _cut(chunks: list) -> str:
     return text if len(text) <= OUTPUT_KEPT else "..." + text[-OUTPUT_KEPT:]
 
 
-def start_child(spec: RunSpec, env: dict) -> tuple:
-    """Start the child that runs ``spec`` with environment ``env``: forked from the warm server where it can be
-    (pcabench/forkserver.py), else a fresh interpreter (``python -m pcabench.child``). (process, its stdout
-    and stderr as binary streams, the read end of its record's pipe)."""
+def start_child(spec: RunSpec, env: dict, fields_path) -> tuple:
+    """Start the child that runs ``spec`` with environment ``env``, its fields to ``fields_path``, in a process
+    group of its own: forked from the warm server where it can be (pcabench/forkserver.py), else a fresh
+    interpreter (``python -m pcabench.child``). (process, its stdout and stderr as binary streams, the read
+    end of its record's pipe)."""
     read_end, write_end = os.pipe()
+    args = ["--fields", str(fields_path), spec.to_json()]
     if forkserver.usable(env):
         ends = [os.pipe(), os.pipe()]
         try:
-            proc = forkserver.ForkedChild(spec.to_json(), ends[0][1], ends[1][1], write_end, env)
+            proc = forkserver.ForkedChild(args, ends[0][1], ends[1][1], write_end, env)
         except BaseException:
             for fd in (read_end, ends[0][0], ends[1][0]):
                 os.close(fd)
@@ -114,7 +119,7 @@ def start_child(spec: RunSpec, env: dict) -> tuple:
             for fd in (write_end, ends[0][1], ends[1][1]):  # the child holds them now
                 os.close(fd)
         return proc, os.fdopen(ends[0][0], "rb"), os.fdopen(ends[1][0], "rb"), read_end
-    cmd = [sys.executable, "-m", "pcabench.child", "--record-fd", str(write_end), spec.to_json()]
+    cmd = [sys.executable, "-m", "pcabench.child", "--record-fd", str(write_end), *args]
     try:
         proc = subprocess.Popen(
             cmd,
@@ -123,6 +128,7 @@ def start_child(spec: RunSpec, env: dict) -> tuple:
             stderr=subprocess.PIPE,
             env=env,
             pass_fds=(write_end,),
+            start_new_session=True,  # its own process group: what the run starts, the sweep ends with it
             preexec_fn=forkserver.die_with_parent if sys.platform.startswith("linux") else None,
         )
     except BaseException:
@@ -133,78 +139,179 @@ def start_child(spec: RunSpec, env: dict) -> tuple:
     return proc, proc.stdout, proc.stderr, read_end
 
 
-def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:
+MEASURED = (
+    "steps",
+    "t_end",
+    "stages",
+    "jit_seconds",
+    "jit_cached",
+    "mean_neighbours",
+    "status",
+    "failed_step",
+    "message",
+)
+CHILD_STATUSES = ("ok", "unstable", "out-of-memory", "error")  # what a run can end in; the sweep says the rest
+
+
+def _measurement_problem(spec: RunSpec, row: dict) -> str:
+    """Why the measurements in a child's ``row`` do not fit its ``spec`` ('' if they do)."""
+    from solvers import STAGES
+
+    scene = spec.scene
+    if row.get("n_particles") != scene.n_particles:
+        return f"it ran {row.get('n_particles')!r:.40} particles, not the spec's {scene.n_particles}"
+    steps = row.get("steps")
+    if not isinstance(steps, int) or isinstance(steps, bool) or not 0 <= steps <= scene.n_steps:
+        return f"its steps {steps!r:.40} are not a count from 0 to the spec's {scene.n_steps}"
+    stages = row.get("stages")
+    if not isinstance(stages, dict) or sorted(stages) != sorted(STAGES):
+        return f"its stages are not the clock's six ({', '.join(STAGES)})"
+    for name, seconds in stages.items():
+        if not isinstance(seconds, (int, float)) or isinstance(seconds, bool) or not 0 <= seconds < 1e9:
+            return f"its stage {name} took {seconds!r:.40}, not a finite time >= 0 s"
+    if row.get("status") not in CHILD_STATUSES:
+        return f"its status {row.get('status')!r:.40} is not one a run ends in ({', '.join(CHILD_STATUSES)})"
+    for key in MEASURED:
+        why = schema.check_value(key, schema.FIELDS[key], row[key]) if key in row else ""
+        if why:
+            return why
+    if row.get("status") in ("ok", "error") and row.get("message", "") == "" and steps != scene.n_steps:
+        return f"it finished after {steps} of the spec's {scene.n_steps} steps"
+    return ""
+
+
+def accept(spec: RunSpec, row: dict, fields_path, commit: str, machine: str) -> RunRecord:
+    """The record of a run whose child sent ``row`` and wrote its fields to ``fields_path``.
+
+    The sweep builds the record's identity itself (:meth:`RunRecord.from_spec`: the spec, the solver and its
+    device, this machine and host, ``commit``, the package versions) and takes from the child only what it
+    measured (:data:`MEASURED`), checked against the spec: its particle count, steps within the spec's,
+    the clock's six stages as finite times, a status a run ends in. The errors are computed here from the
+    fields the child wrote (:func:`pcabench.run.score`), never taken from the child. A record that fails
+    these checks is an ``error`` naming why."""
+    from .run import load_fields, score
+
+    record = RunRecord.from_spec(spec, machine, status="error")
+    record.commit = commit
+    why = _measurement_problem(spec, row)
+    if why:
+        record.message = f"the run's record does not fit its spec: {why}"
+        return record
+    for key in MEASURED:
+        if key in row:
+            setattr(record, key, row[key])
+    record.message = schema.clean_text(str(record.message or ""))
+    finished = row["status"] == "ok" or row["status"] == "error" and not record.message
+    if not finished:  # unstable (at its step), out-of-memory or a failed run: as it ended, nothing to score
+        return record
+    record.status, record.failed_step = "error", None
+    try:  # a regular file of a bounded size (not a link, not a FIFO): what one value a particle takes
+        data = store.read_regular(fields_path, limit=(1 << 20) + 64 * spec.scene.n_particles)
+        fields = load_fields(io.BytesIO(data))
+    except (OSError, ValueError, KeyError, TypeError, EOFError) as exc:
+        record.message = f"the run wrote no usable fields ({type(exc).__name__}: {str(exc)[:200]})"
+        return record
+    record.t_end = float(fields.t) if np.isfinite(fields.t) else 0.0
+    return score(record, spec.scene, fields)
+
+
+def end_group(proc) -> None:
+    """Kill the run's whole process group (its child and whatever the run started), then the child."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    proc.kill()
+
+
+def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr, fields_to=None) -> dict:
     """Run ``spec`` in a child process, relaying its progress to ``stream``; its record as a row.
 
     The child sends its record on a pipe of its own (``--record-fd``), never on stdout: whatever the solver
-    prints on stdout or stderr is kept (cut) in the record's message and never parsed. The child's record
-    carries ``commit`` and ``machine`` (the parent's :func:`~pcabench.profiles.machine_id`).
+    prints on stdout or stderr is kept (cut) in the record's message and never parsed. The record is built
+    here (:func:`accept`): identity from ``spec``, ``commit`` and ``machine`` (the parent's
+    :func:`~pcabench.profiles.machine_id`), the child's measurements checked, the errors computed from its
+    fields. The child's process group is ended when it does, and at once past ``timeout``. With ``fields_to``
+    the run's fields are kept there (an .npz, written as :mod:`pcabench.safeio` writes).
 
-    Raises subprocess.TimeoutExpired (the child is killed first) past ``timeout`` seconds.
+    Raises subprocess.TimeoutExpired (the child's group is killed first) past ``timeout`` seconds.
     """
+    import tempfile
+
     env = {**os.environ, "PCABENCH_COMMIT": commit, MACHINE_ID_ENV: machine}  # every run carries the sweep's
     oom_before = oom_kills()
-    proc, stdout, stderr, read_end = start_child(spec, env)
-    out, err, record = [], [], []
+    with tempfile.TemporaryDirectory(prefix="pcabench-run-") as scratch:
+        fields_path = Path(scratch) / "fields.npz"
+        proc, stdout, stderr, read_end = start_child(spec, env, fields_path)
+        out, err, record = [], [], []
 
-    def relay(text):  # the child's progress lines go on to the user
-        if stream is not None:
-            stream.write(text)
-            stream.flush()
+        def relay(text):  # the child's progress lines go on to the user
+            if stream is not None:
+                stream.write(text)
+                stream.flush()
 
-    def read_record():
-        with os.fdopen(read_end, "rb") as f:
-            data = f.read(RECORD_LIMIT + 1)
-            while f.read(1 << 16):  # a record past the limit: drain the rest, keep none of it
-                pass
-        record.append(data if len(data) <= RECORD_LIMIT else b"")
+        def read_record():
+            with os.fdopen(read_end, "rb") as f:
+                data = f.read(RECORD_LIMIT + 1)
+                while f.read(1 << 16):  # a record past the limit: drain the rest, keep none of it
+                    pass
+            record.append(data if len(data) <= RECORD_LIMIT else b"")
 
-    readers = [
-        threading.Thread(target=_drain, args=(stdout, out), daemon=True),
-        threading.Thread(target=_drain, args=(stderr, err, relay), daemon=True),
-        threading.Thread(target=read_record, daemon=True),
-    ]
-    for reader in readers:
-        reader.start()
-    try:
-        proc.wait(timeout=timeout)
-    except BaseException:
-        proc.kill()
-        proc.wait()
-        raise
-    finally:
+        readers = [
+            threading.Thread(target=_drain, args=(stdout, out), daemon=True),
+            threading.Thread(target=_drain, args=(stderr, err, relay), daemon=True),
+            threading.Thread(target=read_record, daemon=True),
+        ]
         for reader in readers:
-            reader.join(timeout=5)
-        for f in (stdout, stderr):
-            f.close()
-        if stream is not None and err and not err[-1].endswith("\n"):
-            stream.write("\n")  # end the child's last progress line
-    said = PROGRESS.sub("", "".join(err)).strip()  # stderr less the child's own progress lines
-    printed = "".join(
-        f"\nthe solver's {name} (cut): {_cut([text])}"
-        for name, text in (("stdout", "".join(out).strip()), ("stderr", said))
-        if text
-    )
-    data = record[0] if record else b""
-    if proc.returncode == 0 and data:
+            reader.start()
         try:
-            row = json.loads(data.decode("utf-8"))
-        except (ValueError, RecursionError) as exc:
-            row = None
-            what = f"its record could not be read ({type(exc).__name__})"
+            proc.wait(timeout=timeout)
+        except BaseException:
+            end_group(proc)
+            proc.wait()
+            raise
+        finally:
+            end_group(proc)  # what the run left running (a plug-in's own processes) ends with it
+            for reader in readers:
+                reader.join(timeout=5)
+            for f in (stdout, stderr):
+                f.close()
+            if stream is not None and err and not err[-1].endswith("\n"):
+                stream.write("\n")  # end the child's last progress line
+        said = PROGRESS.sub("", "".join(err)).strip()  # stderr less the child's own progress lines
+        printed = "".join(
+            f"\nthe solver's {name} (cut): {_cut([text])}"
+            for name, text in (("stdout", "".join(out).strip()), ("stderr", said))
+            if text
+        )
+        data = record[0] if record else b""
+        if proc.returncode == 0 and data:
+            try:
+                row = json.loads(data.decode("utf-8"))
+            except (ValueError, RecursionError) as exc:
+                row = None
+                what = f"its record could not be read ({type(exc).__name__})"
+            else:
+                what = ""
+            if isinstance(row, dict):
+                accepted = accept(spec, row, fields_path, commit, machine)
+                if printed:
+                    accepted.message = schema.clean_text((accepted.message + printed).strip())
+                if fields_to is not None:
+                    from .safeio import write_file
+
+                    try:
+                        write_file(fields_to, store.read_regular(fields_path))
+                    except FileNotFoundError:
+                        pass
+                return store.to_row(accepted)
+            what = what or "its record is not a JSON object"
         else:
-            what = ""
-        if isinstance(row, dict):
-            if printed:
-                row["message"] = (str(row.get("message") or "") + printed).strip()
-            return store.to_row(row)
-        what = what or "its record is not a JSON object"
-    else:
-        status, what = exit_status(proc.returncode, oom_before, oom_kills())
-        if proc.returncode == 0:
-            what = "it sent no record"
-    status = "error" if proc.returncode == 0 else status
-    return store.to_row(failed_record(spec, status, what + printed, machine))
+            status, what = exit_status(proc.returncode, oom_before, oom_kills())
+            if proc.returncode == 0:
+                what = "it sent no record"
+        status = "error" if proc.returncode == 0 else status
+        return store.to_row(failed_record(spec, status, what + printed, machine))
 
 
 def run_here(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr) -> dict:
@@ -302,13 +409,13 @@ class LocalExecutor(Executor):
 
 
 class StoreFile:
-    """The one store a local sweep writes."""
+    """The one store a local sweep writes, held by its lock (:meth:`pcabench.store.SweepLock.hold`)."""
 
-    def __init__(self, path: Path):
-        self.path = path
+    def __init__(self, path: Path, lock: store.SweepLock):
+        self.path, self.lock = path, lock
 
     def append(self, row: dict) -> dict:
-        return store.append(row, self.path)
+        return store.append(row, self.path, held=self.lock.held(self.path))
 
 
 def run_specs(
@@ -410,10 +517,12 @@ def sweep(
     """Run ``specs`` on this machine (skipping those already stored), one child process each (``runner``),
     into the store at ``store_path``; the rows stored (:func:`run_specs`)."""
     store.check_writable(store_path)
-    with store.SweepLock(store_path):
+    with store.SweepLock(store_path) as lock:
         store_path = Path(store_path)
         rows = store.read_rows(store_path) if store_path.exists() else []
         if runner is None:  # the children are forked from a server with the plan's compiled loops loaded
             forkserver.prepare([s.resolved() for s in specs])
         executor = LocalExecutor(machine_id(), host_id(), git_commit(), runner, stream)
-        return run_specs(specs, executor, StoreFile(store_path), rows, run_budget, sweep_budget, stream, retry_failed)
+        return run_specs(
+            specs, executor, StoreFile(store_path, lock), rows, run_budget, sweep_budget, stream, retry_failed
+        )

@@ -6,10 +6,24 @@ from __future__ import annotations
 import importlib
 import inspect
 import pkgutil
+import re
 import warnings
 from importlib import metadata
 from pathlib import Path
 from typing import Callable
+
+# The one name rule of every registry (solvers, kernels, scenes): a name is stored in records, becomes part of
+# file names and command lines, and is printed in Markdown tables, so it holds nothing a shell, a path or a
+# table would read as syntax.
+NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,31}", re.ASCII)
+NAME_RULE = "letters, digits, '.', '_', '-', starting with a letter or digit, at most 32"
+
+
+def name_problem(name, what: str) -> str | None:
+    """Why ``name`` cannot name a ``what`` (a solver, a kernel, a scene) under :data:`NAME` (None: it can)."""
+    if not isinstance(name, str) or not NAME.fullmatch(name):
+        return f"the {what} name {name!r:.80} is not a plain name ({NAME_RULE}): it names stored records"
+    return None
 
 
 def builtin_classes(package: str, folder: Path, base: type) -> list[type]:
@@ -38,7 +52,9 @@ def entry_point_classes(
         where = f"entry point {entry.name!r} of group {group} ({entry.value})"
         try:
             cls = entry.load()
-        except Exception as exc:  # noqa: BLE001 - a broken plug-in must not take pcabench down
+        except BaseException as exc:  # noqa: BLE001 - a broken plug-in (even one calling sys.exit) is left out
+            if isinstance(exc, KeyboardInterrupt):
+                raise
             warnings.warn(f"{where} left out: it does not load ({type(exc).__name__}: {exc})", warning, stacklevel=3)
             continue
         why = problem(cls, taken)

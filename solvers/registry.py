@@ -23,17 +23,17 @@ import ast
 import importlib
 import inspect
 import pkgutil
-import re
 import warnings
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
 
 from .interface import Solver
+from .plugins import NAME, name_problem
 from .scene import SceneError
 
 ENTRY_POINT_GROUP = "pcabench.solvers"
-SOLVER_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,63}", re.ASCII)  # the record's solver field (pcabench/schema.py)
+SOLVER_NAME = NAME  # the record's solver field (pcabench/schema.py): the one name rule
 DEFAULT_SOLVER = "linkedlist-cpu"  # what a study runs when no solver is named: the paper's cell list, on the CPU
 
 
@@ -93,7 +93,9 @@ def _plugins(taken: set) -> list[type[Solver]]:
 
         try:
             cls = entry.load()
-        except Exception as exc:  # noqa: BLE001 - a broken plug-in must not take pcabench down
+        except BaseException as exc:  # noqa: BLE001 - a broken plug-in (even one calling sys.exit) is left out
+            if isinstance(exc, KeyboardInterrupt):
+                raise
             warn(f" left out: it does not load ({type(exc).__name__}: {exc})")
             continue
         if not (inspect.isclass(cls) and issubclass(cls, Solver)) or inspect.isabstract(cls):
@@ -103,11 +105,8 @@ def _plugins(taken: set) -> list[type[Solver]]:
                 " left out: the class sets no name of its own"
                 + (f" (it would inherit {cls.name!r})" if cls.name else "")
             )
-        elif not isinstance(cls.name, str) or not SOLVER_NAME.fullmatch(cls.name):
-            warn(
-                f" left out: the solver name {cls.name!r:.80} is not a plain name (letters, digits, '.', '_', "
-                "'-', at most 64): it names stored records"
-            )
+        elif name_problem(cls.name, "solver"):
+            warn(f" left out: {name_problem(cls.name, 'solver')}")
         elif cls.name in taken:
             warn(f" left out: the solver name {cls.name!r} is taken")
         else:

@@ -39,6 +39,7 @@ INT_ARRAYS_PER_PARTICLE = 4  # cell id, permutation, sort scratch (int32/int64)
 STRIP_CUTOFFS = 3.0
 
 MAX_STEPS = 10_000_000  # the most steps a run may take (1e7)
+MIN_CFL = 1e-3  # the smallest cfl: 1e7 steps of it cross 1e4 cells, a step smaller than any study needs
 
 # Scene parameters that choose the numerical method rather than the physics.
 NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor", "kernel")
@@ -184,8 +185,11 @@ class Scene:
             f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
             f"(got {reach:g} * {self.h_factor:g} = {reach * self.h_factor:g})",
         )
-        need(self.cfl > 0, f"cfl (dt*c0/dx) must be > 0 (got {self.cfl}); dt must be positive")
-        need(self.cfl <= 50, f"cfl (dt*c0/dx) must be <= 50 (got {self.cfl})")
+        need(
+            MIN_CFL <= self.cfl <= 50,
+            f"cfl (dt*c0/dx) must be in [{MIN_CFL:g}, 50] (got {self.cfl:g}): below it a run of "
+            f"{MAX_STEPS:,} steps would not cross one cell",
+        )
         need(self.blowup_factor > 1, f"blowup_factor must be > 1 (got {self.blowup_factor})")
         need(self.model in MODELS, f"model must be one of {', '.join(MODELS)} (got {self.model!r})")
         need(

@@ -101,7 +101,7 @@ def test_unstable_run_reports_status_and_step_with_exit_1():
         (["--dx", "nan"], ["--dx", "finite"]),
         (["--dx", "0.00001"], ["dx", "smallest dx that fits"]),
         (["--dx", "1", "--cutoff", "0.5"], ["--cutoff", ">= 1"]),
-        (["--dx", "1", "--cfl", "0"], ["--cfl", "> 0"]),
+        (["--dx", "1", "--cfl", "0"], ["--cfl", "[0.001, 50]"]),
         (["--dx", "1", "--steps", "0"], ["--steps", ">= 1"]),
         (["--dx", "1", "--t-end", "-5"], ["--t-end", "> 0"]),
         (["--dx", "0.1", "--strip-height", "0.5"], ["--strip-height", "3 cutoffs"]),

@@ -433,25 +433,12 @@ def test_gpu_check_writes_files_in_its_folder_without_following_links(tmp_path):
 
 # ---------------------------------------------------------------- commands to paste
 def test_advise_quotes_every_command_for_the_shell():
-    from pcabench.advise import command
+    from pcabench.commands import line_of, words_of
 
-    r = {
-        "solver": "x; touch /tmp/pwned",
-        "model": "linear",
-        "precision": "float64",
-        "threads": 1,
-        "dx": 0.5,
-        "kernel": "gaussian $(id)",
-        "h_factor": 2.13,
-        "cutoff_factor": 3.0,
-        "cfl": 0.2,
-        "integrator": "verlet",
-        "strip_height": None,
-    }
-    line = command(r, 10.0)
+    line = line_of(*words_of("x; touch /tmp/pwned", Scene(dx=0.5, t_end=10.0), 1, "gather $(id)"))
     words = shlex.split(line)
     assert words[:4] == ["pcabench", "run", "--solver", "x; touch /tmp/pwned"]
-    assert "gaussian $(id)" in words
+    assert words[-2:] == ["--pair-loop", "gather $(id)"]
 
 
 # ---------------------------------------------------------------- a full disk

@@ -39,7 +39,7 @@ def report_for(ctx: Context) -> Path:
     """The report of one machine's runs (``ctx.name``: its profile id, with its host where a profile has
     several): each section's rows computed once, then its Markdown and its figures from them."""
     out, df = ctx.out, ctx.df_scenes if ctx.df_scenes is not None else ctx.df
-    own_folder(out, "report folder")  # a link there is refused: nothing is written or deleted where it points
+    own_folder(out, "report folder", within=out.parent)  # a link is refused: nothing written or deleted there
     body, figs = [], []
     for section in sections.SECTIONS:  # read at each report: a section appended to the registry is in it
         if ctx.df.empty and not section.all_scenes:
@@ -138,8 +138,7 @@ def write_reports(results_dir: Path, reports_dir: Path, scene: str | None = None
     if df_all.empty:
         raise NoResults(f"no results in {results_dir}" + (f" of the {scene} scene" if scene else "")
                         + ": run `pcabench study --quick` first")
-    reports_dir = Path(reports_dir)
-    reports_dir.mkdir(parents=True, exist_ok=True)
+    reports_dir = own_folder(reports_dir, "report folder")  # never a link: nothing written or deleted where it points
     shared = {}  # rows computed once for every report (Table 6)
     # a machine's name becomes a folder: checked (store.validate made it so) so that nothing lands outside
     paper = df_all[df_all.scene == DEFAULT_SCENE]  # the paper's tables and figures: its scene only

@@ -18,16 +18,15 @@ from __future__ import annotations
 
 import inspect
 import math
-import re
 from functools import lru_cache
 from pathlib import Path
 
-from ..plugins import builtin_classes, entry_point_classes
+from ..plugins import NAME, builtin_classes, entry_point_classes, name_problem
 from .base import Kernel
 
 ENTRY_POINT_GROUP = "pcabench.kernels"
 DEFAULT_KERNEL = "gaussian"  # the paper's: what every run uses unless --kernel says otherwise
-KERNEL_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,31}", re.ASCII)  # the record's kernel field (pcabench/schema.py)
+KERNEL_NAME = NAME  # the record's kernel field (pcabench/schema.py): the one name rule
 
 _added: dict[str, Kernel] = {}  # kernels given to register() in this process
 _classes: dict[str, type] = {}  # every class a name was registered with in this process (names are cache keys)
@@ -48,11 +47,8 @@ def _problem(cls, taken) -> str | None:
     name = cls.__dict__.get("name")
     if not name:
         return "the class sets no name of its own"
-    if not isinstance(name, str) or not KERNEL_NAME.fullmatch(name):
-        return (
-            f"the kernel name {name!r:.80} is not a plain name (letters, digits, '.', '_', '-', at most 32): "
-            "it names stored records"
-        )
+    if name_problem(name, "kernel"):
+        return name_problem(name, "kernel")
     if name in taken:
         return f"the kernel name {name!r} is taken"
     if cls.support is not None and not (isinstance(cls.support, (int, float)) and 0 < cls.support <= 5):

@@ -83,6 +83,11 @@ class SceneKind:
         lo, hi = PULSE_WIDTH_RANGE
         if not lo <= scene.pulse_width <= hi:
             out.append(f"--pulse-width must be in [{lo:g}, {hi:g}] m (got {scene.pulse_width:g})")
+        if not scene.x_min <= scene.pulse_center <= scene.x_max:
+            out.append(
+                f"--pulse-center must be inside the domain, in [{scene.x_min:g}, {scene.x_max:g}] m "
+                f"(got {scene.pulse_center:g})"
+            )
         if scene.strip_height is not None and not self.strip:
             out.append(f"--strip-height: the {self.name} scene depends on y, a strip would change it")
         return out

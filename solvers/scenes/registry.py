@@ -13,7 +13,7 @@ import inspect
 from functools import lru_cache
 from pathlib import Path
 
-from ..plugins import builtin_classes, entry_point_classes
+from ..plugins import builtin_classes, entry_point_classes, name_problem
 from .base import SceneKind
 
 ENTRY_POINT_GROUP = "pcabench.scenes"
@@ -32,6 +32,8 @@ def _problem(cls, taken) -> str | None:
     """Why ``cls`` cannot be a scene under its name (None: it can)."""
     if not (inspect.isclass(cls) and issubclass(cls, SceneKind)) or not cls.__dict__.get("name"):
         return "not a SceneKind subclass with a name of its own"
+    if name_problem(cls.name, "scene"):
+        return name_problem(cls.name, "scene")
     if cls.name in taken:
         return f"the scene name {cls.name!r} is taken"
     return None
