@@ -17,6 +17,7 @@ import argparse
 import math
 import os
 import re
+import signal
 import sys
 import tempfile
 import warnings
@@ -50,6 +51,7 @@ largest stable step the dispersion relation predicts (accuracy)."""
 
 # exit codes: each one means one thing
 EXIT_OK, EXIT_RUN_FAILED, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 3, 4, 130
+EXIT_PIPE, EXIT_TERMINATED = 141, 143  # 128 + SIGPIPE (the reader of stdout left: `| head`), 128 + SIGTERM
 EXIT_HELP = f"""exit codes:
   {EXIT_OK}    ok
   {EXIT_RUN_FAILED}    the run failed: unstable (with its step), out-of-memory or error, recorded, never a
@@ -57,7 +59,8 @@ EXIT_HELP = f"""exit codes:
   {EXIT_BAD_INPUT}    bad input: one line naming the parameter and its allowed range, before any work
   {EXIT_UNAVAILABLE}    the solver cannot run here (no GPU)
   {EXIT_NO_RESULTS}    no results: no stored runs to report or advise from (run `pcabench study` first)
-  {EXIT_INTERRUPTED}  interrupted"""
+  {EXIT_INTERRUPTED}  interrupted (Ctrl-C); {EXIT_TERMINATED}: terminated (SIGTERM); {EXIT_PIPE}: the reader of the
+       output left (`| head`), silently. A sweep stopped either way keeps every finished run and resumes"""
 
 
 def solver_help() -> str:
@@ -878,10 +881,25 @@ def option_words(message: str) -> str:
     return re.sub(rf"^({'|'.join(LEADING_OPTIONS)})\b", r"--\1", message)
 
 
+class Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that a sweep ends as an interrupt does (its lock and reserve
+    released, every finished run kept)."""
+
+
+def _terminated(signum, frame):
+    raise Terminated()
+
+
 def main(argv=None) -> int:
     shown = warnings.formatwarning
     warnings.formatwarning = lambda message, *_, **__: f"pcabench: warning: {message}\n"  # one line each
     prog = "pcabench"
+    parser = Parser(prog=prog)  # until the whole one is built (a Ctrl-C while the plug-ins load)
+    import threading
+
+    on_term = None
+    if threading.current_thread() is threading.main_thread():
+        on_term = signal.signal(signal.SIGTERM, _terminated)
     try:
         parser = build_parser()  # finds the solvers: a plug-in left out is one warning line
         args = parser.parse_args(argv)
@@ -889,6 +907,10 @@ def main(argv=None) -> int:
         return args.func(args)
     except (SceneError, OptionError, StoreError) as exc:
         parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {option_words(str(exc))} (see {prog} --help)\n")
+    except BrokenPipeError:  # `pcabench ... | head`: the reader has what it wanted
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # so that the flush at exit does not complain either
+        return EXIT_PIPE
     except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
         where = f"{exc.filename}: " if exc.filename else ""
         parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {where}{exc.strerror or exc}\n")
@@ -898,8 +920,12 @@ def main(argv=None) -> int:
         parser.exit(EXIT_NO_RESULTS, f"{prog}: {exc}\n")
     except KeyboardInterrupt:
         parser.exit(EXIT_INTERRUPTED, f"{prog}: interrupted\n")
+    except Terminated:
+        parser.exit(EXIT_TERMINATED, f"{prog}: terminated\n")
     finally:
         warnings.formatwarning = shown
+        if on_term is not None:
+            signal.signal(signal.SIGTERM, on_term)
 
 
 if __name__ == "__main__":

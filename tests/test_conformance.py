@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -185,6 +186,8 @@ def test_a_broken_momentum_sweep_fails_the_agreement_check():
     results = check_solver(ScaledMomentum, quick=True, only=("agreement",))
     assert [r.status for r in results] == ["failed"]
     assert "velocity differs" in results[0].message
+    failed, of = map(int, re.match(r"(\d+) of (\d+) configurations", results[0].message).groups())
+    assert 0 < failed <= of  # configurations, not the fields that differ in them (issue 39: "45 of 17")
     with pytest.raises(AssertionError, match="agreement: FAILED"):
         assert_conforms(ScaledMomentum, only=("agreement",))
 
@@ -219,3 +222,20 @@ def test_the_command_line(capsys):
     assert lines[-1].startswith("allpair-cpu: conforms")
     rc, out, err = cli_main("check-solver", "no-such-solver", capsys=capsys)
     assert rc == 2 and len(err.strip().splitlines()) == 1 and "no-such-solver" in err and "Traceback" not in err
+
+
+class WrongPastFourHundred(LinkedListCPU):
+    """A linked-list solver whose velocity goes wrong only on a lattice of more than 400 particles."""
+
+    name = "wrong-past-400"
+
+    def output(self):
+        fields = super().output()
+        if self.scene.n_particles > 400:
+            fields.u[len(fields.u) // 2] += 1e-3
+        return fields
+
+
+def test_the_quick_check_fails_a_solver_wrong_only_past_the_tiny_lattices():
+    (result,) = check_solver(WrongPastFourHundred, quick=True, only=("agreement",))
+    assert result.failed and "plane-pulse-3200" in result.message, result.message

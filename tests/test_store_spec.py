@@ -7,6 +7,7 @@ import errno
 import json
 import os
 import re
+import signal
 import subprocess
 import sys
 import textwrap
@@ -519,3 +520,99 @@ def test_a_stored_message_cannot_add_cells_tags_or_images_to_a_report(tmp_path, 
 def test_every_command_checks_the_scenes_ranges_and_memory_before_any_work(command, option, capsys):
     code, out, err = cli_main(*command, capsys=capsys)
     assert code == 2 and option in err and len(err.strip().splitlines()) == 1 and out == "", (out, err)
+
+
+# ---------------------------------------------------------------- also found: signals, pipes, plug-ins
+def _study_until_running(tmp_path):
+    """A study (in a session of its own, as a terminal's foreground job would be) one run of which has started:
+    (its process, the store it writes)."""
+    from .conftest import run_children
+
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "pcabench.cli",
+            "study",
+            "--dx",
+            "1",
+            "0.25",
+            "--steps",
+            "3",
+            "100000",
+            "--model",
+            "linear",
+            "--no-report",
+            "--results",
+            str(tmp_path),
+        ],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        stored = list(tmp_path.glob("*.jsonl"))
+        if stored and stored[0].read_text().count("\n") >= 1 and run_children(proc.pid):
+            return proc, stored[0]
+        time.sleep(0.1)
+    proc.kill()
+    raise AssertionError("the study never stored its first run")
+
+
+@pytest.mark.parametrize("how, code, word", [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated")])
+def test_a_study_stopped_by_ctrl_c_or_sigterm_says_one_line_and_keeps_its_runs(how, code, word, tmp_path):
+    proc, path = _study_until_running(tmp_path)
+    os.killpg(proc.pid, getattr(signal, how))  # the whole foreground group, as a terminal's Ctrl-C does
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == code and f"pcabench study: {word}" in err, err[-3000:]
+    assert "Traceback" not in err, err[-3000:]
+    assert not list(tmp_path.glob("*.reserve")) and len(store.read_rows(path)) >= 1
+
+
+def test_output_cut_by_its_reader_is_not_bad_input(tmp_path):
+    rows = [dict(store.to_row(advisable()), run_id=f"r{i}") for i in range(1500)]  # more than a pipe holds
+    (tmp_path / "m--h.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pcabench.cli", "runs", "--results", str(tmp_path), "--limit", "100000"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.readline()
+    proc.stdout.close()  # `| head -1`
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 141 and err == "", err
+
+
+def test_a_plugin_that_exits_at_import_is_left_out_not_obeyed(tmp_path):
+    site = tmp_path / "site"
+    (site / "quitter-0.1.dist-info").mkdir(parents=True)
+    (site / "quitter.py").write_text("import sys\nsys.exit(0)\n")
+    (site / "quitter-0.1.dist-info" / "METADATA").write_text("Metadata-Version: 2.1\nName: quitter\nVersion: 0.1\n")
+    (site / "quitter-0.1.dist-info" / "entry_points.txt").write_text(
+        "[pcabench.solvers]\nquitter = quitter:Solver\n[pcabench.scenes]\nquitter = quitter:Scene\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])}
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "pcabench.cli",
+            "run",
+            "--solver",
+            "linkedlist-cpu",
+            "--dx",
+            "1",
+            "--steps",
+            "2",
+            "--json",
+            "--quiet",
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert out.returncode == 0 and json.loads(out.stdout)["status"] == "ok", (out.stdout, out.stderr)
+    assert "quitter" in out.stderr and "left out" in out.stderr
