@@ -305,7 +305,11 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
         lines.append(
             f"  this is the paper's configuration: none of the {out['runs_considered']} stored runs reaching t = "
             f"{t_end:g} s is faster"
-            + ("" if scene == DEFAULT_SCENE else f" (`pcabench study --front --scene {scene}` runs other methods)")
+            + (
+                ""
+                if scene == DEFAULT_SCENE
+                else f" (`{shlex.join(['pcabench', 'study', '--front', '--scene', scene])}` runs other methods)"
+            )
         )
     elif out["paper_seconds"]:
         lines.append(

@@ -17,6 +17,7 @@ import argparse
 import math
 import os
 import re
+import shlex
 import signal
 import sys
 import tempfile
@@ -522,11 +523,11 @@ def cmd_advise(args) -> int:
         mach = Scene.default("mach") if args.mach is None else args.mach
         df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach)]
     if df is None or df.empty:
+        study = ["pcabench", "study", "--front", *([] if args.scene == DEFAULT_SCENE else ["--scene", args.scene])]
         raise NoResults(
             f"no stored runs of the {args.scene} scene at --mach "
             f"{Scene.default('mach') if args.mach is None else args.mach:g} in {results}: run "
-            f"`pcabench study --front{'' if args.scene == DEFAULT_SCENE else ' --scene ' + args.scene}` "
-            "first, or use --reference"
+            f"`{shlex.join(study)}` first, or use --reference"
         )
     machines = df.machine.value_counts()
     if args.machine:
@@ -616,6 +617,17 @@ def cmd_cache(args) -> int:
 
 
 # ---------------------------------------------------------------- the parser
+class PresetHelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """``{size:PRESET}`` in an option's help is the preset's run count, counted from its plan when the help is
+    shown (pcabench/presets.py: :func:`~pcabench.presets.size_text`), so the help cannot drift from the runs."""
+
+    def _expand_help(self, action):
+        from .presets import size_text
+
+        text = super()._expand_help(action)
+        return re.sub(r"\{size:([\w-]+)\}", lambda m: size_text(m.group(1)), text)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(
         prog="pcabench", description=DESCRIPTION, epilog=EXIT_HELP, formatter_class=argparse.RawDescriptionHelpFormatter
@@ -653,18 +665,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="run a sweep (each run in its own process) and write the report",
         description="Run a preset, or the product of the matrix options, one process per run.",
         epilog=solver_help() + "\n" + MODEL_HELP,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=PresetHelpFormatter,
     )
     g = p.add_mutually_exclusive_group()
-    g.add_argument("--quick", action="store_true", help="a few minutes on a laptop CPU (default)")
-    g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets")
+    g.add_argument(
+        "--quick", action="store_true", help="every table and figure at small N ({size:quick}; 2 minutes here; default)"
+    )
+    g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets ({size:paper})")
     g.add_argument(
         "--stability",
         nargs="?",
         const="short",
         choices=("short", "long"),
-        help="short: CFL x integrator x h/dx, run length and float32, the stability map (92 runs); "
-        "long: each model at CFL 4.4-5 to t = 300 s, the moving models' own limit (24 runs)",
+        help="short: CFL x integrator x h/dx, run length and float32, the stability map ({size:stability}); "
+        "long: each model at CFL 4.4-5 to t = 300 s, the moving models' own limit ({size:stability-long})",
     )
     g.add_argument(
         "--front",
@@ -673,13 +687,13 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("quick", "full"),
         help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
         "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the "
-        "predicted fastest, serial (quick: 296 runs; full: 2408)",
+        "predicted fastest, serial (quick: {size:front}; full: {size:front-full}; on the paper's scene)",
     )
     g.add_argument(
         "--walls",
         action="store_true",
         help="sound at a rigid wall (plane-wall, pulse-wall): accuracy at t = 10 s against the prediction, the "
-        "stable CFL per kernel over long runs, and the time per step with and without the wall (64 runs)",
+        "stable CFL per kernel over long runs, and the time per step with and without the wall ({size:walls})",
     )
     p.add_argument("--list", action="store_true", help="print the runs the study would make, one a line, and exit")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")

@@ -4,8 +4,9 @@ The time of one step is fitted as ``a * N**b`` over this host's finished runs
 of the same solver, precision, model and threads (any protocol), per
 neighbour for the cell lists: their step time is taken proportional to the
 neighbours per particle, (cutoff / dx)^2, so runs of another kernel or h/dx
-inform the fit. With two or more sizes ``b`` is fitted; with one, ``b`` is
-the solver's ``order`` (2 for all-pair, 1 for a cell list). A run's time is
+inform the fit. With two or more sizes ``b`` is fitted (bounded to half and
+one and a half times the solver's ``order``); with one, ``b`` is the order
+(2 for all-pair, 1 for a cell list). A run's time is
 its steps times the step, plus the child process's start-up, plus its JIT:
 a cold compile for the first run of a compiled configuration (solver,
 precision, kernel, threaded or not) this host has not run before, a load
@@ -91,7 +92,10 @@ def step_model(spec, rows: list[dict]):
     t = np.array([pts[k] for k in sorted(pts)])
     if len(n) >= 2:
         b = float(np.polyfit(np.log(n[-3:]), np.log(t[-3:]), 1)[0])  # the three largest sizes
-        b = max(b, solver_class(spec.solver).order * 0.5)  # never extrapolate flatter than half the order
+        order = solver_class(spec.solver).order
+        # never flatter than half the order nor steeper than one and a half times it: two small sizes (caches, a
+        # busy neighbour) can fit any slope, and a steep one extrapolated 100x in N overestimates 100-fold
+        b = min(max(b, order * 0.5), order * 1.5)
     else:
         b = solver_class(spec.solver).order
     a = float(t[-1] / n[-1] ** b)

@@ -300,12 +300,12 @@ def front_axes(size: str = "quick", scene: str = DEFAULT_SCENE) -> dict:
     return {"kernel": kernel_names(), **(FRONT if scene_kind(scene).strip else FRONT_2D)[size]}
 
 
-def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
+def front(size: str = "quick", scene: str = DEFAULT_SCENE, fast: bool = True) -> list[RunSpec]:
     """Time to solution against error at t = 10 s: the product of FRONT[size] on the strip, smallest N first;
-    then the paper's scene with its method and the predicted fastest ones, serial, in the same sweep. Another
-    scene a strip serves (plane-wall): the same product on its strip (the paper's method is in it). Any other:
-    its own product (FRONT_2D) on its own domain and the paper's method beside it. Then, on a scene with an
-    isothermal reference, which model it needs at several amplitudes."""
+    then the paper's scene with its method and (``fast``) the predicted fastest ones, serial, in the same sweep.
+    Another scene a strip serves (plane-wall): the same product on its strip (the paper's method is in it). Any
+    other: its own product (FRONT_2D) on its own domain and the paper's method beside it. Then, on a scene with
+    an isothermal reference, which model it needs at several amplitudes."""
     kind = scene_kind(scene)
     axes = front_axes(size, scene)
     names = [k for k in axes if k != "dx"]
@@ -316,7 +316,8 @@ def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     ]
     if scene == DEFAULT_SCENE:
         for model in ("linear", "lagrangian"):
-            runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in fast_methods(model)]
+            if fast:
+                runs += [_spec(t_end=FRONT_T_END, model=model, **method) for method in fast_methods(model)]
             runs.append(_spec(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model=model))
     elif not kind.strip:
         runs += [
@@ -325,6 +326,18 @@ def front(size: str = "quick", scene: str = DEFAULT_SCENE) -> list[RunSpec]:
             for dx in PAPER_METHOD_2D_DX
         ]
     return runs + (model_needs(scene) if kind.has_isothermal else [])
+
+
+def size_text(name: str, scene: str = DEFAULT_SCENE) -> str:
+    """How many runs preset ``name`` makes on ``scene``, as its help says it: counted from the plan itself (the
+    fronts' predicted fastest methods, one per kernel and model at most, without predicting them)."""
+    if name.startswith("front"):
+        size = "full" if name == "front-full" else "quick"
+        fixed = len(front(size, scene, fast=False))
+        if scene != DEFAULT_SCENE:
+            return f"{fixed} runs"
+        return f"{fixed} runs and up to {2 * len(kernel_names())} predicted fastest"
+    return f"{len(PRESETS[name]())} runs"
 
 
 def front_full(scene: str = DEFAULT_SCENE) -> list[RunSpec]:

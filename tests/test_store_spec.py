@@ -616,3 +616,33 @@ def test_a_plugin_that_exits_at_import_is_left_out_not_obeyed(tmp_path):
     )
     assert out.returncode == 0 and json.loads(out.stdout)["status"] == "ok", (out.stdout, out.stderr)
     assert "quitter" in out.stderr and "left out" in out.stderr
+
+
+def test_the_study_help_counts_each_presets_runs_from_its_plan():
+    from pcabench import cli, presets
+
+    text = " ".join(cli.build_parser()._subparsers._group_actions[0].choices["study"].format_help().split())
+    for name in ("quick", "paper", "stability", "stability-long", "walls"):
+        assert f"({len(presets.preset(name))} runs" in text, name
+    fixed = len(presets.front("quick", fast=False))
+    made = len(presets.preset("front"))
+    extra = int(re.search(rf"quick: {fixed} runs and up to (\d+) predicted fastest", text).group(1))
+    assert fixed < made <= fixed + extra
+
+
+def test_the_time_predictor_does_not_extrapolate_a_steep_fit_from_two_small_sizes():
+    from pcabench.predict import predicted_seconds, step_model
+
+    def row(dx, step):
+        spec = RunSpec("linkedlist-cpu", Scene(dx=dx, steps=10)).resolved()
+        rec = RunRecord.from_spec(spec, "m", status="ok")
+        rec.steps = 10
+        rec.stages.update(snp=0.0, pi=10 * step, su=0.0)
+        return store.to_row(rec)
+
+    rows = [row(1.0, 1e-3), row(0.5, 40e-3)]  # 1,000 and 4,000 particles: a slope of 2.7 (a noisy neighbour)
+    big = RunSpec("linkedlist-cpu", Scene(dx=0.05, steps=100)).resolved()  # 400K particles
+    a, b, _ = step_model(big, rows)
+    assert b <= 1.5
+    seconds, why = predicted_seconds(big, rows)
+    assert seconds < 100 * 40e-3 * (400_000 / 4_000) ** 1.5 + 60, why

@@ -60,7 +60,7 @@ def test_killed_sweep_resumes_to_the_same_store(tmp_path):
     "args,words",
     [
         (["--dx", "0"], ["dx", "> 0"]),
-        (["--dx", "1", "--cfl", "-1"], ["cfl", "> 0"]),
+        (["--dx", "1", "--cfl", "-1"], ["cfl", "[0.001, 50]"]),
         (["--quick", "--run-budget", "0"], ["--run-budget", "> 0"]),
         (["--dx", "1", "--threads", "9999"], ["threads", "between 1 and"]),
         (["--dx", "1", "--solver", "allpair-cpu", "--threads", "2"], ["allpair-cpu is serial"]),
