@@ -153,8 +153,9 @@ MEASURED = (
 CHILD_STATUSES = ("ok", "unstable", "out-of-memory", "error")  # what a run can end in; the sweep says the rest
 
 
-def _measurement_problem(spec: RunSpec, row: dict) -> str:
-    """Why the measurements in a child's ``row`` do not fit its ``spec`` ('' if they do)."""
+def _measurement_problem(spec: RunSpec, row: dict, wall: float | None = None) -> str:
+    """Why the measurements in a child's ``row`` do not fit its ``spec`` ('' if they do), nor the child's
+    ``wall`` time (s) as the sweep measured it: its stages and JIT cannot add up to more."""
     from solvers import STAGES
 
     scene = spec.scene
@@ -171,6 +172,9 @@ def _measurement_problem(spec: RunSpec, row: dict) -> str:
             return f"its stage {name} took {seconds!r:.40}, not a finite time >= 0 s"
     if row.get("status") not in CHILD_STATUSES:
         return f"its status {row.get('status')!r:.40} is not one a run ends in ({', '.join(CHILD_STATUSES)})"
+    jit = row.get("jit_seconds") if isinstance(row.get("jit_seconds"), (int, float)) else 0.0
+    if wall is not None and sum(stages.values()) + jit > wall + 0.01:
+        return f"its stages and JIT add up to {sum(stages.values()) + jit:.3g} s, more than its process's {wall:.3g} s"
     for key in MEASURED:
         why = schema.check_value(key, schema.FIELDS[key], row[key]) if key in row else ""
         if why:
@@ -180,20 +184,21 @@ def _measurement_problem(spec: RunSpec, row: dict) -> str:
     return ""
 
 
-def accept(spec: RunSpec, row: dict, fields_path, commit: str, machine: str) -> RunRecord:
+def accept(spec: RunSpec, row: dict, fields_path, commit: str, machine: str, wall: float | None = None) -> RunRecord:
     """The record of a run whose child sent ``row`` and wrote its fields to ``fields_path``.
 
     The sweep builds the record's identity itself (:meth:`RunRecord.from_spec`: the spec, the solver and its
     device, this machine and host, ``commit``, the package versions) and takes from the child only what it
     measured (:data:`MEASURED`), checked against the spec: its particle count, steps within the spec's,
-    the clock's six stages as finite times, a status a run ends in. The errors are computed here from the
+    the clock's six stages as finite times adding up to no more than the child's ``wall`` time (s, measured
+    here; how short a stage was is the child's word), a status a run ends in. The errors are computed here from the
     fields the child wrote (:func:`pcabench.run.score`), never taken from the child. A record that fails
     these checks is an ``error`` naming why."""
     from .run import load_fields, score
 
     record = RunRecord.from_spec(spec, machine, status="error")
     record.commit = commit
-    why = _measurement_problem(spec, row)
+    why = _measurement_problem(spec, row, wall)
     if why:
         record.message = f"the run's record does not fit its spec: {why}"
         return record
@@ -242,6 +247,7 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
     oom_before = oom_kills()
     with tempfile.TemporaryDirectory(prefix="pcabench-run-") as scratch:
         fields_path = Path(scratch) / "fields.npz"
+        started = time.perf_counter()
         proc, stdout, stderr, read_end = start_child(spec, env, fields_path)
         out, err, record = [], [], []
 
@@ -266,6 +272,7 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
             reader.start()
         try:
             proc.wait(timeout=timeout)
+            wall = time.perf_counter() - started
         except BaseException:
             end_group(proc)
             proc.wait()
@@ -294,7 +301,7 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
             else:
                 what = ""
             if isinstance(row, dict):
-                accepted = accept(spec, row, fields_path, commit, machine)
+                accepted = accept(spec, row, fields_path, commit, machine, wall)
                 if printed:
                     accepted.message = schema.clean_text((accepted.message + printed).strip())
                 if fields_to is not None:

@@ -646,3 +646,30 @@ def test_the_time_predictor_does_not_extrapolate_a_steep_fit_from_two_small_size
     assert b <= 1.5
     seconds, why = predicted_seconds(big, rows)
     assert seconds < 100 * 40e-3 * (400_000 / 4_000) ** 1.5 + 60, why
+
+
+SLOW_CLAIM = LIAR.replace('scene=dict(row["scene"], dx=0.01), dx=0.01)', 'stages={**row["stages"], "pi": 1000.0})')
+
+
+def test_a_child_claiming_more_time_than_its_process_took_is_an_error(tmp_path, monkeypatch):
+    with_site(tmp_path, monkeypatch, SLOW_CLAIM)
+    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2)).resolved()
+    row = run_child(spec, 120, "abc", "m", stream=None)
+    assert row["status"] == "error" and "more than its process's" in row["message"], row["message"]
+
+
+def test_a_ctrl_c_while_the_plugins_load_is_one_line(tmp_path):
+    site = tmp_path / "site"
+    (site / "slow-0.1.dist-info").mkdir(parents=True)
+    (site / "slow.py").write_text("raise KeyboardInterrupt\n")  # the user's Ctrl-C, as the plug-in imports
+    (site / "slow-0.1.dist-info" / "METADATA").write_text("Metadata-Version: 2.1\nName: slow\nVersion: 0.1\n")
+    (site / "slow-0.1.dist-info" / "entry_points.txt").write_text("[pcabench.solvers]\nslow = slow:Solver\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])}
+    out = subprocess.run(
+        [sys.executable, "-m", "pcabench.launch", "run", "--solver", "linkedlist-cpu", "--dx", "1"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert out.returncode == 130 and out.stderr.strip().splitlines() == ["pcabench: interrupted"], out.stderr
