@@ -5,6 +5,7 @@ stored runs, ``reports/<profile>/report.md`` and its PNG figures, with the
 paper's published numbers (hardware_profiles/paper-system-1.json) beside ours,
 and ``reports/README.md`` as the index.
 """
+
 from __future__ import annotations
 
 from .build import summary, write_reports

@@ -10,6 +10,7 @@ they took, and only beside measured series of the same kind. Every label says
 the protocol of its series. Legends sit outside the data; constrained layout
 keeps labels from overlapping (tests/test_figures.py checks both).
 """
+
 from __future__ import annotations
 
 from contextlib import contextmanager
@@ -25,11 +26,24 @@ from solvers import kernel_names, scene_kind
 from . import paper as P
 from . import tables as T
 
-CLASS_STYLE = {"stable": ("tab:green", "o"), "inaccurate": ("tab:orange", "s"), "unstable": ("tab:red", "X"),
-               "timeout": ("tab:gray", "v"), "error": ("black", "x"), "out-of-memory": ("tab:purple", "P"),
-               "skipped": ("tab:gray", "."), UNSTABLE_BY_PREDICTION: ("tab:red", "X")}
-STAGE_COLOURS = {"input": "tab:gray", "init": "tab:brown", "snp": "tab:blue", "pi": "tab:orange",
-                 "su": "tab:green", "output": "tab:purple"}
+CLASS_STYLE = {
+    "stable": ("tab:green", "o"),
+    "inaccurate": ("tab:orange", "s"),
+    "unstable": ("tab:red", "X"),
+    "timeout": ("tab:gray", "v"),
+    "error": ("black", "x"),
+    "out-of-memory": ("tab:purple", "P"),
+    "skipped": ("tab:gray", "."),
+    UNSTABLE_BY_PREDICTION: ("tab:red", "X"),
+}
+STAGE_COLOURS = {
+    "input": "tab:gray",
+    "init": "tab:brown",
+    "snp": "tab:blue",
+    "pi": "tab:orange",
+    "su": "tab:green",
+    "output": "tab:purple",
+}
 PRECISION_MARKER = {"float64": "o", "float32": "s"}
 MODEL_COLOUR = {"linear": "tab:blue", "lagrangian": "tab:red", "fixed": "tab:green"}
 SEARCH_COLOUR = {"all-pair": "tab:red", "linked list": "tab:blue"}
@@ -54,8 +68,19 @@ def channels(**named) -> str:
 
 
 @contextmanager
-def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, nrows: int = 1, logx=False,
-           logy=False, size=None, legend="right", sharey=False):
+def figure(
+    path: Path,
+    title: str,
+    xlabel: str,
+    ylabel: str,
+    ncols: int = 1,
+    nrows: int = 1,
+    logx=False,
+    logy=False,
+    size=None,
+    legend="right",
+    sharey=False,
+):
     """A constrained-layout figure with ``nrows x ncols`` axes, labelled and gridded, saved to ``path`` on exit.
 
     ``legend``: "right" puts one legend of every labelled series outside the axes, "below" one legend under
@@ -66,8 +91,14 @@ def figure(path: Path, title: str, xlabel: str, ylabel: str, ncols: int = 1, nro
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(nrows, ncols, figsize=size or (6.5 * ncols + 2.5, 4.2 * nrows), squeeze=False,
-                             layout="constrained", sharey=sharey)
+    fig, axes = plt.subplots(
+        nrows,
+        ncols,
+        figsize=size or (6.5 * ncols + 2.5, 4.2 * nrows),
+        squeeze=False,
+        layout="constrained",
+        sharey=sharey,
+    )
     axes = list(axes.flat)
     for ax in axes:  # scales first: a figure may set its own ticks inside the block
         if logx:
@@ -120,8 +151,9 @@ def nice_log_ticks(ax, values, axis="y"):
     values = [v for v in values if v and np.isfinite(v) and v > 0]
     lo, hi = min(values), max(values)
     mantissas = (1, 2, 5) if hi / lo < 100 else (1,)
-    ticks = [m * 10.0 ** k for k in range(int(np.floor(np.log10(lo))) - 1, int(np.ceil(np.log10(hi))) + 1)
-             for m in mantissas]
+    ticks = [
+        m * 10.0**k for k in range(int(np.floor(np.log10(lo))) - 1, int(np.ceil(np.log10(hi))) + 1) for m in mantissas
+    ]
     inside = [t for t in ticks if lo / 1.5 <= t <= hi * 1.5]
     plain_log_ticks(ax, inside or [lo, hi], axis=axis, spread=1.5)
     (ax.xaxis if axis == "x" else ax.yaxis).set_minor_locator(NullLocator())
@@ -143,35 +175,65 @@ def fig8(series, out: Path, pid: str):
     domains = [s["domain"] for s in series]
     domain = "" if len(set(domains)) > 1 else f", {domains[0]} domain"
     key = channels(colour=("model", models), marker=("precision", precisions), line=("domain", domains))
-    with figure(path, f"Fig. 8: error against dx ({pid}{domain}){key}", "dx (m)",
-                "relative RMS error of u (paper's MSE)", ncols=len(protocols), logx=True, logy=True,
-                size=(5.6 * len(protocols) + 0.6, 4.6 + 0.16 * max(sum(s["protocol"] == p for s in series)
-                                                                 for p in protocols)), legend="below") as axes:
+    with figure(
+        path,
+        f"Fig. 8: error against dx ({pid}{domain}){key}",
+        "dx (m)",
+        "relative RMS error of u (paper's MSE)",
+        ncols=len(protocols),
+        logx=True,
+        logy=True,
+        size=(5.6 * len(protocols) + 0.6, 4.6 + 0.16 * max(sum(s["protocol"] == p for s in series) for p in protocols)),
+        legend="below",
+    ) as axes:
         for ax, protocol in zip(axes, protocols):
             dxs, note = [], ""
             for s in (s for s in series if s["protocol"] == protocol):
                 f32 = s["precision"] == "float32"
                 hidden = s["domain"] == "full" and _under_the_strip(s, series)
-                ax.plot(s["dx"], s["mse"], color=MODEL_COLOUR.get(s["model"], "k"),
-                        marker=PRECISION_MARKER[s["precision"]], ms=9 if f32 else 5, mfc="none" if f32 else None,
-                        mew=1.4 if f32 else 1.0, ls="-" if s["domain"] == "strip" else ":", lw=1.2,
-                        zorder=3 if f32 else 2,  # float32 on top: where it tracks float64 it would hide under it
-                        label=f"{s['model']} {s['precision']}{'' if domain else ' ' + s['domain']}: {T.trend(s)}"
-                        + (" (under the strip's line)" if hidden else ""))
+                ax.plot(
+                    s["dx"],
+                    s["mse"],
+                    color=MODEL_COLOUR.get(s["model"], "k"),
+                    marker=PRECISION_MARKER[s["precision"]],
+                    ms=9 if f32 else 5,
+                    mfc="none" if f32 else None,
+                    mew=1.4 if f32 else 1.0,
+                    ls="-" if s["domain"] == "strip" else ":",
+                    lw=1.2,
+                    zorder=3 if f32 else 2,  # float32 on top: where it tracks float64 it would hide under it
+                    label=f"{s['model']} {s['precision']}{'' if domain else ' ' + s['domain']}: {T.trend(s)}"
+                    + (" (under the strip's line)" if hidden else ""),
+                )
                 dxs += list(s["dx"])
             dx_paper, mse_paper = P.fig8_point()
             if protocol == "100 steps":
                 if min(dxs) / dx_paper <= 4:  # drawn only near our runs; else named, not stretched to
-                    ax.plot([dx_paper], [mse_paper], marker="^", ms=15, mew=1.4, zorder=4, **PUBLISHED,
-                            label=f"paper, dx = {dx_paper:g}, 100 steps (published)")
+                    ax.plot(
+                        [dx_paper],
+                        [mse_paper],
+                        marker="^",
+                        ms=15,
+                        mew=1.4,
+                        zorder=4,
+                        **PUBLISHED,
+                        label=f"paper, dx = {dx_paper:g}, 100 steps (published)",
+                    )
                     dxs.append(dx_paper)
                 else:  # named in the panel's title: a note inside the axes would sit on the data
                     note = f"\npaper (published): {mse_paper:g} at dx = {dx_paper:g}, off this axis"
             plain_log_ticks(ax, dxs)
-            nice_log_ticks(ax, [e for s in series if s["protocol"] == protocol for e in s["mse"]]
-                           + ([mse_paper] if dx_paper in dxs else []))
-            ax.set_title(protocol + (" (fixed physical time)" if protocol.startswith("t =")
-                                     else " (the paper's protocol)") + note, fontsize=9)
+            nice_log_ticks(
+                ax,
+                [e for s in series if s["protocol"] == protocol for e in s["mse"]]
+                + ([mse_paper] if dx_paper in dxs else []),
+            )
+            ax.set_title(
+                protocol
+                + (" (fixed physical time)" if protocol.startswith("t =") else " (the paper's protocol)")
+                + note,
+                fontsize=9,
+            )
     return path
 
 
@@ -179,8 +241,12 @@ def _under_the_strip(s, series, tolerance: float = 0.03) -> bool:
     """Whether full-domain series ``s`` has a strip twin (model, precision, protocol) within ``tolerance`` at
     every dx of ``s``: drawn under it, so the legend says so."""
     for t in series:
-        if (t["domain"], t["model"], t["precision"], t["protocol"]) == ("strip", s["model"], s["precision"],
-                                                                        s["protocol"]):
+        if (t["domain"], t["model"], t["precision"], t["protocol"]) == (
+            "strip",
+            s["model"],
+            s["precision"],
+            s["protocol"],
+        ):
             strip = dict(zip(t["dx"], t["mse"]))
             shared = [(e, strip[d]) for d, e in zip(s["dx"], s["mse"]) if d in strip]
             if len(shared) == len(s["dx"]) and all(b and abs(a / b - 1) <= tolerance for a, b in shared):
@@ -196,29 +262,51 @@ def fig9(rows, out: Path, pid: str):
     path = out / "fig9_allpair_vs_linkedlist.png"
     loop = T.FIG9_LOOP_NAMES.get(rows[0]["linkedlist_loop"], rows[0]["linkedlist_loop"])
     pub = [r for r in P.step_times() if r["source"] == "Fig. 9 text"]
-    with figure(path, f"Fig. 9: all-pair against linked list, serial CPU, float64, {steps}-step runs ({pid})",
-                "particles N", "", ncols=2, logx=True, logy=True, size=(13, 4.4)) as (a, b):
-        for key, search, label in (("allpair_ms", "all-pair", "all-pair (measured)"),
-                                   ("linkedlist_ms", "linked list", f"linked list, {loop} (measured)")):
+    with figure(
+        path,
+        f"Fig. 9: all-pair against linked list, serial CPU, float64, {steps}-step runs ({pid})",
+        "particles N",
+        "",
+        ncols=2,
+        logx=True,
+        logy=True,
+        size=(13, 4.4),
+    ) as (a, b):
+        for key, search, label in (
+            ("allpair_ms", "all-pair", "all-pair (measured)"),
+            ("linkedlist_ms", "linked list", f"linked list, {loop} (measured)"),
+        ):
             pts = [(r["N"], r[key]) for r in rows if r[key]]
             if pts:
                 a.plot(*zip(*pts), marker="o", color=SEARCH_COLOUR[search], label=label)
         for search, marker in (("all-pair", "^"), ("linked list", "v")):
-            _published(a, [r for r in pub if r["search"] == search], marker,  # large and on top: never hidden
-                       f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published)", ms=10, zorder=4)
+            _published(
+                a,
+                [r for r in pub if r["search"] == search],
+                marker,  # large and on top: never hidden
+                f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published)",
+                ms=10,
+                zorder=4,
+            )
         skipped = [r["N"] for r in rows if r["allpair_status"] == "skipped"]
         for n in skipped:
             a.axvline(n, color="tab:gray", ls=":", lw=1)
         a.set_ylabel("one step (ms)")
-        a.set_title("runtime" + (" (dotted: all-pair predicted past the budget, skipped)" if skipped else ""),
-                    fontsize=9)
+        a.set_title(
+            "runtime" + (" (dotted: all-pair predicted past the budget, skipped)" if skipped else ""), fontsize=9
+        )
         pts = [(r["N"], r["eta"]) for r in rows if r["eta"]]
         if pts:
             b.plot(*zip(*pts), marker="o", color="tab:purple", label="speedup eta (measured)")
         ap = {r["N"]: r["ms"] for r in pub if r["search"] == "all-pair"}
         ll = {r["N"]: r["ms"] for r in pub if r["search"] == "linked list"}
-        b.plot(sorted(ap), [ap[n] / ll[n] for n in sorted(ap)], marker="D", **PUBLISHED,
-               label="speedup eta (paper, published)")
+        b.plot(
+            sorted(ap),
+            [ap[n] / ll[n] for n in sorted(ap)],
+            marker="D",
+            **PUBLISHED,
+            label="speedup eta (paper, published)",
+        )
         b.set_ylabel("eta = t_all-pair / t_linked-list")
         b.set_title("speedup (eq. 12)", fontsize=9)
     return path
@@ -243,24 +331,48 @@ def fig10(series, out: Path, pid: str):
     key = channels(colour=("configuration", configs), marker=("precision", [s["precision"] for s in series]))
     ncols = min(len(runs), 2)
     nrows = -(-len(runs) // ncols)
-    with figure(path, f"Fig. 10: one step against N ({pid}, full domain), a panel per run length{key}; grey "
-                "dashed: the paper's, same kind", "particles N", "one step SNP+PI+SU (ms)", ncols=ncols,
-                nrows=nrows, logx=True, logy=True, sharey=True, size=(4.6 * ncols + 4.6, 3.4 * nrows + 0.6)) as axes:
-        for ax in axes[len(runs):]:
+    with figure(
+        path,
+        f"Fig. 10: one step against N ({pid}, full domain), a panel per run length{key}; grey "
+        "dashed: the paper's, same kind",
+        "particles N",
+        "one step SNP+PI+SU (ms)",
+        ncols=ncols,
+        nrows=nrows,
+        logx=True,
+        logy=True,
+        sharey=True,
+        size=(4.6 * ncols + 4.6, 3.4 * nrows + 0.6),
+    ) as axes:
+        for ax in axes[len(runs) :]:
             ax.set_visible(False)
         for ax, run in zip(axes, runs):
             for s in (s for s in series if s["run"] == run):
                 c = (s["config"], s["loop"], s["threads"])
-                ax.plot(s["N"], s["ms"], marker=PRECISION_MARKER[s["precision"]], color=colours[c],
-                        label=f"{s['config']}, {s['loop']}, {T.where(s['threads'], s['device'])}")
+                ax.plot(
+                    s["N"],
+                    s["ms"],
+                    marker=PRECISION_MARKER[s["precision"]],
+                    color=colours[c],
+                    label=f"{s['config']}, {s['loop']}, {T.where(s['threads'], s['device'])}",
+                )
             ax.set_title(f"runs to t = {run[4:]}" if run.startswith("t =") else f"runs of {run}", fontsize=9)
             if ("cpu", "linked list") in kinds:
-                cpu = [r for r in P.step_times() if (r["system"], r["device"], r["search"]) ==
-                       ("paper-system-1", "cpu", "linked list")]
+                cpu = [
+                    r
+                    for r in P.step_times()
+                    if (r["system"], r["device"], r["search"]) == ("paper-system-1", "cpu", "linked list")
+                ]
                 for source, marker in (("Table 6", "v"), ("text, 400K", "<")):
                     pts = [r for r in cpu if r["source"] == source]
-                    _published(ax, pts, marker, f"paper CPU, {pts[0]['processor']}, serial linked list, {source}: "
-                               f"{pts[0]['conversion']} (published)", ls="--" if len(pts) > 1 else "none")
+                    _published(
+                        ax,
+                        pts,
+                        marker,
+                        f"paper CPU, {pts[0]['processor']}, serial linked list, {source}: "
+                        f"{pts[0]['conversion']} (published)",
+                        ls="--" if len(pts) > 1 else "none",
+                    )
             if ("gpu", "linked list") in kinds:
                 pts = [r for r in P.step_times() if r["device"] == "gpu" and r["source"] == "Table 4"]
                 _published(ax, pts, "^", f"paper GPU, {pts[0]['processor']}, Table 4: one step (published)")
@@ -277,16 +389,30 @@ def _shares(path, title, xlabel, rows, published, stages):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(len(panels), 1, figsize=(10.5, 1.5 + 0.26 * sum(heights)), layout="constrained",
-                             gridspec_kw={"height_ratios": heights}, sharex=True, squeeze=False)
+    fig, axes = plt.subplots(
+        len(panels),
+        1,
+        figsize=(10.5, 1.5 + 0.26 * sum(heights)),
+        layout="constrained",
+        gridspec_kw={"height_ratios": heights},
+        sharex=True,
+        squeeze=False,
+    )
     axes = list(axes.flat)
     for ax, (items, hatch, name) in zip(axes, panels):
         left = np.zeros(len(items))
         for s in stages:
             vals = np.array([sh[s] for _, sh in items])
-            ax.barh(range(len(items)), vals, left=left, color=STAGE_COLOURS[s], hatch=hatch,
-                    edgecolor="white" if hatch is None else "0.25", lw=0.4,
-                    label=s.upper() if ax is axes[0] else None)
+            ax.barh(
+                range(len(items)),
+                vals,
+                left=left,
+                color=STAGE_COLOURS[s],
+                hatch=hatch,
+                edgecolor="white" if hatch is None else "0.25",
+                lw=0.4,
+                label=s.upper() if ax is axes[0] else None,
+            )
             left += vals
         ax.set_yticks(range(len(items)))
         ax.set_yticklabels([label for label, _ in items], fontsize=7)
@@ -314,17 +440,26 @@ def fig11(rows, out: Path, pid: str):
     the paper's shares beside rows of the same kind only (``table5``'s ``paper``)."""
     if not rows:
         return None
-    run, rows = _one_run(rows, lambda runs, rows: "100 steps" if "100 steps" in runs else
-                         max(runs, key=lambda x: sum(r["run"] == x for r in rows)))
+    run, rows = _one_run(
+        rows,
+        lambda runs, rows: (
+            "100 steps" if "100 steps" in runs else max(runs, key=lambda x: sum(r["run"] == x for r in rows))
+        ),
+    )
     paper = {}
     for r in rows:
         if r["paper"]:
             source, values = r["paper"]
             name = f"paper {source}" + (f", N={r['N']:,}" if "Table 5" in source else ", every N")
             paper[name] = dict(zip(T.STEP_STAGES, values))
-    return _shares(out / "fig11_step_shares.png", f"Fig. 11 / Table 5: share of a step by stage, runs of {run} "
-                   f"({pid}; Table 5 has every run length)", "% of one step (SNP + PI + SU)", rows,
-                   list(paper.items()), T.STEP_STAGES)
+    return _shares(
+        out / "fig11_step_shares.png",
+        f"Fig. 11 / Table 5: share of a step by stage, runs of {run} ({pid}; Table 5 has every run length)",
+        "% of one step (SNP + PI + SU)",
+        rows,
+        list(paper.items()),
+        T.STEP_STAGES,
+    )
 
 
 def fig13(rows, out: Path, pid: str):
@@ -335,14 +470,29 @@ def fig13(rows, out: Path, pid: str):
     run, rows = _one_run(rows, lambda runs, rows: runs[0])
     paper = []
     if any(r["device"] == "gpu" for r in rows):
-        paper = [(f"paper GPU Tesla K20c, N={n:,} (Table 4, one-step run)",
-                  {s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)}) for n, v in P.table4().items()]
+        paper = [
+            (
+                f"paper GPU Tesla K20c, N={n:,} (Table 4, one-step run)",
+                {s: 100 * x / sum(v) for s, x in zip(T.STAGES, v)},
+            )
+            for n, v in P.table4().items()
+        ]
     spread = max(r.get("init_spread", 1.0) for r in rows)
-    noisy = (f"; init is timed once per run, and stored reruns of one configuration differ in it by up to "
-             f"{spread:.1f}x: one slow init can dominate a row" if spread >= 1.5 else "")
-    return _shares(out / "fig13_task_shares.png",
-                   f"Fig. 13: share of a one-step run by task ({pid}): input + init + one step + output, the step "
-                   f"being the mean step of runs of {run}{noisy}", "% of a run of one step", rows, paper, T.STAGES)
+    noisy = (
+        f"; init is timed once per run, and stored reruns of one configuration differ in it by up to "
+        f"{spread:.1f}x: one slow init can dominate a row"
+        if spread >= 1.5
+        else ""
+    )
+    return _shares(
+        out / "fig13_task_shares.png",
+        f"Fig. 13: share of a one-step run by task ({pid}): input + init + one step + output, the step "
+        f"being the mean step of runs of {run}{noisy}",
+        "% of a run of one step",
+        rows,
+        paper,
+        T.STAGES,
+    )
 
 
 def fig14(rows, out: Path, title: str):
@@ -352,28 +502,59 @@ def fig14(rows, out: Path, title: str):
     pub = P.table6()
     keys = sorted({(r["gpu_profile"], r["precision"], r["protocol"]) for r in rows})
     colours = palette(len(keys))
-    values = [r["speedup"] for r in pub] + [r["speedup"] for r in rows] + \
-        [r["speedup_all_cores"] for r in rows if r["speedup_all_cores"]]
-    with figure(path, f"Fig. 14: GPU speedup per step over its own host's CPU ({title})", "particles N",
-                "speedup per step", logx=True, logy=True, size=(10.5, 4.6)) as (ax,):
+    values = (
+        [r["speedup"] for r in pub]
+        + [r["speedup"] for r in rows]
+        + [r["speedup_all_cores"] for r in rows if r["speedup_all_cores"]]
+    )
+    with figure(
+        path,
+        f"Fig. 14: GPU speedup per step over its own host's CPU ({title})",
+        "particles N",
+        "speedup per step",
+        logx=True,
+        logy=True,
+        size=(10.5, 4.6),
+    ) as (ax,):
         for system in P.SYSTEMS:
             pts = [(r["N"], r["speedup"]) for r in pub if r["system"] == system]
             card = next(r["card"] for r in pub if r["system"] == system)
-            ax.plot(*zip(*pts), marker=PAPER_MARKERS[system], **PUBLISHED,
-                    label=f"{system}: {card} vs one core of its host, Table 6 (published)")
+            ax.plot(
+                *zip(*pts),
+                marker=PAPER_MARKERS[system],
+                **PUBLISHED,
+                label=f"{system}: {card} vs one core of its host, Table 6 (published)",
+            )
         for colour, (gp, prec, how) in zip(colours, keys):
             pts = [r for r in rows if (r["gpu_profile"], r["precision"], r["protocol"]) == (gp, prec, how)]
-            ax.plot([r["N"] for r in pts], [r["speedup"] for r in pts], marker=PRECISION_MARKER[prec], color=colour,
-                    label=f"{gp} {prec} vs one core of its host, {how}")
+            ax.plot(
+                [r["N"] for r in pts],
+                [r["speedup"] for r in pts],
+                marker=PRECISION_MARKER[prec],
+                color=colour,
+                label=f"{gp} {prec} vs one core of its host, {how}",
+            )
             multi = [r for r in pts if r["speedup_all_cores"]]
             if multi:
-                ax.plot([r["N"] for r in multi], [r["speedup_all_cores"] for r in multi],
-                        marker=PRECISION_MARKER[prec], color=colour, ls=":", mfc="none",
-                        label=f"{gp} {prec} vs all cores of its host, {how}")
+                ax.plot(
+                    [r["N"] for r in multi],
+                    [r["speedup_all_cores"] for r in multi],
+                    marker=PRECISION_MARKER[prec],
+                    color=colour,
+                    ls=":",
+                    mfc="none",
+                    label=f"{gp} {prec} vs all cores of its host, {how}",
+                )
         nice_log_ticks(ax, values)
         if not rows:
-            ax.text(0.02, 0.95, "no GPU measured with its own host's CPU yet: only the paper's lines",
-                    transform=ax.transAxes, fontsize=8, color="0.3")
+            ax.text(
+                0.02,
+                0.95,
+                "no GPU measured with its own host's CPU yet: only the paper's lines",
+                transform=ax.transAxes,
+                fontsize=8,
+                color="0.3",
+            )
     return path
 
 
@@ -384,8 +565,18 @@ def _groups(rows, keys):
     return list(seen.items())
 
 
-TAB10 = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:gray",
-         "tab:olive", "tab:cyan")
+TAB10 = (
+    "tab:blue",
+    "tab:orange",
+    "tab:green",
+    "tab:red",
+    "tab:purple",
+    "tab:brown",
+    "tab:pink",
+    "tab:gray",
+    "tab:olive",
+    "tab:cyan",
+)
 
 
 def kernel_colour(kernel: str) -> str:
@@ -402,39 +593,88 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
         return None
     times = [p["t_final"] for p in points]
     t_main = max(set(times), key=times.count)  # one physical time: the one most runs ended at (10 s in the presets)
-    panels = [(t_main, m) for m in T.FRONT_MODELS  # a few points are no front
-              if sum((q["t_final"], q["model"]) == (t_main, m) for q in points) >= 4]
+    panels = [
+        (t_main, m)
+        for m in T.FRONT_MODELS  # a few points are no front
+        if sum((q["t_final"], q["model"]) == (t_main, m) for q in points) >= 4
+    ]
     if not panels:
         return None
     here_all = [p for p in points if (p["t_final"], p["model"]) in panels]
-    key = channels(colour=("kernel", [p["kernel"] for p in here_all]),
-                   hollow=("float32", [p["precision"] for p in here_all]))
+    key = channels(
+        colour=("kernel", [p["kernel"] for p in here_all]), hollow=("float32", [p["precision"] for p in here_all])
+    )
     path = out / "speed_vs_accuracy.png"
-    with figure(path, f"Time to solution against error ({pid}){key}; black line: the fastest run to each error",
-                "time to solution (s: init + steps, no JIT)",
-                "relative RMS error of u at t (lagrangian: vs isothermal)",
-                ncols=len(panels), logx=True, logy=True, size=(5.2 * len(panels) + 3.8, 4.6)) as axes:
+    with figure(
+        path,
+        f"Time to solution against error ({pid}){key}; black line: the fastest run to each error",
+        "time to solution (s: init + steps, no JIT)",
+        "relative RMS error of u at t (lagrangian: vs isothermal)",
+        ncols=len(panels),
+        logx=True,
+        logy=True,
+        size=(5.2 * len(panels) + 3.8, 4.6),
+    ) as axes:
         for ax, (t_final, model) in zip(axes, panels):
             here = [p for p in points if (p["t_final"], p["model"]) == (t_final, model)]
-            for (kern, precision), pts in _groups([p for p in here if not p.get("past_limit")],
-                                                  ("kernel", "precision")):
+            for (kern, precision), pts in _groups(
+                [p for p in here if not p.get("past_limit")], ("kernel", "precision")
+            ):
                 colour = kernel_colour(kern)
-                ax.plot([p["seconds"] for p in pts], [p["error"] for p in pts], ls="none", marker="o", ms=4.5,
-                        color=colour, mfc="none" if precision == "float32" else colour, alpha=0.75,
-                        label=f"{kern}, {precision}")
+                ax.plot(
+                    [p["seconds"] for p in pts],
+                    [p["error"] for p in pts],
+                    ls="none",
+                    marker="o",
+                    ms=4.5,
+                    color=colour,
+                    mfc="none" if precision == "float32" else colour,
+                    alpha=0.75,
+                    label=f"{kern}, {precision}",
+                )
             past = [p for p in here if p.get("past_limit")]
             if past:
-                ax.plot([p["seconds"] for p in past], [p["error"] for p in past], ls="none", marker="X", ms=6,
-                        mfc="none", mec="tab:purple", mew=1.0,
-                        label="unstable by prediction (CFL at or past its stable CFL), any kernel: never on the front")
+                ax.plot(
+                    [p["seconds"] for p in past],
+                    [p["error"] for p in past],
+                    ls="none",
+                    marker="X",
+                    ms=6,
+                    mfc="none",
+                    mec="tab:purple",
+                    mew=1.0,
+                    label="unstable by prediction (CFL at or past its stable CFL), any kernel: never on the front",
+                )
             paper = [p for p in here if p["paper_method"]]
-            ax.plot([p["seconds"] for p in paper], [p["error"] for p in paper], ls="none", marker="*", ms=11,
-                    mfc="none", mec="black", mew=1.1, label="the paper's method (Gaussian, h 2.13dx, 3h, CFL 0.2)")
+            ax.plot(
+                [p["seconds"] for p in paper],
+                [p["error"] for p in paper],
+                ls="none",
+                marker="*",
+                ms=11,
+                mfc="none",
+                mec="black",
+                mew=1.1,
+                label="the paper's method (Gaussian, h 2.13dx, 3h, CFL 0.2)",
+            )
             fp = [p for p in front if (p["t_final"], p["model"]) == (t_final, model)]
-            ax.step([p["seconds"] for p in fp], [p["error"] for p in fp], color="black", where="post", lw=1.3,
-                    label="front: fastest run to each error")
-            ax.plot([p["seconds"] for p in fp], [T.predicted_error(p) for p in fp], ls="none", marker="x", ms=6,
-                    color="crimson", label="front runs, predicted (dispersion relation, linear part)")
+            ax.step(
+                [p["seconds"] for p in fp],
+                [p["error"] for p in fp],
+                color="black",
+                where="post",
+                lw=1.3,
+                label="front: fastest run to each error",
+            )
+            ax.plot(
+                [p["seconds"] for p in fp],
+                [T.predicted_error(p) for p in fp],
+                ls="none",
+                marker="x",
+                ms=6,
+                color="crimson",
+                label="front runs, predicted (dispersion relation, linear part)",
+            )
             ax.set_title(f"{model}, t = {t_final:g} s ({len(here)} runs)", fontsize=9)
             # plain ticks: a narrow log range would label its minor ticks too, and they collide
             nice_log_ticks(ax, [p["seconds"] for p in here], axis="x")
@@ -449,32 +689,64 @@ def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
         return None
     configs = [lim["config"] for lim in limits]
     path = out / "stability_map.png"
-    with figure(path, f"Stability map ({pid}): black bar: the stable CFL (predicted, or long runs where lower); "
-                "past it a run is unstable (a hollow X where it ended bounded: too few steps for round-off to grow); "
-                f"inaccurate = bounded but relative RMS > {100 * inaccurate_above:g} %; numbers: the step where a run "
-                "blew up",
-                "CFL = dt c0 / dx", "", logx=True, size=(11, 2.1 + 0.32 * len(configs))) as (ax,):
+    with figure(
+        path,
+        f"Stability map ({pid}): black bar: the stable CFL (predicted, or long runs where lower); "
+        "past it a run is unstable (a hollow X where it ended bounded: too few steps for round-off to grow); "
+        f"inaccurate = bounded but relative RMS > {100 * inaccurate_above:g} %; numbers: the step where a run "
+        "blew up",
+        "CFL = dt c0 / dx",
+        "",
+        logx=True,
+        size=(11, 2.1 + 0.32 * len(configs)),
+    ) as (ax,):
         for cls, (colour, marker) in CLASS_STYLE.items():
             pts = [p for p in points if p["class"] == cls]
             if pts:
                 hollow = cls == UNSTABLE_BY_PREDICTION
-                ax.scatter([p["cfl"] for p in pts], [configs.index(p["config"]) for p in pts],
-                           c="white" if hollow else colour, edgecolors=colour if hollow else None, marker=marker,
-                           s=40, linewidths=1.2 if hollow else None, label=cls, zorder=3)  # above the limit bar
+                ax.scatter(
+                    [p["cfl"] for p in pts],
+                    [configs.index(p["config"]) for p in pts],
+                    c="white" if hollow else colour,
+                    edgecolors=colour if hollow else None,
+                    marker=marker,
+                    s=40,
+                    linewidths=1.2 if hollow else None,
+                    label=cls,
+                    zorder=3,
+                )  # above the limit bar
         for p in points:
             if p["class"] == "unstable" and p["failed_step"]:
-                ax.annotate(f"{int(p['failed_step'])}", (p["cfl"], configs.index(p["config"])), fontsize=6,
-                            xytext=(3, 3), textcoords="offset points")
+                ax.annotate(
+                    f"{int(p['failed_step'])}",
+                    (p["cfl"], configs.index(p["config"])),
+                    fontsize=6,
+                    xytext=(3, 3),
+                    textcoords="offset points",
+                )
         cfls = [p["cfl"] for p in points]
         drawn = False
         for i, lim in enumerate(limits):
             if lim["stable_cfl"] > 0:
-                ax.plot([lim["stable_cfl"]] * 2, [i - 0.38, i + 0.38], color="black", lw=1.5, solid_capstyle="butt",
-                        label=None if drawn else "stable CFL (predicted; long runs where lower)")
+                ax.plot(
+                    [lim["stable_cfl"]] * 2,
+                    [i - 0.38, i + 0.38],
+                    color="black",
+                    lw=1.5,
+                    solid_capstyle="butt",
+                    label=None if drawn else "stable CFL (predicted; long runs where lower)",
+                )
                 drawn = True
             else:
-                ax.annotate("predicted: grows at every CFL", (min(cfls), i), xytext=(-4, 6),
-                            textcoords="offset points", fontsize=6, color="0.3", ha="left")
+                ax.annotate(
+                    "predicted: grows at every CFL",
+                    (min(cfls), i),
+                    xytext=(-4, 6),
+                    textcoords="offset points",
+                    fontsize=6,
+                    color="0.3",
+                    ha="left",
+                )
         ax.set_xlim(min(cfls) / 1.25, max(cfls + [lim["stable_cfl"] for lim in limits]) * 1.1)
         ax.xaxis.set_major_locator(FixedLocator(sorted(set(cfls))))
         ax.xaxis.set_major_formatter(lambda v, _: f"{v:g}")
@@ -493,17 +765,36 @@ def cards_figure(rows, out: Path):
     cards = sorted({p["card"] for p in rows})
     colours = dict(zip(cards, palette(len(cards))))
     key = channels(colour=("card", cards), marker=("precision", [p["precision"] for p in rows]))
-    with figure(path, "GPU cards side by side: one lagrangian step (SNP+PI+SU) against N" + key
-                + "; grey dashed, marker by card: the paper's", "particles N", "one step (ms)", logx=True, logy=True,
-                size=(10.5, 4.6)) as (ax,):
+    with figure(
+        path,
+        "GPU cards side by side: one lagrangian step (SNP+PI+SU) against N"
+        + key
+        + "; grey dashed, marker by card: the paper's",
+        "particles N",
+        "one step (ms)",
+        logx=True,
+        logy=True,
+        size=(10.5, 4.6),
+    ) as (ax,):
         for (system, card, source), pts in _groups(pub, ("system", "processor", "source")):
             _published(ax, pts, PAPER_MARKERS[system], f"{card}, {source}: {pts[0]['conversion']} (published)")
         for (_, precision, how), pts in _groups(rows, ("profile", "precision", "protocol")):
-            ax.plot([p["N"] for p in pts], [p["step_ms"] for p in pts], marker=PRECISION_MARKER[precision],
-                    color=colours[pts[0]["card"]], label=f"{pts[0]['card']} {precision}, {how} (measured)")
+            ax.plot(
+                [p["N"] for p in pts],
+                [p["step_ms"] for p in pts],
+                marker=PRECISION_MARKER[precision],
+                color=colours[pts[0]["card"]],
+                label=f"{pts[0]['card']} {precision}, {how} (measured)",
+            )
         if not rows:
-            ax.text(0.02, 0.95, "no GPU card measured yet: only the paper's", transform=ax.transAxes, fontsize=8,
-                    color="0.3")
+            ax.text(
+                0.02,
+                0.95,
+                "no GPU card measured yet: only the paper's",
+                transform=ax.transAxes,
+                fontsize=8,
+                color="0.3",
+            )
     return path
 
 
@@ -517,10 +808,18 @@ def scene_fronts(points, out: Path, pid: str):
     past = " x: past the predicted stable CFL," if any(p["past_stable"] for p in points) else ""
     ncols = min(len(scenes), 2)  # two panels a row: four scenes (the walls too) stay readable
     nrows = -(-len(scenes) // ncols)
-    with figure(path, f"Time to solution against error on each scene, t = 10 s, Mach 0.05 ({pid});{past} "
-                      "colour: model", "time to solution, s", "relative RMS error",
-                ncols=ncols, nrows=nrows, logx=True, logy=True, size=(6.5 * ncols + 2.5, 3.9 * nrows)) as axes:
-        for ax in axes[len(scenes):]:
+    with figure(
+        path,
+        f"Time to solution against error on each scene, t = 10 s, Mach 0.05 ({pid});{past} colour: model",
+        "time to solution, s",
+        "relative RMS error",
+        ncols=ncols,
+        nrows=nrows,
+        logx=True,
+        logy=True,
+        size=(6.5 * ncols + 2.5, 3.9 * nrows),
+    ) as axes:
+        for ax in axes[len(scenes) :]:
             ax.set_visible(False)
         for ax, scene in zip(axes, scenes):
             mine = [p for p in points if p["scene"] == scene and np.isclose(p["mach"], 0.05)]
@@ -529,10 +828,15 @@ def scene_fronts(points, out: Path, pid: str):
                     pts = [p for p in mine if p["model"] == model and p["past_stable"] == past]
                     if not pts:
                         continue
-                    ax.scatter([p["seconds"] for p in pts], [p["error"] for p in pts], s=14 if not past else 22,
-                               marker="x" if past else "o", color=MODEL_COLOUR[model],
-                               alpha=0.8 if not past else 0.6,
-                               label=f"{model}" + (" (past the stable CFL)" if past else ""))
+                    ax.scatter(
+                        [p["seconds"] for p in pts],
+                        [p["error"] for p in pts],
+                        s=14 if not past else 22,
+                        marker="x" if past else "o",
+                        color=MODEL_COLOUR[model],
+                        alpha=0.8 if not past else 0.6,
+                        label=f"{model}" + (" (past the stable CFL)" if past else ""),
+                    )
             errors = [p["error"] for p in mine]
             if errors:
                 nice_log_ticks(ax, errors)
@@ -551,11 +855,17 @@ def phase_direction(curves, fronts, out: Path, pid: str):
     path = out / "phase_direction.png"
     colours = palette(len(curves))
     fronts = [f for f in fronts if f["predicted"][0] is not None]
-    with figure(path, f"Phase speed against the direction of travel, predicted at dx = 0.25 m ({pid}); "
-                      "colour: method", "direction, degrees from the lattice's x axis",
-                "phase speed error minus its value along the axis, %", ncols=3 if fronts else 2) as axes:
-        for ax, key, title in ((axes[0], "error", "the pulse's wavenumber k = 1/b"),
-                               (axes[1], "short", "a short wave, 8 particles per wavelength")):
+    with figure(
+        path,
+        f"Phase speed against the direction of travel, predicted at dx = 0.25 m ({pid}); colour: method",
+        "direction, degrees from the lattice's x axis",
+        "phase speed error minus its value along the axis, %",
+        ncols=3 if fronts else 2,
+    ) as axes:
+        for ax, key, title in (
+            (axes[0], "error", "the pulse's wavenumber k = 1/b"),
+            (axes[1], "short", "a short wave, 8 particles per wavelength"),
+        ):
             for c, colour in zip(curves, colours):
                 values = 100 * np.asarray(c[key])
                 ax.plot(c["angles"], values - values[0], color=colour, label=c["label"])
@@ -569,8 +879,14 @@ def phase_direction(curves, fronts, out: Path, pid: str):
             values = []
             for f in fronts:
                 for k, marker in ((0, "o"), (1, "^")):
-                    ax.scatter(100 * f["predicted"][k], 100 * f["measured"][k], marker=marker, facecolors="none",
-                               edgecolors="tab:blue", s=28)
+                    ax.scatter(
+                        100 * f["predicted"][k],
+                        100 * f["measured"][k],
+                        marker=marker,
+                        facecolors="none",
+                        edgecolors="tab:blue",
+                        s=28,
+                    )
                     values += [100 * f["predicted"][k], 100 * f["measured"][k]]
             lo, hi = min(values), max(values)
             pad = 0.05 * (hi - lo or 1.0)

@@ -8,6 +8,7 @@ what ran (``device``; ``search``: linked list or all-pair; ``loop``: the pair
 loop), the machine (a profile, and its host where several share it), ``t_step`` (s
 per step) and ``t_solution`` (init + steps, s, no JIT or I/O).
 """
+
 from __future__ import annotations
 
 import json
@@ -20,8 +21,17 @@ from pcabench.record import STEP_STAGES
 from pcabench.spec import stored_parameters
 from solvers import registry
 
-SCENE_COLUMNS = ("strip_height", "cutoff_factor", "kernel", "h_factor", "cfl", "t_final", "height", "mach",
-                 "pulse_width")
+SCENE_COLUMNS = (
+    "strip_height",
+    "cutoff_factor",
+    "kernel",
+    "h_factor",
+    "cfl",
+    "t_final",
+    "height",
+    "mach",
+    "pulse_width",
+)
 NUMERIC = ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal")
 
 

@@ -1,5 +1,6 @@
 """Markdown helpers of the reports: a table, text from a store made inert, and numbers written for a reader
 ('-' for none)."""
+
 from __future__ import annotations
 
 import html

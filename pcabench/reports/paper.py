@@ -12,6 +12,7 @@ run is divided by its own step count, once, here (:func:`per_step_ms`):
 Every CPU number is one serial core (the paper's CPU codes are single-thread), and every code but
 Fig. 9's all-pair one uses the linked list; all ran in double precision.
 """
+
 from __future__ import annotations
 
 from functools import lru_cache
@@ -21,8 +22,12 @@ from pcabench import profiles
 SYSTEMS = ("paper-system-1", "paper-system-2", "paper-system-3")
 TABLE6_STEPS = 100  # Table 6's "Number of timesteps"
 FIG9_STEPS = 10  # Fig. 9: "the comparisons are based on the results of the 10th timestep"
-CONVERSION = {"Table 4": "one step, ms", "Table 6": "run / 100 steps, printed min read as s",
-              "Fig. 9 text": "run / 10 steps", "text, 400K": "one step, ms"}
+CONVERSION = {
+    "Table 4": "one step, ms",
+    "Table 6": "run / 100 steps, printed min read as s",
+    "Fig. 9 text": "run / 10 steps",
+    "text, 400K": "one step, ms",
+}
 
 
 def per_step_ms(run_seconds: float, steps: int) -> float:
@@ -67,8 +72,16 @@ def step_times() -> tuple[dict, ...]:
 
 
 def _row(system, device, search, n, ms, source) -> dict:
-    return {"system": system, "device": device, "processor": processor(system, device), "search": search,
-            "N": int(n), "ms": ms, "source": source, "conversion": CONVERSION[source]}
+    return {
+        "system": system,
+        "device": device,
+        "processor": processor(system, device),
+        "search": search,
+        "N": int(n),
+        "ms": ms,
+        "source": source,
+        "conversion": CONVERSION[source],
+    }
 
 
 def same_kind(device: str, search: str, n: int) -> list[dict]:
@@ -97,8 +110,16 @@ def table6() -> list[dict]:
     rows = []
     for system in SYSTEMS:
         for n, (cpu, gpu, speedup) in published(system)["table6"]["rows"].items():
-            rows.append({"system": system, "card": processor(system, "gpu"), "N": int(n), "cpu": cpu, "gpu": gpu,
-                         "speedup": speedup})
+            rows.append(
+                {
+                    "system": system,
+                    "card": processor(system, "gpu"),
+                    "N": int(n),
+                    "cpu": cpu,
+                    "gpu": gpu,
+                    "speedup": speedup,
+                }
+            )
     return sorted(rows, key=lambda r: (r["system"], r["N"]))
 
 

@@ -8,6 +8,7 @@ or past its predicted stable CFL (solvers/dispersion.py) is never the
 fastest to an accuracy, whatever its error: it ended bounded because it was
 too short for round-off to grow.
 """
+
 from __future__ import annotations
 
 import json
@@ -40,37 +41,70 @@ def stable_cfl_of(r) -> float:
 def points(df) -> list[dict]:
     """Every finished run at t = 10 s with its scene, method, time to solution and error (against the
     physics its model converges to), and whether its CFL is past the predicted stable one."""
-    d = df[(df.status == "ok") & np.isclose(df.t_final.astype(float), T_FINAL) & df.model.isin(("linear",
-                                                                                                 "lagrangian"))]
+    d = df[
+        (df.status == "ok") & np.isclose(df.t_final.astype(float), T_FINAL) & df.model.isin(("linear", "lagrangian"))
+    ]
     out = []
     for _, r in latest(d).iterrows():
         error = r.mse if r.model == "linear" else r.mse_isothermal
         if error is None or not np.isfinite(error):
             continue
         stable = stable_cfl_of(r)
-        out.append({"scene": r.scene, "model": r.model, "mach": float(r.mach), "method": numerics_label(r),
-                    "kernel": r.kernel, "h_factor": float(r.h_factor), "cfl": float(r.cfl), "dx": float(r.dx),
-                    "precision": r.precision, "threads": int(r.threads), "domain": r.domain,
-                    "seconds": float(r.t_solution), "error": float(error), "linear_error": float(r.mse),
-                    "isothermal_error": None if r.mse_isothermal is None or not np.isfinite(r.mse_isothermal)
-                    else float(r.mse_isothermal),
-                    "paper_method": is_paper_method(r), "stable_cfl": stable, "past_stable": past_limit(r.cfl, stable),
-                    "front_axis": r.get("err_front_axis"), "front_diagonal": r.get("err_front_diagonal"),
-                    "commit": str(r.commit),
-                    "N": int(r.n_particles), "row": r})
+        out.append(
+            {
+                "scene": r.scene,
+                "model": r.model,
+                "mach": float(r.mach),
+                "method": numerics_label(r),
+                "kernel": r.kernel,
+                "h_factor": float(r.h_factor),
+                "cfl": float(r.cfl),
+                "dx": float(r.dx),
+                "precision": r.precision,
+                "threads": int(r.threads),
+                "domain": r.domain,
+                "seconds": float(r.t_solution),
+                "error": float(error),
+                "linear_error": float(r.mse),
+                "isothermal_error": None
+                if r.mse_isothermal is None or not np.isfinite(r.mse_isothermal)
+                else float(r.mse_isothermal),
+                "paper_method": is_paper_method(r),
+                "stable_cfl": stable,
+                "past_stable": past_limit(r.cfl, stable),
+                "front_axis": r.get("err_front_axis"),
+                "front_diagonal": r.get("err_front_diagonal"),
+                "commit": str(r.commit),
+                "N": int(r.n_particles),
+                "row": r,
+            }
+        )
     return out
 
 
 def fastest(points_, scene: str, model: str, target: float, mach: float) -> tuple[dict | None, dict | None]:
     """(the fastest run of ``scene``/``model`` at ``mach`` reaching ``target`` and not past its stable CFL,
     the fastest of the paper's method reaching it on the same kind of domain, threads and commit)."""
-    ok = [p for p in points_ if p["scene"] == scene and p["model"] == model and np.isclose(p["mach"], mach)
-          and p["error"] <= target and not p["past_stable"]]
+    ok = [
+        p
+        for p in points_
+        if p["scene"] == scene
+        and p["model"] == model
+        and np.isclose(p["mach"], mach)
+        and p["error"] <= target
+        and not p["past_stable"]
+    ]
     if not ok:
         return None, None
     best = min(ok, key=lambda p: p["seconds"])
-    paper = [p for p in ok if p["paper_method"] and p["domain"] == best["domain"] and p["threads"] == best["threads"]
-             and p["commit"] == best["commit"]]
+    paper = [
+        p
+        for p in ok
+        if p["paper_method"]
+        and p["domain"] == best["domain"]
+        and p["threads"] == best["threads"]
+        and p["commit"] == best["commit"]
+    ]
     return best, min(paper, key=lambda p: p["seconds"]) if paper else None
 
 
@@ -85,9 +119,17 @@ def time_to_accuracy(df) -> list[dict]:
                 best, paper = fastest(pts, scene, model, target, Scene.default("mach"))
                 if best is None:
                     continue
-                rows.append({"scene": scene, "model": model, "target": target, "best": best, "paper": paper,
-                             "predicted": predicted(best["row"]),
-                             "speedup": paper["seconds"] / best["seconds"] if paper else None})
+                rows.append(
+                    {
+                        "scene": scene,
+                        "model": model,
+                        "target": target,
+                        "best": best,
+                        "paper": paper,
+                        "predicted": predicted(best["row"]),
+                        "speedup": paper["seconds"] / best["seconds"] if paper else None,
+                    }
+                )
     return rows
 
 
@@ -121,9 +163,12 @@ def model_needs(df, target: float = MODEL_TARGET) -> list[dict]:
                 continue
             hits = [p for p in mine if p["isothermal_error"] <= target]
             best = min(hits, key=lambda p: p["seconds"]) if hits else None
-            row[model] = {"reaches": best is not None, "seconds": best["seconds"] if best else None,
-                          "dx": best["dx"] if best else None,
-                          "best": min(p["isothermal_error"] for p in mine)}
+            row[model] = {
+                "reaches": best is not None,
+                "seconds": best["seconds"] if best else None,
+                "dx": best["dx"] if best else None,
+                "best": min(p["isothermal_error"] for p in mine),
+            }
         if row.get("linear") or row.get("lagrangian"):
             rows.append(row)
     return rows
@@ -140,25 +185,54 @@ def phase_directions(methods, angles=np.linspace(0.0, np.pi / 4, 19)) -> list[di
 
     out = []
     for m in methods:
-        scene = Scene(dx=m["dx"], name="acoustic-pulse", kernel=m["kernel"], h_factor=m["h_factor"], cfl=m["cfl"],
-                      model="linear", t_end=T_FINAL, memory_limit_bytes=2**62)
+        scene = Scene(
+            dx=m["dx"],
+            name="acoustic-pulse",
+            kernel=m["kernel"],
+            h_factor=m["h_factor"],
+            cfl=m["cfl"],
+            model="linear",
+            t_end=T_FINAL,
+            memory_limit_bytes=2**62,
+        )
         short = scene.replace(pulse_width=SHORT_WAVE * scene.dx / (2 * np.pi))  # k = 1 / width
-        out.append({**m, "angles": np.degrees(angles), "error": [phase_errors(scene, a)[1] for a in angles],
-                    "short": [phase_errors(short, a)[1] for a in angles]})
+        out.append(
+            {
+                **m,
+                "angles": np.degrees(angles),
+                "error": [phase_errors(scene, a)[1] for a in angles],
+                "short": [phase_errors(short, a)[1] for a in angles],
+            }
+        )
     return out
 
 
 def front_shifts(points_, most: int = 12) -> list[dict]:
     """The 2D runs' wave front speed error along the lattice's axis and its diagonal, measured and predicted
     (the same measure on the predicted fields), for the fastest `linear` runs of the 2D scenes."""
-    runs = sorted((p for p in points_ if p["scene"] != DEFAULT_SCENE and p["model"] == "linear"
-                   and not p["past_stable"] and p["front_axis"] is not None and np.isfinite(p["front_axis"])),
-                  key=lambda p: p["seconds"])[:most]
+    runs = sorted(
+        (
+            p
+            for p in points_
+            if p["scene"] != DEFAULT_SCENE
+            and p["model"] == "linear"
+            and not p["past_stable"]
+            and p["front_axis"] is not None
+            and np.isfinite(p["front_axis"])
+        ),
+        key=lambda p: p["seconds"],
+    )[:most]
     out = []
     for p in runs:
         from solvers.dispersion import predict
 
         measures = predict(scene_of(p["row"]).replace(model="linear")).measures or {}
-        out.append({"method": p["method"], "dx": p["dx"], "measured": (p["front_axis"], p["front_diagonal"]),
-                    "predicted": (measures.get("front_axis"), measures.get("front_diagonal"))})
+        out.append(
+            {
+                "method": p["method"],
+                "dx": p["dx"],
+                "measured": (p["front_axis"], p["front_diagonal"]),
+                "predicted": (measures.get("front_axis"), measures.get("front_diagonal")),
+            }
+        )
     return out

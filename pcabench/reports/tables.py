@@ -8,6 +8,7 @@ threads), and rows of different protocols are never merged: a newest-run
 choice is always made within one protocol. The paper's numbers come from
 :mod:`.paper`, beside rows of the same kind only (device, search, serial, float64).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -86,20 +87,33 @@ def table4(df) -> list[dict]:
     keys = ["solver", "precision", "n_particles", *PROTOCOL]
     every = default_numerics(df[(df.status == "ok") & (df.model == "lagrangian") & (df.domain == "full")])
     # init is timed once per run: how far the stored reruns of one configuration (any commit) differ in it
-    spread = every.groupby(keys).t_init.agg(lambda x: x.max() / x.min() if len(x) > 1 and x.min() > 0 else 1.0) \
-        if not every.empty else {}
+    spread = (
+        every.groupby(keys).t_init.agg(lambda x: x.max() / x.min() if len(x) > 1 and x.min() > 0 else 1.0)
+        if not every.empty
+        else {}
+    )
     rows = []
-    for _, r in _newest_per(paper_scene(df), keys).sort_values(["solver", "precision", "threads", "loop",
-                                                                 "steps", "n_particles"]).iterrows():
-        row = {"config": label(r), "protocol": protocol(r), "run": r.protocol, "steps": int(r.steps),
-               "N": int(r.n_particles),
-               "device": r.device, "search": r.search, "threads": int(r.threads), "commit": str(r.commit)[:7]}
+    for _, r in (
+        _newest_per(paper_scene(df), keys)
+        .sort_values(["solver", "precision", "threads", "loop", "steps", "n_particles"])
+        .iterrows()
+    ):
+        row = {
+            "config": label(r),
+            "protocol": protocol(r),
+            "run": r.protocol,
+            "steps": int(r.steps),
+            "N": int(r.n_particles),
+            "device": r.device,
+            "search": r.search,
+            "threads": int(r.threads),
+            "commit": str(r.commit)[:7],
+        }
         row.update({s: 1e3 * r[f"t_{s}"] for s in ("input", "init", "output")})
         row["init_spread"] = float(spread.get(tuple(r[k] for k in keys), 1.0))
         row.update(per_step_ms(r))
         row["paper"] = P.same_kind(r.device, r.search, r.n_particles) if _paper_kind(r) else []
-        row["paper_stages"] = (P.table4().get(int(r.n_particles)) if r.device == "gpu" and _paper_kind(r)
-                               else None)
+        row["paper_stages"] = P.table4().get(int(r.n_particles)) if r.device == "gpu" and _paper_kind(r) else None
         rows.append(row)
     return rows
 
@@ -120,9 +134,18 @@ def table5(rows4) -> list[dict]:
                 paper = ("K20c, Table 5", t5[row["N"]])
             elif row["device"] == "cpu" and row["search"] == "linked list":
                 paper = ("Xeon, Fig. 11 text", [cpu[s] for s in STEP_STAGES])
-        rows.append({"config": row["config"], "protocol": row["protocol"], "run": row["run"], "N": row["N"],
-                     "device": row["device"], "search": row["search"],
-                     **{s: 100 * row[s] / total for s in STEP_STAGES}, "paper": paper})
+        rows.append(
+            {
+                "config": row["config"],
+                "protocol": row["protocol"],
+                "run": row["run"],
+                "N": row["N"],
+                "device": row["device"],
+                "search": row["search"],
+                **{s: 100 * row[s] / total for s in STEP_STAGES},
+                "paper": paper,
+            }
+        )
     return rows
 
 
@@ -132,9 +155,18 @@ def one_step_shares(rows4) -> list[dict]:
     rows = []
     for row in rows4:
         total = sum(row[s] for s in STAGES)
-        rows.append({"config": row["config"], "protocol": row["protocol"], "run": row["run"], "steps": row["steps"],
-                     "N": row["N"], "device": row["device"], "init_spread": row.get("init_spread", 1.0),
-                     **{s: 100 * row[s] / total for s in STAGES}})
+        rows.append(
+            {
+                "config": row["config"],
+                "protocol": row["protocol"],
+                "run": row["run"],
+                "steps": row["steps"],
+                "N": row["N"],
+                "device": row["device"],
+                "init_spread": row.get("init_spread", 1.0),
+                **{s: 100 * row[s] / total for s in STAGES},
+            }
+        )
     return rows
 
 
@@ -150,8 +182,11 @@ def table6(df_all) -> list[dict]:
     gpu = runs[runs.device == "gpu"]
     cpu = runs[(runs.device == "cpu") & (runs.search == "linked list") & (runs.precision == "float64")]
     rows = []
-    for _, g in _newest_per(gpu, ["profile_id", "precision", "n_particles", *PROTOCOL]) \
-            .sort_values(["profile_id", "n_particles", "precision", "steps"]).iterrows():
+    for _, g in (
+        _newest_per(gpu, ["profile_id", "precision", "n_particles", *PROTOCOL])
+        .sort_values(["profile_id", "n_particles", "precision", "steps"])
+        .iterrows()
+    ):
         same_n = cpu[(cpu.n_particles == g.n_particles) & (cpu.protocol == g.protocol)]
         serial = same_n[same_n.threads == 1]
         if serial.empty:
@@ -160,12 +195,22 @@ def table6(df_all) -> list[dict]:
         c = (here if not here.empty else serial).sort_values("timestamp").iloc[-1]
         multi = same_n[(same_n.threads > 1) & (same_n.profile_id == c.profile_id)]
         m = multi.sort_values(["threads", "timestamp"]).iloc[-1] if not multi.empty else None
-        rows.append({"gpu_profile": g.profile_id, "cpu_profile": c.profile_id, "same_machine": c.profile_id ==
-                     g.profile_id, "N": int(g.n_particles), "protocol": f"{g.protocol}, {g.domain}",
-                     "cpu_loop": c.loop, "precision": g.precision, "cpu_ms": 1e3 * c.t_step, "gpu_ms": 1e3 * g.t_step,
-                     "speedup": c.t_step / g.t_step,
-                     "cpu_threads": None if m is None else int(m.threads),
-                     "speedup_all_cores": None if m is None else m.t_step / g.t_step})
+        rows.append(
+            {
+                "gpu_profile": g.profile_id,
+                "cpu_profile": c.profile_id,
+                "same_machine": c.profile_id == g.profile_id,
+                "N": int(g.n_particles),
+                "protocol": f"{g.protocol}, {g.domain}",
+                "cpu_loop": c.loop,
+                "precision": g.precision,
+                "cpu_ms": 1e3 * c.t_step,
+                "gpu_ms": 1e3 * g.t_step,
+                "speedup": c.t_step / g.t_step,
+                "cpu_threads": None if m is None else int(m.threads),
+                "speedup_all_cores": None if m is None else m.t_step / g.t_step,
+            }
+        )
     return rows
 
 
@@ -182,13 +227,24 @@ def speed(df) -> list[dict]:
     runs = default_numerics(latest(df[(df.status == "ok") & (df.domain == "full")]))
     rows = []
     keys = ["solver", "precision", "model", "n_particles", *PROTOCOL]
-    for _, r in _newest_per(runs, keys).sort_values(["solver", "threads", "loop", "precision", "model", "steps",
-                                                     "n_particles"]).iterrows():
+    for _, r in (
+        _newest_per(runs, keys)
+        .sort_values(["solver", "threads", "loop", "precision", "model", "steps", "n_particles"])
+        .iterrows()
+    ):
         pairs = 2 * r.n_particles * r.mean_neighbours
-        rows.append({"config": label(r), "protocol": protocol(r), "model": r.model, "N": int(r.n_particles),
-                     "commit": str(r.commit)[:7], "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
-                     "ns_per_pair": 1e9 * r.t_step / pairs if pairs > 0 and r.search == "linked list" else None,
-                     "snp_pct": 100 * r.t_snp / (r.t_snp + r.t_pi + r.t_su)})
+        rows.append(
+            {
+                "config": label(r),
+                "protocol": protocol(r),
+                "model": r.model,
+                "N": int(r.n_particles),
+                "commit": str(r.commit)[:7],
+                "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
+                "ns_per_pair": 1e9 * r.t_step / pairs if pairs > 0 and r.search == "linked list" else None,
+                "snp_pct": 100 * r.t_snp / (r.t_snp + r.t_pi + r.t_su),
+            }
+        )
     return rows
 
 
@@ -206,8 +262,9 @@ def fig9(df) -> list[dict]:
     fewer points. Each row names it (``linkedlist_loop``).
     """
     runs = paper_scene(df)
-    serial = runs[(runs.device == "cpu") & (runs.search == "linked list") & (runs.threads == 1)
-                  & (runs.precision == "float64")]
+    serial = runs[
+        (runs.device == "cpu") & (runs.search == "linked list") & (runs.threads == 1) & (runs.precision == "float64")
+    ]
     everything = latest(default_numerics(df[(df.model == "lagrangian") & (df.domain == "full")]))
     ap_all = everything[everything.search == "all-pair"]
     # a run's length: the steps it made, or for a run that made none (skipped, timed out) the steps it asked for
@@ -222,19 +279,33 @@ def fig9(df) -> list[dict]:
         ok = g[g.status == "ok"]
         r = (ok if not ok.empty else g).sort_values("timestamp").iloc[-1]
         key = (int(steps), n)
-        row = {"steps": int(steps), "N": int(n), "allpair_ms": 1e3 * r.t_step if r.status == "ok" else None,
-               "allpair_status": r.status, "allpair_note": "" if r.status == "ok" else str(r.message),
-               "linkedlist_ms": 1e3 * ll.loc[key, "t_step"] if key in ll.index else None, "linkedlist_loop": loop}
-        row["eta"] = (row["allpair_ms"] / row["linkedlist_ms"]
-                      if row["allpair_ms"] and row["linkedlist_ms"] else None)
+        row = {
+            "steps": int(steps),
+            "N": int(n),
+            "allpair_ms": 1e3 * r.t_step if r.status == "ok" else None,
+            "allpair_status": r.status,
+            "allpair_note": "" if r.status == "ok" else str(r.message),
+            "linkedlist_ms": 1e3 * ll.loc[key, "t_step"] if key in ll.index else None,
+            "linkedlist_loop": loop,
+        }
+        row["eta"] = row["allpair_ms"] / row["linkedlist_ms"] if row["allpair_ms"] and row["linkedlist_ms"] else None
         rows.append(row)
     have = {(r["steps"], r["N"]) for r in rows}
     ap_steps = {r["steps"] for r in rows}
     for steps, n in ll.index:
         if (steps, n) not in have and steps in ap_steps:  # a linked-list run length all-pair never ran is not Fig. 9
-            rows.append({"steps": int(steps), "N": int(n), "allpair_ms": None, "allpair_status": "not run",
-                         "allpair_note": "", "linkedlist_ms": 1e3 * ll.loc[(steps, n), "t_step"], "eta": None,
-                         "linkedlist_loop": loop})
+            rows.append(
+                {
+                    "steps": int(steps),
+                    "N": int(n),
+                    "allpair_ms": None,
+                    "allpair_status": "not run",
+                    "allpair_note": "",
+                    "linkedlist_ms": 1e3 * ll.loc[(steps, n), "t_step"],
+                    "eta": None,
+                    "linkedlist_loop": loop,
+                }
+            )
     return sorted(rows, key=lambda r: (r["steps"], r["N"]))
 
 
@@ -256,9 +327,21 @@ def runtime_series(df) -> list[dict]:
     for _, g in runs.groupby(["solver", "precision", *PROTOCOL]):
         g = g.sort_values(["n_particles", "timestamp"]).drop_duplicates("n_particles", keep="last")
         r = g.iloc[0]
-        out.append({"config": label(r), "protocol": protocol(r), "run": r.protocol, "domain": r.domain,
-                    "loop": r.loop, "threads": int(r.threads), "precision": r.precision, "device": r.device,
-                    "search": r.search, "N": g.n_particles.astype(int).tolist(), "ms": (1e3 * g.t_step).tolist()})
+        out.append(
+            {
+                "config": label(r),
+                "protocol": protocol(r),
+                "run": r.protocol,
+                "domain": r.domain,
+                "loop": r.loop,
+                "threads": int(r.threads),
+                "precision": r.precision,
+                "device": r.device,
+                "search": r.search,
+                "N": g.n_particles.astype(int).tolist(),
+                "ms": (1e3 * g.t_step).tolist(),
+            }
+        )
     return out
 
 
@@ -284,9 +367,18 @@ def error_series(df) -> list[dict]:
         g = _newest_per(g, ["dx"]).sort_values("dx", ascending=False)
         if len(g) < 2:
             continue
-        series = {"model": model, "precision": precision, "protocol": protocol, "domain": domain,
-                  "dx": g.dx.tolist(), "N": g.n_particles.astype(int).tolist(), "mse": g.mse.tolist(),
-                  "me": g.me.tolist(), "t_final": g.t_final.tolist(), "order": fit_order(g.dx, g.mse)}
+        series = {
+            "model": model,
+            "precision": precision,
+            "protocol": protocol,
+            "domain": domain,
+            "dx": g.dx.tolist(),
+            "N": g.n_particles.astype(int).tolist(),
+            "mse": g.mse.tolist(),
+            "me": g.me.tolist(),
+            "t_final": g.t_final.tolist(),
+            "order": fit_order(g.dx, g.mse),
+        }
         series["stops_falling"] = stops_falling(series["dx"], series["mse"])
         out.append(series)
     return sorted(out, key=lambda s: (s["protocol"], s["domain"], s["model"], s["precision"]))
@@ -307,7 +399,7 @@ def stops_falling(dx, err, gain=0.75):
     """The dx below which refining no longer cuts the error by 25 % per halving, or None."""
     for i in range(len(dx) - 1):
         ratio = np.log(dx[i] / dx[i + 1]) / np.log(2)  # halvings between the two
-        if err[i + 1] > err[i] * gain ** ratio:
+        if err[i + 1] > err[i] * gain**ratio:
             return dx[i]
     return None
 
@@ -315,19 +407,36 @@ def stops_falling(dx, err, gain=0.75):
 def accuracy_bars(series) -> list[dict]:
     """The issue's bars, from Fig. 8's ``series``: linear, Verlet, cutoff 3h, strip, t = 10 s: order >= 1 and
     < 2 % at dx = 0.05."""
-    series = [s for s in series if s["model"] == "linear" and s["protocol"] == "t = 10 s"
-              and s["domain"] == "strip" and s["precision"] == "float64"]
+    series = [
+        s
+        for s in series
+        if s["model"] == "linear"
+        and s["protocol"] == "t = 10 s"
+        and s["domain"] == "strip"
+        and s["precision"] == "float64"
+    ]
     if not series:
-        return [{"bar": "linear, t = 10 s, strip: order >= 1 and error < 2 % at dx = 0.05",
-                 "measured": "not measured", "verdict": "not measured"}]
+        return [
+            {
+                "bar": "linear, t = 10 s, strip: order >= 1 and error < 2 % at dx = 0.05",
+                "measured": "not measured",
+                "verdict": "not measured",
+            }
+        ]
     s = series[0]
     at = dict(zip(np.round(s["dx"], 9), s["mse"]))
     e05 = at.get(0.05)
     return [
-        {"bar": f"fitted order >= 1 (dx = {', '.join(f'{d:g}' for d in s['dx'])})",
-         "measured": f"{s['order']:.2f}", "verdict": "met" if s["order"] >= 1 else "missed"},
-        {"bar": "relative RMS < 2 % at dx = 0.05", "measured": "not measured" if e05 is None else f"{100 * e05:.2f} %",
-         "verdict": "not measured" if e05 is None else "met" if e05 < 0.02 else "missed"},
+        {
+            "bar": f"fitted order >= 1 (dx = {', '.join(f'{d:g}' for d in s['dx'])})",
+            "measured": f"{s['order']:.2f}",
+            "verdict": "met" if s["order"] >= 1 else "missed",
+        },
+        {
+            "bar": "relative RMS < 2 % at dx = 0.05",
+            "measured": "not measured" if e05 is None else f"{100 * e05:.2f} %",
+            "verdict": "not measured" if e05 is None else "met" if e05 < 0.02 else "missed",
+        },
     ]
 
 
@@ -342,7 +451,8 @@ def numerics_label(r) -> str:
 def is_paper_method(r) -> bool:
     """The paper's numerics: the Gaussian at Scene's default h/dx, cutoff, CFL and integrator."""
     return r["kernel"] == DEFAULT_KERNEL and all(
-        (r[k] == v) if isinstance(v, str) else bool(np.isclose(float(r[k]), v)) for k, v in DEFAULT_NUMERICS.items())
+        (r[k] == v) if isinstance(v, str) else bool(np.isclose(float(r[k]), v)) for k, v in DEFAULT_NUMERICS.items()
+    )
 
 
 FRONT_MODELS = ("linear", "lagrangian")  # fixed solves neither equation: it is in the simplifications' table
@@ -370,20 +480,41 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
     from pcabench.stability import assess
 
     accuracy_runs = df.preset != "stability-long"  # runs to t = 300 s to measure a stable step, not an error
-    pts = latest(df[(df.status == "ok") & df.protocol.str.startswith("t =") & df.model.isin(FRONT_MODELS)
-                    & accuracy_runs])
+    pts = latest(
+        df[(df.status == "ok") & df.protocol.str.startswith("t =") & df.model.isin(FRONT_MODELS) & accuracy_runs]
+    )
     points = []
     for _, r in pts.iterrows():
         error = r[error_column(r.model)]
         if error is None or not np.isfinite(error):
             continue
-        points.append({"config": label(r), "method": numerics_label(r), "paper_method": is_paper_method(r),
-                       "kernel": r["kernel"], "h_factor": r.h_factor, "cfl": r.cfl,
-                       "integrator": r.integrator, "cutoff_factor": r.cutoff_factor, "precision": r.precision,
-                       "model": r.model, "domain": r.domain, "dx": r.dx, "N": int(r.n_particles),
-                       "t_final": r.t_final, "seconds": r.t_solution, "error": float(error), "mse": r.mse,
-                       "strip_height": r.strip_height, "solver": r.solver, "threads": int(r.threads),
-                       "commit": str(r.commit), "steps": int(r.steps), **assess(r)})
+        points.append(
+            {
+                "config": label(r),
+                "method": numerics_label(r),
+                "paper_method": is_paper_method(r),
+                "kernel": r["kernel"],
+                "h_factor": r.h_factor,
+                "cfl": r.cfl,
+                "integrator": r.integrator,
+                "cutoff_factor": r.cutoff_factor,
+                "precision": r.precision,
+                "model": r.model,
+                "domain": r.domain,
+                "dx": r.dx,
+                "N": int(r.n_particles),
+                "t_final": r.t_final,
+                "seconds": r.t_solution,
+                "error": float(error),
+                "mse": r.mse,
+                "strip_height": r.strip_height,
+                "solver": r.solver,
+                "threads": int(r.threads),
+                "commit": str(r.commit),
+                "steps": int(r.steps),
+                **assess(r),
+            }
+        )
     return points, fronts([p for p in points if not p["past_limit"]])
 
 
@@ -392,8 +523,10 @@ def fronts(points) -> list[dict]:
     front = []
     for t_final, model in sorted({(p["t_final"], p["model"]) for p in points}):
         best = np.inf
-        for p in sorted((p for p in points if p["t_final"] == t_final and p["model"] == model),
-                        key=lambda p: (p["seconds"], p["error"])):
+        for p in sorted(
+            (p for p in points if p["t_final"] == t_final and p["model"] == model),
+            key=lambda p: (p["seconds"], p["error"]),
+        ):
             if p["error"] < best:
                 best = p["error"]
                 front.append(p)
@@ -423,8 +556,9 @@ def predicted_error(p: dict) -> float:
         scene["cutoff_factor"] = p.get("cutoff_factor") or Scene.default("cutoff_factor")
     strip = p.get("strip_height")
     strip = None if strip is None or (isinstance(strip, float) and np.isnan(strip)) else strip
-    return predict(Scene(dx=p["dx"], t_end=p["t_final"], model="linear", strip_height=strip,
-                         memory_limit_bytes=2**62, **scene)).predicted_error
+    return predict(
+        Scene(dx=p["dx"], t_end=p["t_final"], model="linear", strip_height=strip, memory_limit_bytes=2**62, **scene)
+    ).predicted_error
 
 
 def predicted_by_model(df, dxs=(0.4, 0.2, 0.1)) -> list[dict]:
@@ -437,10 +571,25 @@ def predicted_by_model(df, dxs=(0.4, 0.2, 0.1)) -> list[dict]:
             if r.empty:
                 continue
             r = r.sort_values("timestamp").iloc[-1]
-            p = {"kernel": DEFAULT_KERNEL, "h_factor": r.h_factor, "cfl": r.cfl, "integrator": r.integrator,
-                 "cutoff_factor": r.cutoff_factor, "dx": dx, "t_final": r.t_final, "strip_height": r.strip_height}
-            rows.append({"model": model, "dx": dx, "measured": r.mse, "predicted": predicted_error(p),
-                         "isothermal": r.mse_isothermal if model == "lagrangian" else None})
+            p = {
+                "kernel": DEFAULT_KERNEL,
+                "h_factor": r.h_factor,
+                "cfl": r.cfl,
+                "integrator": r.integrator,
+                "cutoff_factor": r.cutoff_factor,
+                "dx": dx,
+                "t_final": r.t_final,
+                "strip_height": r.strip_height,
+            }
+            rows.append(
+                {
+                    "model": model,
+                    "dx": dx,
+                    "measured": r.mse,
+                    "predicted": predicted_error(p),
+                    "isothermal": r.mse_isothermal if model == "lagrangian" else None,
+                }
+            )
     return rows
 
 
@@ -455,14 +604,25 @@ def fastest_to(points, targets=(0.10, 0.05, 0.02, 0.01, 0.005)) -> list[dict]:
     (``past_limit``) are never picked."""
     rows = []
     for t_final, model in sorted({(p["t_final"], p["model"]) for p in points}):
-        pts = sorted((p for p in points if p["t_final"] == t_final and p["model"] == model
-                      and not p.get("past_limit")), key=lambda p: p["seconds"])
+        pts = sorted(
+            (p for p in points if p["t_final"] == t_final and p["model"] == model and not p.get("past_limit")),
+            key=lambda p: p["seconds"],
+        )
         for target in targets:
             hit = next((p for p in pts if p["error"] <= target), None)
-            paper = hit and next((p for p in pts if p["error"] <= target and p["paper_method"] and comparable(p, hit)),
-                                 None)
-            rows.append({"t_final": t_final, "model": model, "target": target, "best": hit, "paper": paper,
-                         "speedup": paper["seconds"] / hit["seconds"] if hit and paper else None})
+            paper = hit and next(
+                (p for p in pts if p["error"] <= target and p["paper_method"] and comparable(p, hit)), None
+            )
+            rows.append(
+                {
+                    "t_final": t_final,
+                    "model": model,
+                    "target": target,
+                    "best": hit,
+                    "paper": paper,
+                    "speedup": paper["seconds"] / hit["seconds"] if hit and paper else None,
+                }
+            )
     return rows
 
 
@@ -489,12 +649,20 @@ def simplifications(df) -> list[dict]:
                 continue
             a, b = a.sort_values("timestamp").iloc[-1], b.sort_values("timestamp").iloc[-1]
             ctx = dict(zip(keys, key))
-            rows.append({"simplification": what,
-                         "runs": " ".join(str(ctx[k]) for k in ("solver", "model", "precision", "domain", "protocol")
-                                          if k in ctx) + f", {ctx['loop']}, {where(ctx['threads'], a.device)}",
-                         "dx": ctx["dx"], "N": (int(a.n_particles), int(b.n_particles)),
-                         "seconds": (a.t_solution, b.t_solution), "speedup": a.t_solution / b.t_solution,
-                         "mse": (a.mse, b.mse)})
+            rows.append(
+                {
+                    "simplification": what,
+                    "runs": " ".join(
+                        str(ctx[k]) for k in ("solver", "model", "precision", "domain", "protocol") if k in ctx
+                    )
+                    + f", {ctx['loop']}, {where(ctx['threads'], a.device)}",
+                    "dx": ctx["dx"],
+                    "N": (int(a.n_particles), int(b.n_particles)),
+                    "seconds": (a.t_solution, b.t_solution),
+                    "speedup": a.t_solution / b.t_solution,
+                    "mse": (a.mse, b.mse),
+                }
+            )
     return rows
 
 
@@ -545,8 +713,14 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
     """
     from pcabench.stability import UNSTABLE_BY_PREDICTION, assess, e_foldings
 
-    runs = latest(df[df.preset.isin(["stability", "quick"]) & df.protocol.str.startswith("t =")
-                     & (df.model == "linear") & (df.domain == "strip")])
+    runs = latest(
+        df[
+            df.preset.isin(["stability", "quick"])
+            & df.protocol.str.startswith("t =")
+            & (df.model == "linear")
+            & (df.domain == "strip")
+        ]
+    )
     keys = ["integrator", "kernel", "h_factor", "cutoff_factor", "precision", "protocol", "dx"]
     if not runs.empty:
         sweeps = runs.groupby(keys + ["preset"]).cfl.transform("nunique")
@@ -563,25 +737,49 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
             a = assess(r)
             cls = classify(r, inaccurate_above, a["past_limit"])
             steps = r.steps if r.status == "ok" else r.steps_requested
-            mine.append({"config": name, "cfl": float(r.cfl), "class": cls, "mse": r.mse,
-                         "failed_step": _step_or_none(r.failed_step), "steps": _step_or_none(steps),
-                         "stable_cfl": a["stable_cfl"], "past_limit": a["past_limit"],
-                         "limit_from": a["limit_from"], "predicted": a["predicted"],
-                         "e_foldings": e_foldings(r, int(r.steps)) if cls == UNSTABLE_BY_PREDICTION else None})
+            mine.append(
+                {
+                    "config": name,
+                    "cfl": float(r.cfl),
+                    "class": cls,
+                    "mse": r.mse,
+                    "failed_step": _step_or_none(r.failed_step),
+                    "steps": _step_or_none(steps),
+                    "stable_cfl": a["stable_cfl"],
+                    "past_limit": a["past_limit"],
+                    "limit_from": a["limit_from"],
+                    "predicted": a["predicted"],
+                    "e_foldings": e_foldings(r, int(r.steps)) if cls == UNSTABLE_BY_PREDICTION else None,
+                }
+            )
         points += mine
-        limits.append({"config": name, "integrator": integ, "kernel": kern, "h_factor": h, "precision": precision,
-                       "protocol": protocol, "dx": dx, "cfls": [p["cfl"] for p in mine],
-                       "stable_cfl": mine[0]["stable_cfl"], "limit_from": mine[0]["limit_from"],
-                       "predicted": mine[0]["predicted"],
-                       "accurate_at": [p["cfl"] for p in mine if p["class"] == "stable"],
-                       "inaccurate_at": [(p["cfl"], p["mse"]) for p in mine if p["class"] == "inaccurate"],
-                       "blew_up_at": [(p["cfl"], p["failed_step"]) for p in mine if p["class"] == "unstable"],
-                       "bounded_past_limit": [(p["cfl"], p["steps"], p["e_foldings"]) for p in mine
-                                              if p["class"] == UNSTABLE_BY_PREDICTION],
-                       "blew_up_below_limit": [p["cfl"] for p in mine
-                                               if p["class"] == "unstable" and not p["past_limit"]],
-                       "other": [(p["cfl"], p["class"]) for p in mine if p["class"] not in
-                                 ("stable", "inaccurate", "unstable", UNSTABLE_BY_PREDICTION)]})
+        limits.append(
+            {
+                "config": name,
+                "integrator": integ,
+                "kernel": kern,
+                "h_factor": h,
+                "precision": precision,
+                "protocol": protocol,
+                "dx": dx,
+                "cfls": [p["cfl"] for p in mine],
+                "stable_cfl": mine[0]["stable_cfl"],
+                "limit_from": mine[0]["limit_from"],
+                "predicted": mine[0]["predicted"],
+                "accurate_at": [p["cfl"] for p in mine if p["class"] == "stable"],
+                "inaccurate_at": [(p["cfl"], p["mse"]) for p in mine if p["class"] == "inaccurate"],
+                "blew_up_at": [(p["cfl"], p["failed_step"]) for p in mine if p["class"] == "unstable"],
+                "bounded_past_limit": [
+                    (p["cfl"], p["steps"], p["e_foldings"]) for p in mine if p["class"] == UNSTABLE_BY_PREDICTION
+                ],
+                "blew_up_below_limit": [p["cfl"] for p in mine if p["class"] == "unstable" and not p["past_limit"]],
+                "other": [
+                    (p["cfl"], p["class"])
+                    for p in mine
+                    if p["class"] not in ("stable", "inaccurate", "unstable", UNSTABLE_BY_PREDICTION)
+                ],
+            }
+        )
     return points, limits
 
 
@@ -602,23 +800,41 @@ def long_run_limits(df, preset: str = "stability-long") -> list[dict]:
     from pcabench.stability import assess, e_foldings, measured_limit
 
     runs = latest(df[df.preset == preset]) if "preset" in df else df.iloc[:0]
-    keys = ["scene", "mach", "model", "kernel", "h_factor", "cutoff_factor", "integrator", "precision", "dx",
-            "protocol"]
+    keys = [
+        "scene",
+        "mach",
+        "model",
+        "kernel",
+        "h_factor",
+        "cutoff_factor",
+        "integrator",
+        "precision",
+        "dx",
+        "protocol",
+    ]
     out = []
     for key, g in runs.groupby(keys, sort=False):
         row = dict(zip(keys, key))
         g = g.sort_values("cfl")
         blew = [(float(r.cfl), _step_or_none(r.failed_step)) for _, r in g.iterrows() if r.status == "unstable"]
         first_blow = blew[0][0] if blew else None
-        bounded = [float(r.cfl) for _, r in g.iterrows() if r.status == "ok"
-                   and (first_blow is None or r.cfl < first_blow)]
+        bounded = [
+            float(r.cfl) for _, r in g.iterrows() if r.status == "ok" and (first_blow is None or r.cfl < first_blow)
+        ]
         top = g[g.cfl == max(bounded)].iloc[0] if bounded else None
         held = measured_limit(row)
-        row.update(cfls=[float(c) for c in g.cfl], predicted=assess({**row, "cfl": 1.0})["predicted"], bounded_to=max(bounded) if bounded else None, blew_up_from=first_blow,
-                   first_step=blew[0][1] if blew else None, blew_up_at=blew,
-                   steps=int(g.steps.max()), other=[(float(r.cfl), r.status) for _, r in g.iterrows()
-                                                    if r.status not in ("ok", "unstable")],
-                   e_foldings=_fold(e_foldings(top, int(top.steps))) if top is not None else None, held=held)
+        row.update(
+            cfls=[float(c) for c in g.cfl],
+            predicted=assess({**row, "cfl": 1.0})["predicted"],
+            bounded_to=max(bounded) if bounded else None,
+            blew_up_from=first_blow,
+            first_step=blew[0][1] if blew else None,
+            blew_up_at=blew,
+            steps=int(g.steps.max()),
+            other=[(float(r.cfl), r.status) for _, r in g.iterrows() if r.status not in ("ok", "unstable")],
+            e_foldings=_fold(e_foldings(top, int(top.steps))) if top is not None else None,
+            held=held,
+        )
         out.append(row)
     return out
 
@@ -635,8 +851,16 @@ def float32_vs_float64(df, tolerance: float = 0.10) -> list[dict]:
             continue
         pairs = [(d, a.loc[d, "mse"], b.loc[d, "mse"]) for d in both]
         bad = next((d for d, e64, e32 in pairs if abs(e32 / e64 - 1) > tolerance), None)
-        out.append({"model": model, "protocol": protocol, "domain": domain, "pairs": pairs,
-                    "stops_at": bad, "tolerance": tolerance})
+        out.append(
+            {
+                "model": model,
+                "protocol": protocol,
+                "domain": domain,
+                "pairs": pairs,
+                "stops_at": bad,
+                "tolerance": tolerance,
+            }
+        )
     return out
 
 
@@ -651,12 +875,20 @@ def cards(df_all) -> list[dict]:
         per = per_step_ms(r)
         total = sum(per.values())
         pairs = 2 * r.n_particles * (r.mean_neighbours if np.isfinite(r.mean_neighbours or np.nan) else np.nan)
-        rows.append({"profile": r.profile_id, "card": card, "precision": r.precision, "N": int(r.n_particles),
-                     "protocol": f"{r.protocol}, {r.domain}",
-                     "step_ms": 1e3 * r.t_step, **{f"{s}_ms": v for s, v in per.items()},
-                     **{f"{s}_pct": 100 * v / total if total else np.nan for s, v in per.items()},
-                     "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
-                     "ps_per_pair": 1e12 * r.t_step / pairs if pairs and np.isfinite(pairs) else np.nan})
+        rows.append(
+            {
+                "profile": r.profile_id,
+                "card": card,
+                "precision": r.precision,
+                "N": int(r.n_particles),
+                "protocol": f"{r.protocol}, {r.domain}",
+                "step_ms": 1e3 * r.t_step,
+                **{f"{s}_ms": v for s, v in per.items()},
+                **{f"{s}_pct": 100 * v / total if total else np.nan for s, v in per.items()},
+                "ns_per_particle_step": 1e9 * r.t_step / r.n_particles,
+                "ps_per_pair": 1e12 * r.t_step / pairs if pairs and np.isfinite(pairs) else np.nan,
+            }
+        )
     return rows
 
 
@@ -668,8 +900,13 @@ def card_ceilings(rows) -> list[dict]:
         prof = profiles.stored().get(pid, {})
         measured = prof.get("measured") or {}
         if measured:
-            out.append({"profile": pid, "card": (prof.get("gpu") or {}).get("name", pid),
-                        **{k: measured.get(k) for k in ("copy_bandwidth_tbs", "fp32_fma_tflops", "fp64_fma_tflops")}})
+            out.append(
+                {
+                    "profile": pid,
+                    "card": (prof.get("gpu") or {}).get("name", pid),
+                    **{k: measured.get(k) for k in ("copy_bandwidth_tbs", "fp32_fma_tflops", "fp64_fma_tflops")},
+                }
+            )
     return out
 
 
@@ -680,16 +917,24 @@ def card_ratios(rows) -> list[dict]:
     out = []
     pids = sorted(ceil)
     for i, a in enumerate(pids):
-        for b in pids[i + 1:]:
+        for b in pids[i + 1 :]:
             ta = {(r["precision"], r["N"], r["protocol"]): r["step_ms"] for r in rows if r["profile"] == a}
             tb = {(r["precision"], r["N"], r["protocol"]): r["step_ms"] for r in rows if r["profile"] == b}
             for key in sorted(set(ta) & set(tb)):
                 precision, n, how = key
                 fma = "fp32_fma_tflops" if precision == "float32" else "fp64_fma_tflops"
-                out.append({"a": ceil[a]["card"], "b": ceil[b]["card"], "precision": precision, "N": n,
-                            "protocol": how, "speed_ratio": tb[key] / ta[key],
-                            "bandwidth_ratio": _ratio(ceil[a]["copy_bandwidth_tbs"], ceil[b]["copy_bandwidth_tbs"]),
-                            "fma_ratio": _ratio(ceil[a][fma], ceil[b][fma])})
+                out.append(
+                    {
+                        "a": ceil[a]["card"],
+                        "b": ceil[b]["card"],
+                        "precision": precision,
+                        "N": n,
+                        "protocol": how,
+                        "speed_ratio": tb[key] / ta[key],
+                        "bandwidth_ratio": _ratio(ceil[a]["copy_bandwidth_tbs"], ceil[b]["copy_bandwidth_tbs"]),
+                        "fma_ratio": _ratio(ceil[a][fma], ceil[b][fma]),
+                    }
+                )
     return out
 
 
@@ -700,5 +945,8 @@ def _ratio(x, y):
 def cards_published() -> list[dict]:
     """The paper's cards, one step (ms) by N, one source per card: the K20c's Table 4 (measured per step),
     the other two cards' Table 6 (:mod:`.paper` states the conversion)."""
-    return [r for r in P.step_times() if r["device"] == "gpu"
-            and r["source"] == ("Table 4" if r["system"] == "paper-system-1" else "Table 6")]
+    return [
+        r
+        for r in P.step_times()
+        if r["device"] == "gpu" and r["source"] == ("Table 4" if r["system"] == "paper-system-1" else "Table 6")
+    ]

@@ -215,7 +215,8 @@ def _accuracy_text(rows) -> list[str]:
         "linear solution (the pulse plus its mirror image): u for plane-wall, drho for pulse-wall, relative RMS "
         "over the domain; near the wall (the particles within a cutoff of a wall, the ones with mirror "
         "neighbours) and in the bulk (the others), each over the RMS of the reference over the whole domain, "
-        "so that their squares, weighted by each band's share of the particles, add up to the whole's square. The prediction (`pcabench accuracy --scene NAME`) "
+        "so that their squares, weighted by each band's share of the particles, add up to the whole's square. "
+        "The prediction (`pcabench accuracy --scene NAME`) "
         "is the dispersion relation's on the mirror extension of the lattice: exact for `linear` where that "
         "extension is the run's whole problem; for `lagrangian` it is the linear part only.",
         "",
@@ -302,7 +303,8 @@ def _stability_text(rows) -> list[str]:
         "",
         "`pcabench study --walls`: on each wall scene at dx = 0.25 to t = 300 s (long enough for round-off to "
         "grow, as the long runs of the free scenes; the plane pulse at Mach 0.01 so that it does not break "
-        "before then, the 2D pulse, which spreads and never breaks, at the default 0.05), the linear model of each kernel at CFLs bracketing its "
+        "before then, the 2D pulse, which spreads and never breaks, at the default 0.05), the linear model of each "
+        "kernel at CFLs bracketing its "
         "predicted stable CFL, and the paper's method in every model at the free long runs' CFLs. Beside each, "
         "the same model and method's long runs on the free counterpart (`--stability long`: the plane pulse's "
         "strip with free ends, the 2D pulse's periodic square) where they were made. 'e-foldings': how far the "
