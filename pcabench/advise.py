@@ -187,7 +187,6 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                         model="linear",
                         kernel=kern,
                         h_factor=h,
-                        memory_limit_bytes=2**62,
                     )
                 except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
                     continue
@@ -204,7 +203,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                 break
     for dx in sorted(dxs, reverse=True):  # the coarsest dx at which the paper's configuration reaches the error
         try:
-            candidate = Scene(dx=dx, name=scene, t_end=t_end, model="linear", memory_limit_bytes=2**62)
+            candidate = Scene(dx=dx, name=scene, t_end=t_end, model="linear")
         except Exception:  # noqa: BLE001 - a dx the scene refuses (its wall inside the support) is not searched
             continue
         if predict(candidate).predicted_error <= error:

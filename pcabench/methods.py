@@ -34,7 +34,7 @@ def cost(scene: Scene) -> float:
 
 def _stable(kernel: str, h_factor: float) -> float:
     """The predicted stable CFL of Verlet with ``kernel`` at ``h_factor`` (independent of dx)."""
-    return stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h_factor, model="linear", memory_limit_bytes=2**62))
+    return stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h_factor, model="linear"))
 
 
 def fastest(
@@ -63,7 +63,6 @@ def _fastest(error: float, t_end: float, model: str, name: str, per_kernel: int,
                     cfl=round(share * limit, 2),
                     t_end=t_end,
                     model="linear",
-                    memory_limit_bytes=2**62,
                 )
             except ValueError:  # a combination Scene refuses is not a candidate
                 continue

@@ -196,7 +196,7 @@ def walls() -> list[RunSpec]:
         if mach is not None:
             base["mach"] = mach
         for kernel, h in WALL_LINEAR_METHODS:
-            limit = stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear", memory_limit_bytes=2**62))
+            limit = stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear"))
             runs += [
                 _spec(kernel=kernel, h_factor=h, model="linear", cfl=round(f * limit, 2), **base) for f in WALL_BRACKET
             ]
@@ -250,7 +250,7 @@ def fast_methods(model: str) -> tuple[dict, ...]:
 
     from .methods import fastest
 
-    paper = predict(Scene(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model="linear", memory_limit_bytes=2**62))
+    paper = predict(Scene(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model="linear"))
     return tuple(
         {k: m[k] for k in ("kernel", "h_factor", "cfl", "dx")}
         for m in fastest(paper.predicted_error, FRONT_T_END, model)

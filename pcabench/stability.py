@@ -63,7 +63,7 @@ def _scene(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, 
     method = {"kernel": kernel, "h_factor": h_factor, "integrator": integrator}
     if truncated(kernel):  # a kernel of compact support (the Wendland kernels) is cut there
         method["cutoff_factor"] = cutoff_factor
-    return Scene(dx=dx, t_end=1.0, model="linear", memory_limit_bytes=2**62, **method)
+    return Scene(dx=dx, t_end=1.0, model="linear", **method)
 
 
 @lru_cache(maxsize=1024)

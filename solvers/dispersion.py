@@ -188,7 +188,6 @@ def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: 
         cutoff_factor=cutoff_factor,
         integrator=integrator,
         model="linear",
-        memory_limit_bytes=2**62,
     )
     return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
 

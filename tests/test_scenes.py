@@ -227,7 +227,7 @@ def test_the_fast_methods_come_from_the_prediction():
     from pcabench.methods import MARGIN, fastest
     from pcabench.presets import fast_methods
 
-    paper = predict(Scene(dx=0.05, t_end=10.0, model="linear", memory_limit_bytes=2**62)).predicted_error
+    paper = predict(Scene(dx=0.05, t_end=10.0, model="linear")).predicted_error
     found = fastest(paper, 10.0, "linear")
     assert len({m["kernel"] for m in found}) == len(found) == 3
     for m in found:
@@ -239,7 +239,6 @@ def test_the_fast_methods_come_from_the_prediction():
             kernel=m["kernel"],
             h_factor=m["h_factor"],
             cfl=m["cfl"],
-            memory_limit_bytes=2**62,
         )
         assert predict(scene).predicted_error == pytest.approx(m["predicted_error"])
     assert [dict(kernel=m["kernel"], h_factor=m["h_factor"], cfl=m["cfl"], dx=m["dx"]) for m in found] == list(

@@ -29,7 +29,7 @@ MODEL_TARGET = 0.02  # "which model this scene needs": the error against the iso
 
 def scene_of(r) -> Scene:
     """The Scene of a frame row (its stored parameters; the defaults where it predates them)."""
-    return Scene(**stored_parameters(json.loads(r.scene_key)), memory_limit_bytes=2**62)
+    return Scene(**stored_parameters(json.loads(r.scene_key)))
 
 
 def stable_cfl_of(r) -> float:
@@ -144,7 +144,7 @@ def predicted(r) -> float:
 def linear_floor(name: str, mach: float, t_final: float) -> float | None:
     """The `linear` model's error floor against the isothermal physics (exact linear against isothermal
     solution, no discretisation) for scene ``name`` at ``mach`` and ``t_final``, on a 0.1 m lattice."""
-    scene = Scene(dx=0.1, name=name, mach=mach, t_end=t_final, model="linear", memory_limit_bytes=2**62)
+    scene = Scene(dx=0.1, name=name, mach=mach, t_end=t_final, model="linear")
     return scene.kind.linear_floor(scene)
 
 
@@ -193,7 +193,6 @@ def phase_directions(methods, angles=np.linspace(0.0, np.pi / 4, 19)) -> list[di
             cfl=m["cfl"],
             model="linear",
             t_end=T_FINAL,
-            memory_limit_bytes=2**62,
         )
         short = scene.replace(pulse_width=SHORT_WAVE * scene.dx / (2 * np.pi))  # k = 1 / width
         out.append(

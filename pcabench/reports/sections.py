@@ -617,7 +617,7 @@ def _why_the_paper_method() -> list[str]:  # pure: cached, as every report shows
     """Why the paper's h and dt sit where they do, from the prediction at its own scene's dx."""
     from solvers.dispersion import lattice_offsets, predict
 
-    base = Scene(dx=0.1, t_end=10.0, model="linear", memory_limit_bytes=2**62)
+    base = Scene(dx=0.1, t_end=10.0, model="linear")
     rows = []
     for what, scene in (
         ("the paper's method", base),

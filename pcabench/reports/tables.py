@@ -556,9 +556,7 @@ def predicted_error(p: dict) -> float:
         scene["cutoff_factor"] = p.get("cutoff_factor") or Scene.default("cutoff_factor")
     strip = p.get("strip_height")
     strip = None if strip is None or (isinstance(strip, float) and np.isnan(strip)) else strip
-    return predict(
-        Scene(dx=p["dx"], t_end=p["t_final"], model="linear", strip_height=strip, memory_limit_bytes=2**62, **scene)
-    ).predicted_error
+    return predict(Scene(dx=p["dx"], t_end=p["t_final"], model="linear", strip_height=strip, **scene)).predicted_error
 
 
 def predicted_by_model(df, dxs=(0.4, 0.2, 0.1)) -> list[dict]:
