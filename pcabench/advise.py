@@ -16,7 +16,6 @@ that would.
 from __future__ import annotations
 
 import itertools
-import json
 import shlex
 
 import numpy as np
@@ -59,7 +58,7 @@ def command(r, t_end: float | None = None) -> str:
     shell). ``t_end`` is the run's own (kept for callers)."""
     from .commands import line_of, words_of
 
-    scene = scene_from_row({"scene": json.loads(r["scene_key"])})
+    scene = scene_from_row(r)
     return line_of(*words_of(str(r["solver"]), scene, int(r["threads"]), str(r.get("pair_loop") or "")))
 
 

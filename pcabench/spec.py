@@ -159,8 +159,14 @@ def stored_parameters(scene: dict) -> dict:
     return {k: fields[k].default if scene.get(k) is None else scene[k] for k in fields if fields[k].compare}
 
 
-def scene_from_row(row: dict) -> Scene:
-    """The Scene of a stored row (derived keys dropped)."""
+def scene_from_row(row) -> Scene:
+    """The Scene of a run: a stored row (its ``scene`` dict) or a row of the reports' frame (its ``scene_key``);
+    derived keys dropped, each parameter the row predates at its default. The one way from a record to a
+    Scene."""
+    if "scene_key" in row and isinstance(row["scene_key"], str):
+        import json as _json
+
+        return Scene(**stored_parameters(_json.loads(row["scene_key"])))
     return Scene(**stored_parameters(row.get("scene") or {}))
 
 

@@ -487,7 +487,8 @@ def test_a_stored_message_cannot_add_cells_tags_or_images_to_a_report(tmp_path, 
     code, _, err = cli_main("report", "--results", str(results), "--out", str(tmp_path / "out"), capsys=capsys)
     assert code == 0, err
     text = (tmp_path / "out" / "m" / "report.md").read_text()
-    assert "<script>" not in text and "![remote]" not in text and "](http://example.com" not in text
+    assert "<script>" not in text and "![remote]" not in text
+    assert not re.search(r"(?<!\\)\]\(http://example\.com", text)  # no link or image syntax left live
     lines = text.splitlines()
     (at,) = [i for i, ln in enumerate(lines) if "alert" in ln]
     top = at

@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 
-_ACTIVE = re.compile(r"([\\`*_\[\]()!#~|])")  # what Markdown reads as syntax: emphasis, links, images, code
+_ACTIVE = re.compile(r"([\\`*_\[\]!~|])")  # what Markdown reads as syntax here: emphasis, links, images, code
 
 
 def md_cell(value) -> str:

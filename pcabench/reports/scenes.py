@@ -11,12 +11,11 @@ too short for round-off to grow.
 
 from __future__ import annotations
 
-import json
 from functools import lru_cache
 
 import numpy as np
 
-from pcabench.spec import stored_parameters
+from pcabench.spec import scene_from_row
 from pcabench.stability import past_limit, stable_limit
 from solvers import DEFAULT_SCENE, Scene
 
@@ -25,11 +24,6 @@ from .tables import is_paper_method, latest, numerics_label
 TARGETS = (0.10, 0.05, 0.02)  # relative RMS errors of the primary field
 T_FINAL = 10.0  # s
 MODEL_TARGET = 0.02  # "which model this scene needs": the error against the isothermal physics asked for
-
-
-def scene_of(r) -> Scene:
-    """The Scene of a frame row (its stored parameters; the defaults where it predates them)."""
-    return Scene(**stored_parameters(json.loads(r.scene_key)))
 
 
 def stable_cfl_of(r) -> float:
@@ -137,7 +131,7 @@ def predicted(r) -> float:
     """The linear prediction of row ``r``'s primary error (solvers/dispersion.py; exact for `linear`)."""
     from solvers.dispersion import predict
 
-    return predict(scene_of(r).replace(model="linear")).predicted_error
+    return predict(scene_from_row(r).replace(model="linear")).predicted_error
 
 
 @lru_cache(maxsize=256)
@@ -225,7 +219,7 @@ def front_shifts(points_, most: int = 12) -> list[dict]:
     for p in runs:
         from solvers.dispersion import predict
 
-        measures = predict(scene_of(p["row"]).replace(model="linear")).measures or {}
+        measures = predict(scene_from_row(p["row"]).replace(model="linear")).measures or {}
         out.append(
             {
                 "method": p["method"],

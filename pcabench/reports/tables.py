@@ -16,13 +16,13 @@ import pandas as pd
 
 from pcabench import profiles
 from pcabench.record import STEP_STAGES
-from solvers import DEFAULT_KERNEL, NUMERICS, STAGES, Scene
+from solvers import DEFAULT_KERNEL, STAGES, Scene
 from solvers.kernels import truncated
+from solvers.method import Method
 
 from . import paper as P
 
 # The scene's numerics unless a study varies them (Scene's defaults: Verlet, CFL, h/dx, cutoff).
-DEFAULT_NUMERICS = {name: Scene.default(name) for name in NUMERICS}
 # The exact isothermal solution at Ma = 0.05 against the linear pulse (design 1b; solvers/isothermal1d.py).
 ISOTHERMAL_VS_LINEAR = {5.0: 0.051, 10.0: 0.098}
 # What makes two runs the same measurement: a newest-run choice is made within one of these.
@@ -52,11 +52,8 @@ def latest(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def default_numerics(df: pd.DataFrame) -> pd.DataFrame:
-    mask = np.ones(len(df), bool)
-    for key, value in DEFAULT_NUMERICS.items():
-        col = df[key]
-        mask &= (col == value) if isinstance(value, str) else np.isclose(col.astype(float), value)
-    return df[mask]
+    """The rows of ``df`` whose method is the paper's (:meth:`solvers.method.Method.is_paper`)."""
+    return df[[Method.of(r).is_paper() for _, r in df.iterrows()]] if not df.empty else df
 
 
 def paper_scene(df: pd.DataFrame) -> pd.DataFrame:
@@ -442,17 +439,14 @@ def accuracy_bars(series) -> list[dict]:
 
 # ---------------------------------------------------------------- speed against accuracy
 def numerics_label(r) -> str:
-    """The method of a run: kernel, h/dx, cutoff (a truncated kernel's only: the Gaussian's) and CFL."""
-    kern = r["kernel"]
-    cut = f", {r['cutoff_factor']:g}h" if truncated(kern) else ""
-    return f"{kern}, h {r['h_factor']:g}dx{cut}, CFL {r['cfl']:g}"
+    """The method of a run (:attr:`solvers.method.Method.label`): kernel, h/dx, cutoff (a truncated kernel's only:
+    the Gaussian's) and CFL."""
+    return Method.of(r).label
 
 
 def is_paper_method(r) -> bool:
-    """The paper's numerics: the Gaussian at Scene's default h/dx, cutoff, CFL and integrator."""
-    return r["kernel"] == DEFAULT_KERNEL and all(
-        (r[k] == v) if isinstance(v, str) else bool(np.isclose(float(r[k]), v)) for k, v in DEFAULT_NUMERICS.items()
-    )
+    """The paper's numerics (:meth:`solvers.method.Method.is_paper`)."""
+    return Method.of(r).is_paper()
 
 
 FRONT_MODELS = ("linear", "lagrangian")  # fixed solves neither equation: it is in the simplifications' table
@@ -551,9 +545,7 @@ def predicted_error(p: dict) -> float:
     """The error the dispersion relation predicts for front point ``p`` (its linear part; solvers/dispersion.py)."""
     from solvers.dispersion import predict
 
-    scene = {"kernel": p["kernel"], "h_factor": p["h_factor"], "cfl": p["cfl"], "integrator": p["integrator"]}
-    if truncated(p["kernel"]):
-        scene["cutoff_factor"] = p.get("cutoff_factor") or Scene.default("cutoff_factor")
+    scene = Method.of(p).scene_fields()
     strip = p.get("strip_height")
     strip = None if strip is None or (isinstance(strip, float) and np.isnan(strip)) else strip
     return predict(Scene(dx=p["dx"], t_end=p["t_final"], model="linear", strip_height=strip, **scene)).predicted_error

@@ -11,10 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from pcabench.presets import FREE_COUNTERPART, LONG_T_END, WALLS, cost_round
+from pcabench.spec import scene_from_row
 from solvers import Scene, scenes
 
 from .md import fmt, md_table
-from .scenes import T_FINAL, scene_of
+from .scenes import T_FINAL
 from .tables import is_paper_method, latest, long_run_limits
 
 
@@ -46,7 +47,7 @@ def accuracy(df) -> list[dict]:
     for _, r in d.iterrows():
         if not is_paper_method(r):
             continue
-        p = predict(scene_of(r).replace(model="linear"))
+        p = predict(scene_from_row(r).replace(model="linear"))
         measures = p.measures or {}
         rows.append(
             {

@@ -1,0 +1,81 @@
+"""The numerical method of a run, as one value: the kernel, h/dx, the truncation, the CFL and the integrator.
+
+A :class:`Method` is what a Scene's numerics are (``Scene.method``) and what a stored row's are
+(:meth:`Method.of`): the one answer to "which method is this" (its :attr:`~Method.label`) and "is this the
+paper's" (:meth:`~Method.is_paper`). Its defaults are Scene's (``Scene.default``: one place per fact); the
+Gaussian-only rule lives here: a kernel of compact support (the Wendland kernels) is cut at its support, so
+its ``cutoff_factor`` is no part of its method.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+FIELDS = ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator")  # Scene's fields a Method holds
+
+
+def _close(a: float, b: float) -> bool:
+    return math.isclose(float(a), float(b), rel_tol=1e-5, abs_tol=1e-8)  # as numpy.isclose, a stored float's
+
+
+@dataclass(frozen=True)
+class Method:
+    """Kernel (a registered name), h / dx, the truncation in units of h (the Gaussian's; None for a kernel cut
+    at its own support), CFL (dt c0 / dx) and time integrator."""
+
+    kernel: str
+    h_factor: float
+    cutoff_factor: float | None
+    cfl: float
+    integrator: str
+
+    @classmethod
+    def of(cls, values) -> "Method":
+        """The method of a Scene or of a stored row (a dict, a DataFrame row: the fields of :data:`FIELDS`; one a
+        row predates at Scene's default)."""
+        from .kernels import truncated
+        from .scene import Scene
+
+        def get(name):
+            value = getattr(values, name, None) if not hasattr(values, "get") else values.get(name)
+            if value is None or isinstance(value, float) and math.isnan(value):
+                return Scene.default(name)
+            return value
+
+        kernel = str(get("kernel"))
+        return cls(
+            kernel=kernel,
+            h_factor=float(get("h_factor")),
+            cutoff_factor=float(get("cutoff_factor")) if truncated(kernel) else None,
+            cfl=float(get("cfl")),
+            integrator=str(get("integrator")),
+        )
+
+    @classmethod
+    def paper(cls) -> "Method":
+        """The paper's method: Scene's defaults (the Gaussian at h = 2.13 dx, cut at 3h, CFL 0.2, Verlet)."""
+        from .scene import Scene
+
+        return cls.of({name: Scene.default(name) for name in FIELDS})
+
+    def is_paper(self) -> bool:
+        """Whether this is the paper's method (floats compared as stored floats are)."""
+        paper = self.paper()
+        if (self.kernel, self.integrator) != (paper.kernel, paper.integrator):
+            return False
+        same = _close(self.h_factor, paper.h_factor) and _close(self.cfl, paper.cfl)
+        return same and (self.cutoff_factor is None or _close(self.cutoff_factor, paper.cutoff_factor))
+
+    @property
+    def label(self) -> str:
+        """``kernel, h 2.13dx, 3h, CFL 0.2``: the truncation written only for a kernel that has one."""
+        cut = f", {self.cutoff_factor:g}h" if self.cutoff_factor is not None else ""
+        return f"{self.kernel}, h {self.h_factor:g}dx{cut}, CFL {self.cfl:g}"
+
+    def scene_fields(self) -> dict:
+        """The Scene fields this method sets (a compact kernel's ``cutoff_factor`` left at its default)."""
+        out = {"kernel": self.kernel, "h_factor": self.h_factor, "cfl": self.cfl, "integrator": self.integrator}
+        if self.cutoff_factor is not None:
+            out["cutoff_factor"] = self.cutoff_factor
+        return out

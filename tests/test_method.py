@@ -1,0 +1,54 @@
+"""The method as one value (issue 40, item 1): what a Scene's numerics are, what a stored row's are, and the one
+answer to "is this the paper's method"."""
+
+from __future__ import annotations
+
+import pytest
+
+from pcabench import store
+from pcabench.record import RunRecord
+from pcabench.reports import frame
+from pcabench.reports.tables import default_numerics, is_paper_method, numerics_label
+from pcabench.spec import RunSpec, scene_from_row
+from solvers import Scene
+from solvers.method import Method
+
+
+def test_the_paper_method_is_scenes_defaults_and_every_change_leaves_it():
+    assert Scene(dx=1.0, steps=2).method == Method.paper() and Method.paper().is_paper()
+    assert Method.paper().label == "gaussian, h 2.13dx, 3h, CFL 0.2"
+    for change in (
+        dict(kernel="wendland-c2"),
+        dict(h_factor=1.3),
+        dict(cutoff_factor=2.5),
+        dict(cfl=0.4),
+        dict(integrator="rk2"),
+    ):
+        assert not Scene(dx=1.0, steps=2, **change).method.is_paper(), change
+
+
+def test_a_compact_kernels_method_has_no_truncation():
+    m = Scene(dx=1.0, steps=2, kernel="wendland-c2").method
+    assert m.cutoff_factor is None and m.label == "wendland-c2, h 2.13dx, CFL 0.2"
+    stored = {"kernel": "wendland-c2", "h_factor": 2.13, "cutoff_factor": 2.5, "cfl": 0.2, "integrator": "verlet"}
+    assert Method.of(stored) == m  # a compact kernel is cut at its support, whatever a row's factor says
+
+
+def test_a_stored_row_and_its_frame_row_give_the_scenes_method_and_scene(tmp_path):
+    scene = Scene(
+        dx=0.5, name="plane-wall", x_max=12.0, t_end=10.0, kernel="wendland-c4", h_factor=1.7, cfl=0.9, model="linear"
+    )
+    rec = RunRecord.from_spec(RunSpec("linkedlist-cpu", scene).resolved(), "m", status="ok")
+    row = store.append(rec, tmp_path / "m--h.jsonl")
+    (r,) = [r for _, r in frame.load(tmp_path).iterrows()]
+    assert Method.of(row["scene"]) == Method.of(r) == scene.method
+    assert scene_from_row(row) == scene_from_row(r) == scene
+    assert numerics_label(r) == scene.method.label and not is_paper_method(r)
+    assert default_numerics(frame.load(tmp_path)).empty
+
+
+@pytest.mark.parametrize("missing", ["kernel", "cutoff_factor", "integrator"])
+def test_a_row_that_predates_a_parameter_reads_it_at_its_default(missing):
+    row = {k: Scene.default(k) for k in ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator")}
+    del row[missing]
+    assert Method.of(row).is_paper()
