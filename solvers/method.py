@@ -73,6 +73,15 @@ class Method:
         cut = f", {self.cutoff_factor:g}h" if self.cutoff_factor is not None else ""
         return f"{self.kernel}, h {self.h_factor:g}dx{cut}, CFL {self.cfl:g}"
 
+    def stable_cfl(self) -> float:
+        """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion
+        relation's, solvers/dispersion.py; the same at every dx, so dx = 1 stands for all; 0 where the
+        integrator grows at any step)."""
+        from .dispersion import stable_cfl
+        from .scene import Scene
+
+        return stable_cfl(Scene(dx=1.0, t_end=1.0, model="linear", **{**self.scene_fields(), "cfl": 0.2}))
+
     def scene_fields(self) -> dict:
         """The Scene fields this method sets (a compact kernel's ``cutoff_factor`` left at its default)."""
         out = {"kernel": self.kernel, "h_factor": self.h_factor, "cfl": self.cfl, "integrator": self.integrator}

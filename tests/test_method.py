@@ -52,3 +52,14 @@ def test_a_row_that_predates_a_parameter_reads_it_at_its_default(missing):
     row = {k: Scene.default(k) for k in ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator")}
     del row[missing]
     assert Method.of(row).is_paper()
+
+
+def test_the_stable_cfl_is_the_dispersion_relations_for_the_method():
+    from solvers.dispersion import stable_cfl
+
+    for scene in (
+        Scene(dx=0.25, t_end=1.0, model="linear"),
+        Scene(dx=1.0, t_end=1.0, kernel="wendland-c2", h_factor=1.3, model="linear", cfl=2.0),
+    ):
+        assert scene.method.stable_cfl() == pytest.approx(stable_cfl(scene), rel=1e-9)
+    assert Scene(dx=1.0, steps=2, integrator="euler").method.stable_cfl() == 0
