@@ -77,15 +77,14 @@ def _limits(kernel: str, h_factor: float, cutoff_factor: float, integrator: str)
 
 
 def method_of(r) -> tuple[str, float, float, str]:
-    """(kernel, h/dx, cutoff/h, integrator) of a stored run or a front point (Scene's defaults where missing)."""
+    """(kernel, h/dx, cutoff/h, integrator) of a stored run or a front point (:meth:`solvers.method.Method.of`:
+    Scene's defaults where missing; a compact kernel's truncation is its support, written as the default)."""
     from solvers import Scene
+    from solvers.method import Method
 
-    return (
-        str(_value(r, "kernel", Scene.default("kernel"))),
-        float(_value(r, "h_factor", Scene.default("h_factor"))),
-        float(_value(r, "cutoff_factor", Scene.default("cutoff_factor"))),
-        str(_value(r, "integrator", Scene.default("integrator"))),
-    )
+    m = Method.of(r)
+    cut = Scene.default("cutoff_factor") if m.cutoff_factor is None else m.cutoff_factor
+    return m.kernel, m.h_factor, cut, m.integrator
 
 
 def measured_limit(r) -> float | None:
