@@ -268,9 +268,9 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
             threading.Thread(target=_drain, args=(stderr, err, relay), daemon=True),
             threading.Thread(target=read_record, daemon=True),
         ]
-        for reader in readers:
-            reader.start()
-        try:
+        try:  # from the child's start: a Ctrl-C at any moment from here ends the child's group with the sweep
+            for reader in readers:
+                reader.start()
             proc.wait(timeout=timeout)
             wall = time.perf_counter() - started
         except BaseException:
@@ -280,7 +280,8 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
         finally:
             end_group(proc)  # what the run left running (a plug-in's own processes) ends with it
             for reader in readers:
-                reader.join(timeout=5)
+                if reader.is_alive() or reader.ident is not None:
+                    reader.join(timeout=5)
             for f in (stdout, stderr):
                 f.close()
             if stream is not None and err and not err[-1].endswith("\n"):

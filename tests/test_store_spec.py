@@ -566,7 +566,12 @@ def _study_until_running(tmp_path):
 def test_a_study_stopped_by_ctrl_c_or_sigterm_says_one_line_and_keeps_its_runs(how, code, word, tmp_path):
     proc, path = _study_until_running(tmp_path)
     os.killpg(proc.pid, getattr(signal, how))  # the whole foreground group, as a terminal's Ctrl-C does
-    _, err = proc.communicate(timeout=60)
+    try:
+        _, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        _, err = proc.communicate()
+        raise AssertionError(f"the study did not end within 60 s of {how}: {err[-3000:]}") from None
     assert proc.returncode == code and f"pcabench study: {word}" in err, err[-3000:]
     assert "Traceback" not in err, err[-3000:]
     assert not list(tmp_path.glob("*.reserve")) and len(store.read_rows(path)) >= 1
