@@ -18,6 +18,7 @@ from functools import lru_cache
 
 from solvers import DEFAULT_SCENE, Scene, kernel_names
 from solvers.dispersion import predict
+from solvers.method import Method
 
 H_FACTORS = (1.0, 1.1, 1.2, 1.3, 1.4, 1.6, 2.0, 2.13)
 DXS = (0.4, 0.3, 0.25, 0.2, 0.15, 0.125, 0.1, 0.075, 0.05)
@@ -35,7 +36,7 @@ def cost(scene: Scene) -> float:
 @lru_cache(maxsize=256)
 def _stable(kernel: str, h_factor: float) -> float:
     """The predicted stable CFL of Verlet with ``kernel`` at ``h_factor`` (independent of dx)."""
-    return Scene(dx=1.0, kernel=kernel, h_factor=h_factor, model="linear", steps=1).method.stable_cfl()
+    return Method.of(Scene(dx=1.0, kernel=kernel, h_factor=h_factor, model="linear", steps=1)).stable_cfl()
 
 
 def fastest(

@@ -398,18 +398,6 @@ class Scene:
         h_factor = cls.default("h_factor") if h_factor is None else h_factor
         return math.ceil(STRIP_CUTOFFS * cls.cutoff_ratio(kernel, cutoff_factor) * h_factor * (1 + 1e-9)) * dx
 
-    @property
-    def method(self):
-        """This scene's numerical method (:class:`solvers.method.Method`: kernel, h/dx, truncation, CFL,
-        integrator)."""
-        from .method import Method
-
-        return Method.of(self)
-
-    def uses_default_numerics(self) -> bool:
-        """True when the method is the paper's (:meth:`solvers.method.Method.is_paper`)."""
-        return self.method.is_paper()
-
     # ------------------------------------------------------------ helpers
     def replace(self, **changes) -> "Scene":
         return replace(self, **changes)

@@ -32,6 +32,7 @@ from solvers.dispersion import predict, stable_cfl
 from solvers.kernel import GRAD0, INV_H2
 from solvers.kernels import Kernel, KernelPluginWarning, register, unregister
 from solvers.kernels import registry as kernel_registry
+from solvers.method import Method
 
 from .conftest import run_fields
 from .test_gpu import _max_rel, _simulate
@@ -192,7 +193,7 @@ def test_the_scene_decides_the_cutoff_and_refuses_what_does_not_apply():
     with pytest.raises(SceneError, match="kernel must be one of gaussian, wendland-c2, wendland-c4"):
         Scene(dx=0.1, kernel="cubic")
     assert Scene(dx=0.1, kernel="wendland-c2").as_dict()["kernel"] == "wendland-c2"
-    assert not Scene(dx=0.1, kernel="wendland-c2").uses_default_numerics()
+    assert not Method.of(Scene(dx=0.1, kernel="wendland-c2")).is_paper()
 
 
 def test_rows_without_a_kernel_are_gaussian_to_resume():

@@ -15,7 +15,7 @@ from solvers.method import Method
 
 
 def test_the_paper_method_is_scenes_defaults_and_every_change_leaves_it():
-    assert Scene(dx=1.0, steps=2).method == Method.paper() and Method.paper().is_paper()
+    assert Method.of(Scene(dx=1.0, steps=2)) == Method.paper() and Method.paper().is_paper()
     assert Method.paper().label == "gaussian, h 2.13dx, 3h, CFL 0.2"
     for change in (
         dict(kernel="wendland-c2"),
@@ -24,11 +24,11 @@ def test_the_paper_method_is_scenes_defaults_and_every_change_leaves_it():
         dict(cfl=0.4),
         dict(integrator="rk2"),
     ):
-        assert not Scene(dx=1.0, steps=2, **change).method.is_paper(), change
+        assert not Method.of(Scene(dx=1.0, steps=2, **change)).is_paper(), change
 
 
 def test_a_compact_kernels_method_has_no_truncation():
-    m = Scene(dx=1.0, steps=2, kernel="wendland-c2").method
+    m = Method.of(Scene(dx=1.0, steps=2, kernel="wendland-c2"))
     assert m.cutoff_factor is None and m.label == "wendland-c2, h 2.13dx, CFL 0.2"
     stored = {"kernel": "wendland-c2", "h_factor": 2.13, "cutoff_factor": 2.5, "cfl": 0.2, "integrator": "verlet"}
     assert Method.of(stored) == m  # a compact kernel is cut at its support, whatever a row's factor says
@@ -41,9 +41,9 @@ def test_a_stored_row_and_its_frame_row_give_the_scenes_method_and_scene(tmp_pat
     rec = RunRecord.from_spec(RunSpec("linkedlist-cpu", scene).resolved(), "m", status="ok")
     row = store.append(rec, tmp_path / "m--h.jsonl")
     (r,) = [r for _, r in frame.load(tmp_path).iterrows()]
-    assert Method.of(row["scene"]) == Method.of(r) == scene.method
+    assert Method.of(row["scene"]) == Method.of(r) == Method.of(scene)
     assert scene_from_row(row) == scene_from_row(r) == scene
-    assert numerics_label(r) == scene.method.label and not is_paper_method(r)
+    assert numerics_label(r) == Method.of(scene).label and not is_paper_method(r)
     assert default_numerics(frame.load(tmp_path)).empty
 
 
@@ -61,5 +61,5 @@ def test_the_stable_cfl_is_the_dispersion_relations_for_the_method():
         Scene(dx=0.25, t_end=1.0, model="linear"),
         Scene(dx=1.0, t_end=1.0, kernel="wendland-c2", h_factor=1.3, model="linear", cfl=2.0),
     ):
-        assert scene.method.stable_cfl() == pytest.approx(stable_cfl(scene), rel=1e-9)
-    assert Scene(dx=1.0, steps=2, integrator="euler").method.stable_cfl() == 0
+        assert Method.of(scene).stable_cfl() == pytest.approx(stable_cfl(scene), rel=1e-9)
+    assert Method.of(Scene(dx=1.0, steps=2, integrator="euler")).stable_cfl() == 0

@@ -21,6 +21,7 @@ from pcabench.reports import frame, sections  # noqa: E402
 from pcabench.reports import walls as W  # noqa: E402
 from solvers import Scene, kernel_names, scenes  # noqa: E402
 from solvers.dispersion import predict, stable_cfl  # noqa: E402
+from solvers.method import Method
 
 from .figure_check import record  # noqa: E402
 from .test_study import row  # noqa: E402
@@ -38,7 +39,7 @@ def test_the_walls_preset_covers_every_wall_scene_of_the_registry(plan):
     for name in walled:
         mine = [s.scene for s in accuracy if s.scene.name == name]
         assert {s.model for s in mine} == {"linear", "lagrangian"}
-        assert len({s.dx for s in mine}) >= 2 and all(s.uses_default_numerics() for s in mine)
+        assert len({s.dx for s in mine}) >= 2 and all(Method.of(s).is_paper() for s in mine)
         assert all((s.strip_height is not None) == scenes()[name].strip for s in mine)  # plane-wall on its strip
     assert all(s.preset == presets.WALLS or presets.cost_round(s.preset) for s in plan)
     assert len(plan) == len(set(plan))
@@ -50,7 +51,7 @@ def test_the_stability_runs_bracket_each_methods_predicted_limit(plan):
     for name in W.wall_scenes():
         mine = [s for s in long if s.name == name]
         assert {s.kernel for s in mine if s.model == "linear"} == set(kernel_names())  # every registered kernel
-        assert {s.model for s in mine if s.uses_default_numerics() or s.cfl != Scene.default("cfl")} >= {
+        assert {s.model for s in mine if Method.of(s).is_paper() or s.cfl != Scene.default("cfl")} >= {
             "linear",
             "fixed",
             "lagrangian",
@@ -187,7 +188,7 @@ def test_the_front_of_a_wall_scene_is_its_own_product_with_the_papers_method(nam
     axes = presets.front_axes("quick", name)
     assert axes == presets.front_axes("quick", "plane-pulse" if kind.strip else "acoustic-pulse")
     assert {s.scene.kernel for s in runs} == set(kernel_names())
-    paper = [s.scene for s in runs if s.scene.uses_default_numerics()]
+    paper = [s.scene for s in runs if Method.of(s.scene).is_paper()]
     assert {s.model for s in paper} == {"linear", "lagrangian"} and len({s.dx for s in paper}) >= 2
     # no isothermal reference at a wall: no runs of "which model this scene needs" (they score against it)
     assert not kind.has_isothermal and {s.scene.mach for s in runs} == {Scene.default("mach")}
