@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import json
+import os
 import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +18,25 @@ from pcabench.spec import RunSpec
 from solvers import Scene
 
 strip_for = Scene.thinnest_strip  # the thinnest y-periodic strip the cell list accepts at dx, m
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def in_simulator(script: str, *args, timeout: float = 900) -> dict:
+    """Run the Python ``script`` (with ``args``) in a fresh interpreter under numba-cuda's CUDA simulator
+    (NUMBA_ENABLE_CUDASIM=1: the GPU kernels run on the CPU, NumPy in place of CuPy); the JSON object its last
+    line prints. The one way the tests reach the GPU solver without a GPU."""
+    path = os.pathsep.join([str(ROOT), *(p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p)])
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", PYTHONPATH=path)
+    proc = subprocess.run(
+        [sys.executable, "-c", script, *map(str, args)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=timeout,
+        cwd=ROOT,
+    )
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
 def run_fields(scene: Scene, solver: str, tmp_path, threads=1):

@@ -8,7 +8,6 @@ and skip cleanly without one.
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -18,7 +17,7 @@ import pytest
 
 from solvers import Scene, SceneError, SolverUnavailable, make_solver
 
-from .conftest import run_fields
+from .conftest import in_simulator, run_fields
 
 SIM_SCRIPT = r"""
 import json, sys, tempfile, numpy as np
@@ -42,16 +41,7 @@ print(json.dumps(out))
 
 
 def _simulate(precision, model, steps, integrator="verlet", kernel="gaussian"):
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run(
-        [sys.executable, "-c", SIM_SCRIPT, precision, model, str(steps), integrator, kernel],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=900,
-    )
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    return in_simulator(SIM_SCRIPT, precision, model, steps, integrator, kernel)
 
 
 def _max_rel(a, b):
@@ -187,10 +177,7 @@ print(json.dumps(out))
 def test_simulated_step_launches_and_host_round_trips():
     """A lagrangian Verlet step is at most 8 kernel launches, touches no array-module operation (each would be
     a CuPy launch or a host round trip on a GPU) and never synchronises; the one-block cellBegin scan is exact."""
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run([sys.executable, "-c", LAUNCH_SCRIPT], capture_output=True, text=True, env=env, timeout=900)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out = in_simulator(LAUNCH_SCRIPT)
     verlet = out["verlet"]
     assert len(verlet["launches"]) <= 8, verlet["launches"]
     assert {"cell_count", "cell_begin", "scatter", "continuity", "momentum"} <= set(verlet["launches"])

@@ -3,15 +3,14 @@ order and the solver's cell list as they were, and counts what re-sorting the st
 
 from __future__ import annotations
 
-import json
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 from solvers import Scene, make_solver
+
+from .conftest import in_simulator
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -105,10 +104,5 @@ print(json.dumps({"same": bool(same), "mean": mean, "resorted": int(counts.sum()
 
 
 def test_simulated_gpu_mean_neighbours_leaves_the_state_as_it_was():
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", PYTHONPATH=ROOT)
-    proc = subprocess.run(
-        [sys.executable, "-c", SIM_SCRIPT], capture_output=True, text=True, env=env, timeout=900, cwd=ROOT
-    )
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out = in_simulator(SIM_SCRIPT)
     assert out["same"] and out["mean"] == out["resorted"] == pytest.approx(out["cpu"]), out

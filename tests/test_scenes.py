@@ -4,9 +4,6 @@ its convergence to the exact reference, conservation on the periodic square, and
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -19,7 +16,7 @@ from solvers.dispersion import predict, predicted_fields_2d, stable_cfl
 from solvers.integrators import step_program
 from solvers.linkedlist_cpu import LinkedListCPU
 
-from .conftest import cli_main
+from .conftest import cli_main, in_simulator
 
 
 def pulse(dx=1.0, **kw) -> Scene:
@@ -120,10 +117,7 @@ print(json.dumps(out))
 
 
 def test_the_gpu_solver_runs_the_periodic_square_in_the_simulator():
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT], capture_output=True, text=True, env=env, timeout=900)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out = in_simulator(SIM_SCRIPT)
     for precision, tol in (("float64", 1e-12), ("float32", 2e-5)):
         cpu, gpu = np.array(out[precision + "linkedlist-cpu"]), np.array(out[precision + "linkedlist-gpu"])
         assert np.abs(gpu - cpu).max() <= tol * np.abs(cpu).max()

@@ -4,11 +4,6 @@ the integrator's accuracy, and bad wall input is one line before any work."""
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
@@ -19,7 +14,7 @@ from solvers.dispersion import predict
 from solvers.integrators import step_program
 from solvers.linkedlist_cpu import LinkedListCPU
 
-from .conftest import cli_main
+from .conftest import cli_main, in_simulator
 
 
 def wall_scene(name, dx=0.5, **kw) -> Scene:
@@ -189,10 +184,7 @@ print(json.dumps(out))
 
 
 def test_the_gpu_solver_runs_the_walls_in_the_simulator():
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    proc = subprocess.run([sys.executable, "-c", SIM_SCRIPT], capture_output=True, text=True, env=env, timeout=900)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out = in_simulator(SIM_SCRIPT)
     for name, tol in (("pulse-wall", 1e-12), ("plane-wall", 2e-5)):
         cpu, gpu = np.array(out[name + "linkedlist-cpu"]), np.array(out[name + "linkedlist-gpu"])
         assert np.abs(cpu).max() > 0
