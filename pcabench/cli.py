@@ -366,7 +366,7 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
 
 
 def cmd_study(args) -> int:
-    from .presets import RUN_BUDGET
+    from .presets import budget
     from .study import bounded_spec, check_specs, run_study
 
     name, specs = study_specs(args)
@@ -379,7 +379,7 @@ def cmd_study(args) -> int:
         for i, spec in enumerate(specs, 1):
             print(f"[{i}/{len(specs)}] {spec.preset}: {spec.label}")
         return EXIT_OK
-    run_budget = args.run_budget if args.run_budget is not None else RUN_BUDGET[name]
+    run_budget = args.run_budget if args.run_budget is not None else budget(name)
     for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
         if not value > 0:
             raise OptionError(f"{flag} must be > 0 seconds (got {value})")
@@ -622,9 +622,11 @@ class PresetHelpFormatter(argparse.RawDescriptionHelpFormatter):
     shown (pcabench/presets.py: :func:`~pcabench.presets.size_text`), so the help cannot drift from the runs."""
 
     def _expand_help(self, action):
-        from .presets import size_text
+        from .presets import MATRIX_BUDGET, PRESETS, size_text
 
         text = super()._expand_help(action)
+        budgets = ", ".join(f"{name} {p.budget:g}" for name, p in PRESETS.items()) + f", matrix {MATRIX_BUDGET:g}"
+        text = text.replace("{budgets}", budgets)
         return re.sub(r"\{size:([\w-]+)\}", lambda m: size_text(m.group(1)), text)
 
 
@@ -705,8 +707,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--run-budget",
         type=number("--run-budget"),
-        help="seconds per run before it is a timeout "
-        "(default: quick 120, paper 900, stability 120, stability long 300, walls 300, matrix 900)",
+        help="seconds per run before it is a timeout (default: {budgets})",
     )
     p.add_argument(
         "--sweep-budget", type=number("--sweep-budget"), default=4 * 3600.0, help="seconds for the whole sweep"

@@ -10,22 +10,14 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+from typing import Callable
 
 from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind, solver_class
 
 from .spec import ALL_CORES, SERIAL, RunSpec
 
-# Seconds per run before it is recorded as a timeout, by preset (--run-budget overrides).
-RUN_BUDGET = {
-    "quick": 120.0,
-    "paper": 900.0,
-    "stability": 120.0,
-    "stability-long": 300.0,
-    "matrix": 900.0,
-    "front": 300.0,
-    "front-full": 900.0,
-    "walls": 300.0,
-}
+MATRIX_BUDGET = 900.0  # s per run of a matrix of options (--dx ...), not a preset (--run-budget overrides)
+
 
 # The stability preset's scene: the design's dx = 0.25 on a strip, the linear model
 # (exactly the linear wave equation, so growth is the integrator's, not the physics').
@@ -337,22 +329,45 @@ def size_text(name: str, scene: str = DEFAULT_SCENE) -> str:
         if scene != DEFAULT_SCENE:
             return f"{fixed} runs"
         return f"{fixed} runs and up to {2 * len(kernel_names())} predicted fastest"
-    return f"{len(PRESETS[name]())} runs"
+    return f"{len(PRESETS[name].specs(scene))} runs"
 
 
 def front_full(scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     return front("full", scene)
 
 
-PRESETS = {
-    "quick": quick,
-    "paper": paper,
-    "stability": stability,
-    "stability-long": stability_long,
-    "front": front,
-    "front-full": front_full,
-    WALLS: walls,
+@dataclasses.dataclass(frozen=True)
+class Preset:
+    """A named study: ``plan`` makes its runs (RunSpecs, smallest first, so that a sweep predicts a large run from
+    the smaller ones before it; a front's takes ``scene=``), ``budget`` is the seconds a run may take before it is
+    a timeout (``--run-budget`` overrides). Its run count is counted from the plan (:func:`size_text`)."""
+
+    name: str
+    plan: Callable[..., list]
+    budget: float
+    scened: bool = False  # whether the plan takes the scene it runs on (the fronts)
+
+    def specs(self, scene: str = DEFAULT_SCENE) -> list:
+        return self.plan(scene=scene) if self.scened else self.plan()
+
+
+PRESETS = {  # what `pcabench study` offers; a preset of one's own: PRESETS[p.name] = p (CONTRIBUTING.md)
+    p.name: p
+    for p in (
+        Preset("quick", quick, 120.0),
+        Preset("paper", paper, 900.0),
+        Preset("stability", stability, 120.0),
+        Preset("stability-long", stability_long, 300.0),
+        Preset("front", front, 300.0, scened=True),
+        Preset("front-full", front_full, 900.0, scened=True),
+        Preset(WALLS, walls, 300.0),
+    )
 }
+
+
+def budget(name: str) -> float:
+    """The run budget of preset ``name`` (s), or a matrix's (``name`` "matrix")."""
+    return MATRIX_BUDGET if name == "matrix" else PRESETS[name].budget
 
 
 def preset(name: str, scene: str = DEFAULT_SCENE) -> list[RunSpec]:
@@ -360,8 +375,7 @@ def preset(name: str, scene: str = DEFAULT_SCENE) -> list[RunSpec]:
     own tag, where the preset names its repeats: ``walls-cost-<round>``)."""
     if name not in PRESETS:
         raise ValueError(f"preset must be one of {', '.join(PRESETS)} (got {name!r})")
-    make = PRESETS[name]
-    specs = make(scene=scene) if name.startswith("front") else make()
+    specs = PRESETS[name].specs(scene)
     return [RunSpec(s.solver, s.scene, s.threads, s.preset or name, s.pair_loop) for s in specs]
 
 

@@ -45,7 +45,7 @@ def run_recipe(tmp_path, monkeypatch):
     monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # the recipe's mkdtemp() lands in the test's folder
     solvers_before, scenes_before = dict(registry()), scene_names()
-    sections_before, presets_before = sections.SECTIONS, (dict(presets.PRESETS), dict(presets.RUN_BUDGET))
+    sections_before, presets_before = sections.SECTIONS, dict(presets.PRESETS)
 
     def execute(title: str) -> dict:
         namespace = {"__name__": "__recipe__"}
@@ -56,7 +56,7 @@ def run_recipe(tmp_path, monkeypatch):
     # each recipe unregisters what it registered
     assert dict(registry()) == solvers_before and scene_names() == scenes_before
     assert sections.SECTIONS is sections_before or sections.SECTIONS == sections_before
-    assert (presets.PRESETS, presets.RUN_BUDGET) == presets_before
+    assert presets.PRESETS == presets_before
 
 
 def test_every_recipe_has_one_block_and_the_workflow_is_named():
@@ -136,7 +136,7 @@ def test_the_section_recipe_adds_its_section_to_the_report(run_recipe):
 
 def test_the_preset_recipe_expands_to_runs_that_a_sweep_stores(run_recipe):
     ns = run_recipe("Add a preset")
-    assert "tiny" not in presets.PRESETS and "tiny" not in presets.RUN_BUDGET  # unregistered
+    assert "tiny" not in presets.PRESETS  # unregistered
     specs = ns["specs"]
     assert [s.scene.dx for s in specs] == [1.0, 0.8, 0.5] and {s.preset for s in specs} == {"tiny"}
     rows = store.read_rows(ns["store_path"])
