@@ -39,7 +39,7 @@ from solvers import (
 
 from . import __version__, jsonout, memory, paths
 from .errors import NoResults
-from .parameters import METHOD, NUMERICS, PARAMETERS, PROBLEM
+from .parameters import METHOD, PARAMETERS, PRECISION_MODEL, PROBLEM
 from .parser import EXIT_BAD_INPUT, Parser
 from .progress import Progress
 from .spec import SERIAL, OptionError, RunSpec, parse_threads
@@ -166,11 +166,11 @@ def add_scene_options(p: argparse.ArgumentParser, many: bool) -> None:
         **n,
         help="lattice spacing, m (paper: 1 .. 0.004; 0.1 is 100K particles)",
     )
-    add_parameter_options(p, NUMERICS[:1], many)
+    add_parameter_options(p, PRECISION_MODEL[:1], many)
     end = p.add_mutually_exclusive_group()
     end.add_argument("--steps", type=positive_int("--steps"), **n, help="number of steps (default 100, the paper's)")
     end.add_argument("--t-end", type=number("--t-end"), **n, help="physical end time, s")
-    add_parameter_options(p, NUMERICS[1:], many)
+    add_parameter_options(p, PRECISION_MODEL[1:], many)
     add_method_options(p, many)
     threaded = ", ".join(name for name, cls in registry().items() if cls.threaded)
     loops = {name: cls.pair_loops for name, cls in registry().items() if len(cls.pair_loops) > 1}

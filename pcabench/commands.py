@@ -13,7 +13,7 @@ import shlex
 
 from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, kernel_named, resolve_pair_loop
 
-from .parameters import METHOD, NUMERICS, PROBLEM
+from .parameters import METHOD, PRECISION_MODEL, PROBLEM
 from .spec import SERIAL, RunSpec
 
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
@@ -59,7 +59,7 @@ def words_of(solver: str, scene, threads=SERIAL, pair_loop: str = "") -> tuple[l
             unset += [k for k in DOMAIN if k != "x_max" and not _same(domain[k], defaults[k])]
     if scene.strip_height is not None:
         words += ["--strip-height", _number(scene.strip_height)]
-    for par in (*PROBLEM[1:], *NUMERICS, *METHOD):
+    for par in (*PROBLEM[1:], *PRECISION_MODEL, *METHOD):
         value, default = getattr(scene, par.field), scene.default_of(par.field)
         if _same(value, default):
             continue

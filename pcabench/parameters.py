@@ -80,7 +80,7 @@ PROBLEM = (
     Parameter("pulse_center", "--pulse-center", "the pulse's centre x at t = 0, m", numeric=True),
     Parameter("x_max", "--wall-x", _wall_help, numeric=True, per_scene=True),
 )
-NUMERICS = (
+PRECISION_MODEL = (
     Parameter("precision", "--precision", "floating-point precision", lambda: PRECISIONS),
     Parameter("model", "--model", "the physics model", lambda: MODELS),
 )
@@ -91,7 +91,7 @@ METHOD = (
     Parameter("h_factor", "--h-factor", "h / dx", numeric=True),
     Parameter("cfl", "--cfl", "dt * c0 / dx", numeric=True),
 )
-PARAMETERS = PROBLEM + NUMERICS + METHOD
+PARAMETERS = PROBLEM + PRECISION_MODEL + METHOD
 
 
 def parameter(field: str) -> Parameter:

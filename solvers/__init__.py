@@ -20,7 +20,7 @@ from .registry import (
     solver_class,
     solver_names,
 )
-from .scene import INTEGRATORS, MODELS, NUMERICS, PRECISIONS, Scene, SceneError
+from .scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
 from .scenes import DEFAULT_SCENE, SceneKind, scene_kind, scene_names, scenes
 
 __all__ = [
@@ -37,7 +37,6 @@ __all__ = [
     "Kernel",
     "kernel_named",
     "kernel_names",
-    "NUMERICS",
     "DEFAULT_SOLVER",
     "ENTRY_POINT_GROUP",
     "registry",

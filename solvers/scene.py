@@ -42,7 +42,6 @@ MAX_STEPS = 10_000_000  # the most steps a run may take (1e7)
 MIN_CFL = 1e-3  # the smallest cfl: 1e7 steps of it cross 1e4 cells, a step smaller than any study needs
 
 # Scene parameters that choose the numerical method rather than the physics.
-NUMERICS = ("integrator", "cfl", "h_factor", "cutoff_factor", "kernel")
 # The domain: the scene kind's default (solvers/scenes/) where not given.
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
 PAPER_DOMAIN = {"x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
