@@ -13,7 +13,7 @@ import shlex
 
 from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, kernel_named, resolve_pair_loop
 
-from .parameters import METHOD, PRECISION_MODEL, PROBLEM
+from .parameters import METHOD, PRECISION_MODEL, PROBLEM, number_word
 from .spec import SERIAL, RunSpec
 
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
@@ -24,10 +24,6 @@ def _same(a, b) -> bool:
     if isinstance(a, (int, float)) and isinstance(b, (int, float)):
         return math.isclose(a, b, rel_tol=1e-12, abs_tol=1e-15)
     return a == b
-
-
-def _number(value) -> str:
-    return repr(float(value)) if float(value) != float(f"{value:g}") else f"{value:g}"
 
 
 def run_words(spec: RunSpec) -> tuple[list[str], list[str]]:
@@ -41,8 +37,8 @@ def words_of(solver: str, scene, threads=SERIAL, pair_loop: str = "") -> tuple[l
     words = ["pcabench", "run", "--solver", solver or DEFAULT_SOLVER]
     if scene.name != DEFAULT_SCENE:
         words += ["--scene", scene.name]
-    words += ["--dx", _number(scene.dx)]
-    words += ["--t-end", _number(scene.t_end)] if scene.t_end is not None else ["--steps", str(scene.steps)]
+    words += ["--dx", number_word(scene.dx)]
+    words += ["--t-end", number_word(scene.t_end)] if scene.t_end is not None else ["--steps", str(scene.steps)]
     unset = []
     domain = {k: getattr(scene, k) for k in DOMAIN}
     defaults = {k: scene.default_of(k) for k in DOMAIN}
@@ -53,12 +49,12 @@ def words_of(solver: str, scene, threads=SERIAL, pair_loop: str = "") -> tuple[l
         except ValueError:
             sized = None
         if sized is not None and all(_same(domain[k], sized[k]) for k in DOMAIN):
-            words += ["--domain-size", _number(scene.x_max - scene.x_min)]
+            words += ["--domain-size", number_word(scene.x_max - scene.x_min)]
             wall_written = True
         elif not all(_same(domain[k], defaults[k]) for k in DOMAIN if k != "x_max"):
             unset += [k for k in DOMAIN if k != "x_max" and not _same(domain[k], defaults[k])]
     if scene.strip_height is not None:
-        words += ["--strip-height", _number(scene.strip_height)]
+        words += ["--strip-height", number_word(scene.strip_height)]
     for par in (*PROBLEM[1:], *PRECISION_MODEL, *METHOD):
         value, default = getattr(scene, par.field), scene.default_of(par.field)
         if _same(value, default):
@@ -69,7 +65,7 @@ def words_of(solver: str, scene, threads=SERIAL, pair_loop: str = "") -> tuple[l
             continue
         if par.field == "cutoff_factor" and kernel_named(scene.kernel).support is not None:
             continue  # a compact kernel is cut at its support, whatever the factor says
-        words += [par.option, _number(value) if par.numeric else str(value)]
+        words += par.words(value)
     unset += [k for k in NO_OPTION if not _same(getattr(scene, k), scene.default(k))]
     if int(threads) != SERIAL:
         words += ["--threads", str(int(threads))]

@@ -47,8 +47,13 @@ class Parameter:
         return f"{text} (default {value:g})" if isinstance(value, float) else f"{text} (default {value})"
 
     def words(self, value) -> list[str]:
-        """``[option, value]`` as a command line writes them."""
-        return [self.option, f"{value:g}" if isinstance(value, float) else str(value)]
+        """``[option, value]`` as a command line writes them (a number in its shortest exact form)."""
+        return [self.option, number_word(value) if self.numeric or isinstance(value, float) else str(value)]
+
+
+def number_word(value) -> str:
+    """A number as a command line writes it: ``%g`` where that is exact, else every digit (``repr``)."""
+    return f"{value:g}" if float(value) == float(f"{value:g}") else repr(float(value))
 
 
 def _kernel_help() -> str:

@@ -73,6 +73,7 @@ def _time(required=False, null=False):
     return Field(("number", "null") if null else ("number",), required, low=0, high=MAX_SECONDS)
 
 
+STAGE_TIME = _time()  # one stage's total time in a record, s
 PATH_NAME = _name(empty=False, path=True, max_len=2 * MAX_NAME + 2)  # a file or folder name (profile--host)
 _STEPS = Field(("int",), True, low=0, high=MAX_STEPS)
 _ERROR = Field(("number", "null"), low=0, high=1e300)
@@ -292,7 +293,7 @@ def check(row) -> str:
                 return why
     stages = row["stages"]
     for stage, seconds in stages.items():
-        why = _key(stage) or check_value(f"stage {stage}", Field(("number",), low=0, high=MAX_SECONDS), seconds)
+        why = _key(stage) or check_value(f"stage {stage}", STAGE_TIME, seconds)
         if why:
             return why
     missing = [s for s in STAGES if s not in stages]

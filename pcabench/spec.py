@@ -164,9 +164,7 @@ def scene_from_row(row) -> Scene:
     derived keys dropped, each parameter the row predates at its default. The one way from a record to a
     Scene."""
     if "scene_key" in row and isinstance(row["scene_key"], str):
-        import json as _json
-
-        return Scene(**stored_parameters(_json.loads(row["scene_key"])))
+        return Scene(**stored_parameters(json.loads(row["scene_key"])))
     return Scene(**stored_parameters(row.get("scene") or {}))
 
 

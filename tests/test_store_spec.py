@@ -26,6 +26,7 @@ from pcabench.sweep import run_child, sweep
 from solvers import Scene
 
 from .conftest import cli_main
+from .test_registry import install
 
 
 def advisable(**kw) -> RunRecord:
@@ -99,6 +100,16 @@ def with_site(tmp_path, monkeypatch, code: str) -> None:
     would have it."""
     (tmp_path / "sitecustomize.py").write_text(textwrap.dedent(code))
     monkeypatch.setenv("PYTHONPATH", f"{tmp_path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}")
+
+
+def pcabench(*args, module: str = "pcabench.cli", site=None, timeout: float = 120):
+    """``python -m pcabench.cli ARGS`` (or ``module``) in a fresh interpreter, with the plug-ins of ``site`` on its
+    path: the finished process (text output)."""
+    env = dict(os.environ)
+    if site is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])
+    cmd = [sys.executable, "-m", module, *args]
+    return subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=timeout)
 
 
 LIAR = """
@@ -216,26 +227,7 @@ LinkedListCPU.init = init
 def test_run_budget_holds_for_a_solver_that_never_returns_to_python(tmp_path, monkeypatch):
     with_site(tmp_path, monkeypatch, DEAF)
     t0 = time.monotonic()
-    out = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "pcabench.cli",
-            "run",
-            "--solver",
-            "linkedlist-cpu",
-            "--dx",
-            "1",
-            "--steps",
-            "2",
-            "--run-budget",
-            "4",
-            "--json",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    out = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "2", "--run-budget", "4", "--json")
     assert out.returncode == 1 and json.loads(out.stdout)["status"] == "timeout", (out.stdout, out.stderr)
     assert time.monotonic() - t0 < 60
 
@@ -598,34 +590,8 @@ def test_output_cut_by_its_reader_is_not_bad_input(tmp_path):
 
 
 def test_a_plugin_that_exits_at_import_is_left_out_not_obeyed(tmp_path):
-    site = tmp_path / "site"
-    (site / "quitter-0.1.dist-info").mkdir(parents=True)
-    (site / "quitter.py").write_text("import sys\nsys.exit(0)\n")
-    (site / "quitter-0.1.dist-info" / "METADATA").write_text("Metadata-Version: 2.1\nName: quitter\nVersion: 0.1\n")
-    (site / "quitter-0.1.dist-info" / "entry_points.txt").write_text(
-        "[pcabench.solvers]\nquitter = quitter:Solver\n[pcabench.scenes]\nquitter = quitter:Scene\n"
-    )
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])}
-    out = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "pcabench.cli",
-            "run",
-            "--solver",
-            "linkedlist-cpu",
-            "--dx",
-            "1",
-            "--steps",
-            "2",
-            "--json",
-            "--quiet",
-        ],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-    )
+    site = install(tmp_path / "site", "quitter", "import sys\nsys.exit(0)\n", {"quitter": "quitter:Solver"})
+    out = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "2", "--json", "--quiet", site=site)
     assert out.returncode == 0 and json.loads(out.stdout)["status"] == "ok", (out.stdout, out.stderr)
     assert "quitter" in out.stderr and "left out" in out.stderr
 
@@ -671,17 +637,6 @@ def test_a_child_claiming_more_time_than_its_process_took_is_an_error(tmp_path, 
 
 
 def test_a_ctrl_c_while_the_plugins_load_is_one_line(tmp_path):
-    site = tmp_path / "site"
-    (site / "slow-0.1.dist-info").mkdir(parents=True)
-    (site / "slow.py").write_text("raise KeyboardInterrupt\n")  # the user's Ctrl-C, as the plug-in imports
-    (site / "slow-0.1.dist-info" / "METADATA").write_text("Metadata-Version: 2.1\nName: slow\nVersion: 0.1\n")
-    (site / "slow-0.1.dist-info" / "entry_points.txt").write_text("[pcabench.solvers]\nslow = slow:Solver\n")
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")])}
-    out = subprocess.run(
-        [sys.executable, "-m", "pcabench.launch", "run", "--solver", "linkedlist-cpu", "--dx", "1"],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-    )
+    site = install(tmp_path / "site", "slow", "raise KeyboardInterrupt\n", {"slow": "slow:Solver"})  # a Ctrl-C
+    out = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", module="pcabench.launch", site=site)
     assert out.returncode == 130 and out.stderr.strip().splitlines() == ["pcabench: interrupted"], out.stderr
