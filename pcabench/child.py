@@ -24,7 +24,7 @@ import os
 import sys
 import warnings
 
-from solvers.registry import PluginWarning
+from solvers.plugins import PluginWarning
 
 from .profiles import machine_id
 from .progress import Progress

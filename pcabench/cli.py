@@ -318,13 +318,11 @@ def run_in_child(spec: RunSpec, args):
 
 def study_specs(args) -> tuple[str, list[RunSpec]]:
     """The preset named by the flags, or the matrix built from the scene options."""
-    from .presets import matrix, preset
+    from .presets import DEFAULT_PRESET, PRESETS, flags, matrix, named_by, preset
 
-    presets = [flag for flag in ("quick", "paper", "walls", "stability", "front") if getattr(args, flag, None)]
-    if args.dx and presets:
-        raise OptionError(
-            f"--dx builds a matrix of runs; --{presets[0]} is a preset with its own: give one or the other"
-        )
+    given = [flag for flag in flags() if getattr(args, flag, None)]
+    if args.dx and given:
+        raise OptionError(f"--dx builds a matrix of runs; --{given[0]} is a preset with its own: give one or the other")
     if args.dx:
         lists = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt)}
         check_wall_option(lists.get("name", [DEFAULT_SCENE]), "x_max" in lists)
@@ -348,20 +346,16 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
         or args.strip
     ):
         raise OptionError(
-            "--dx is needed to build a matrix from the scene options; a preset (--quick, --paper, --stability, "
-            "--walls, --front) takes none of them"
+            "--dx is needed to build a matrix from the scene options; a preset ("
+            + ", ".join(f"--{flag}" for flag in flags())
+            + ") takes none of them"
         )
-    name = (
-        "paper"
-        if args.paper
-        else "walls"
-        if args.walls
-        else {"short": "stability", "long": "stability-long"}[args.stability]
-        if args.stability
-        else {None: "quick", "quick": "front", "full": "front-full"}[args.front]
-    )
-    if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not name.startswith("front")):
-        raise OptionError("--scene with a preset: one scene, with --front (the other presets choose their own scenes)")
+    name = named_by(given[0], getattr(args, given[0])) if given else DEFAULT_PRESET
+    scened = [p.option for p in PRESETS.all().values() if p.scened]
+    if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not PRESETS.get(name).scened):
+        raise OptionError(
+            f"--scene with a preset: one scene, with {' or '.join(scened)} (the other presets choose their own scenes)"
+        )
     return name, preset(name, scene[0])
 
 
@@ -619,15 +613,34 @@ def cmd_cache(args) -> int:
 # ---------------------------------------------------------------- the parser
 class PresetHelpFormatter(argparse.RawDescriptionHelpFormatter):
     """``{size:PRESET}`` in an option's help is the preset's run count, counted from its plan when the help is
-    shown (pcabench/presets.py: :func:`~pcabench.presets.size_text`), so the help cannot drift from the runs."""
+    shown (:meth:`pcabench.presets.Preset.size`), so the help cannot drift from the runs."""
 
     def _expand_help(self, action):
         from .presets import MATRIX_BUDGET, PRESETS, size_text
 
         text = super()._expand_help(action)
-        budgets = ", ".join(f"{name} {p.budget:g}" for name, p in PRESETS.items()) + f", matrix {MATRIX_BUDGET:g}"
+        budgets = ", ".join(f"{p.name} {p.budget:g}" for p in PRESETS.all().values()) + f", matrix {MATRIX_BUDGET:g}"
         text = text.replace("{budgets}", budgets)
         return re.sub(r"\{size:([\w-]+)\}", lambda m: size_text(m.group(1)), text)
+
+
+def add_preset_options(group) -> None:
+    """One option per preset flag (pcabench/presets/: each preset names its flag, choice and help): a flag of
+    one preset is a switch, a flag several share takes their choices (the first one's when none is given)."""
+    from .presets import flags
+
+    for flag, shared in flags().items():
+        sized = [p.help.replace("{size}", "{size:" + p.name + "}") for p in shared]
+        if len(shared) == 1 and shared[0].choice is None:
+            group.add_argument(f"--{flag}", action="store_true", help=sized[0])
+            continue
+        group.add_argument(
+            f"--{flag}",
+            nargs="?",
+            const=shared[0].choice,
+            choices=[p.choice for p in shared],
+            help="; ".join(f"{p.choice}: {text}" for p, text in zip(shared, sized)),
+        )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -669,34 +682,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=solver_help() + "\n" + MODEL_HELP,
         formatter_class=PresetHelpFormatter,
     )
-    g = p.add_mutually_exclusive_group()
-    g.add_argument(
-        "--quick", action="store_true", help="every table and figure at small N ({size:quick}; 2 minutes here; default)"
-    )
-    g.add_argument("--paper", action="store_true", help="the paper's CPU matrix, within the budgets ({size:paper})")
-    g.add_argument(
-        "--stability",
-        nargs="?",
-        const="short",
-        choices=("short", "long"),
-        help="short: CFL x integrator x h/dx, run length and float32, the stability map ({size:stability}); "
-        "long: each model at CFL 4.4-5 to t = 300 s, the moving models' own limit ({size:stability-long})",
-    )
-    g.add_argument(
-        "--front",
-        nargs="?",
-        const="quick",
-        choices=("quick", "full"),
-        help="time to solution against error at t = 10 s: kernel x h/dx x CFL x dx x precision x "
-        "model on the strip, and the paper's scene (dx 0.05, full domain) with its method and the "
-        "predicted fastest, serial (quick: {size:front}; full: {size:front-full}; on the paper's scene)",
-    )
-    g.add_argument(
-        "--walls",
-        action="store_true",
-        help="sound at a rigid wall (plane-wall, pulse-wall): accuracy at t = 10 s against the prediction, the "
-        "stable CFL per kernel over long runs, and the time per step with and without the wall ({size:walls})",
-    )
+    add_preset_options(p.add_mutually_exclusive_group())
     p.add_argument("--list", action="store_true", help="print the runs the study would make, one a line, and exit")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
     m.add_argument("--solver", nargs="+", choices=registry())

@@ -9,7 +9,7 @@ import warnings
 
 from numba.core.registry import cpu_target
 
-from solvers.registry import PluginWarning
+from solvers.plugins import PluginWarning
 
 warnings.filterwarnings("ignore", category=PluginWarning)  # the sweep (the parent) says it once
 

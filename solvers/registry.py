@@ -19,122 +19,41 @@ does not name a Solver subclass with a ``name`` of its own is left out with one
 
 from __future__ import annotations
 
-import ast
-import importlib
-import inspect
-import pkgutil
-import warnings
-from functools import lru_cache
-from importlib import metadata
-from pathlib import Path
-
 from .interface import Solver
-from .plugins import NAME, name_problem
+from .plugins import NAME, PluginWarning, Registry, declares_a_name
 from .scene import SceneError
 
 ENTRY_POINT_GROUP = "pcabench.solvers"
 SOLVER_NAME = NAME  # the record's solver field (pcabench/schema.py): the one name rule
 DEFAULT_SOLVER = "linkedlist-cpu"  # what a study runs when no solver is named: the paper's cell list, on the CPU
 
+SOLVERS = Registry(
+    "solver",
+    __package__,
+    Solver,
+    group=ENTRY_POINT_GROUP,
+    order=lambda cls: cls.__module__,  # by module, as found
+    option="solver",
+    error=SceneError,
+    declares=declares_a_name,  # a module is imported only if its source names a class: no GPU library touched
+)
 
-def _declares_a_solver(path: Path) -> bool:
-    """Whether the module at ``path`` defines a class with a ``name`` attribute (without importing it)."""
-    try:
-        tree = ast.parse(path.read_text(encoding="utf-8"))
-    except (OSError, SyntaxError, UnicodeDecodeError):
-        return False
-    return any(
-        isinstance(node, ast.ClassDef)
-        and any(
-            isinstance(stmt, (ast.Assign, ast.AnnAssign))
-            and any(
-                getattr(t, "id", None) == "name"
-                for t in (stmt.targets if isinstance(stmt, ast.Assign) else [stmt.target])
-            )
-            for stmt in node.body
-        )
-        for node in tree.body
-    )
+__all__ = ["PluginWarning", "SOLVERS"]
 
 
-def _solver_classes(module) -> list[type[Solver]]:
-    """The named, concrete Solver subclasses defined in ``module``."""
-    return [
-        cls
-        for _, cls in inspect.getmembers(module, inspect.isclass)
-        if issubclass(cls, Solver)
-        and cls.__module__ == module.__name__
-        and "name" in cls.__dict__
-        and cls.name
-        and not inspect.isabstract(cls)
-    ]
-
-
-def _builtin() -> list[type[Solver]]:
-    package = Path(__file__).parent
-    found = []
-    for info in sorted(pkgutil.iter_modules([str(package)]), key=lambda m: m.name):
-        if info.name != "registry" and _declares_a_solver(package / f"{info.name}.py"):
-            found += _solver_classes(importlib.import_module(f"{__package__}.{info.name}"))
-    return found
-
-
-class PluginWarning(UserWarning):
-    """A plug-in solver left out, or registered under another name than its entry point's."""
-
-
-def _plugins(taken: set) -> list[type[Solver]]:
-    found = []
-    for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
-        where = f"entry point {entry.name!r} of group {ENTRY_POINT_GROUP} ({entry.value})"
-
-        def warn(what: str, where: str = where) -> None:
-            warnings.warn(f"{where}{what}", PluginWarning, stacklevel=3)
-
-        try:
-            cls = entry.load()
-        except BaseException as exc:  # noqa: BLE001 - a broken plug-in (even one calling sys.exit) is left out
-            if isinstance(exc, KeyboardInterrupt):
-                raise
-            warn(f" left out: it does not load ({type(exc).__name__}: {exc})")
-            continue
-        if not (inspect.isclass(cls) and issubclass(cls, Solver)) or inspect.isabstract(cls):
-            warn(" left out: not a concrete Solver subclass")
-        elif not cls.__dict__.get("name"):  # a subclass of a built-in inherits its name: not its own
-            warn(
-                " left out: the class sets no name of its own"
-                + (f" (it would inherit {cls.name!r})" if cls.name else "")
-            )
-        elif name_problem(cls.name, "solver"):
-            warn(f" left out: {name_problem(cls.name, 'solver')}")
-        elif cls.name in taken:
-            warn(f" left out: the solver name {cls.name!r} is taken")
-        else:
-            if entry.name != cls.name:
-                warn(f": registered as {cls.name!r}, its class's name")
-            found.append(cls)
-            taken.add(cls.name)
-    return found
-
-
-@lru_cache(maxsize=None)
 def registry() -> dict[str, type[Solver]]:
     """{name: solver class}: the built-in solvers first, then those of installed plug-ins."""
-    builtin = {cls.name: cls for cls in _builtin()}
-    return {**builtin, **{cls.name: cls for cls in _plugins(set(builtin))}}
+    return SOLVERS.all()
 
 
 def solver_names() -> tuple[str, ...]:
     """Every solver's name, built-in first."""
-    return tuple(registry())
+    return SOLVERS.names()
 
 
 def solver_class(name: str) -> type[Solver]:
     """The class of solver ``name``; SceneError naming ``solver`` and the choices otherwise."""
-    try:
-        return registry()[name]
-    except (KeyError, TypeError):
-        raise SceneError(f"solver must be one of {', '.join(registry())} (got {name!r})") from None
+    return SOLVERS.get(name)
 
 
 def check_pair_loop(name: str, requested: str) -> None:

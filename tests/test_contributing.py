@@ -23,7 +23,7 @@ from pcabench.reports import sections
 from pcabench.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene, registry, solver_names
-from solvers.scenes import scene_names
+from solvers.scenes import SCENES, scene_names
 
 ROOT = Path(__file__).resolve().parents[1]
 RECIPES = ("Add a solver", "Add a kernel", "Add a scene", "Add a report section", "Add a preset")
@@ -45,7 +45,7 @@ def run_recipe(tmp_path, monkeypatch):
     monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # the recipe's mkdtemp() lands in the test's folder
     solvers_before, scenes_before = dict(registry()), scene_names()
-    sections_before, presets_before = sections.SECTIONS, dict(presets.PRESETS)
+    sections_before, presets_before = sections.SECTIONS, presets.PRESETS.all()
 
     def execute(title: str) -> dict:
         namespace = {"__name__": "__recipe__"}
@@ -56,7 +56,7 @@ def run_recipe(tmp_path, monkeypatch):
     # each recipe unregisters what it registered
     assert dict(registry()) == solvers_before and scene_names() == scenes_before
     assert sections.SECTIONS is sections_before or sections.SECTIONS == sections_before
-    assert presets.PRESETS == presets_before
+    assert presets.PRESETS.all() == presets_before
 
 
 def test_every_recipe_has_one_block_and_the_workflow_is_named():
@@ -110,7 +110,7 @@ def test_the_scene_recipe_registers_a_scene_with_finite_initial_fields(run_recip
     assert kind.name not in scene_names()  # unregistered once its block ended
     assert ns["record"].status == "ok" and 0 < ns["record"].mse < 0.05
     assert ns["record"].scene["name"] == kind.name
-    with ns["registered_scene"](kind):
+    with SCENES.registered(ns["StandingWave"]) as kind:
         assert kind.name in scene_names()
         scene = Scene(name=kind.name, dx=0.5, steps=2, model="linear")
         assert scene.periodic_x and scene.n_particles == 40 * 40

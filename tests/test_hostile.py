@@ -234,6 +234,7 @@ class Path(LinkedListCPU):
 
 def test_a_plugin_whose_name_would_not_read_back_is_left_out(tmp_path, monkeypatch):
     from solvers import registry
+    from solvers.registry import SOLVERS
 
     from .test_registry import install
 
@@ -244,13 +245,13 @@ def test_a_plugin_whose_name_would_not_read_back_is_left_out(tmp_path, monkeypat
         {"newline": "badname_solver:Newline", "path": "badname_solver:Path"},
     )
     monkeypatch.syspath_prepend(str(site))
-    registry.cache_clear()
+    SOLVERS.cache_clear()
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             found = registry()
     finally:
-        registry.cache_clear()
+        SOLVERS.cache_clear()
         sys.modules.pop("badname_solver", None)
     assert "two\nlines" not in found and "../../forged" not in found
     assert sum("not a plain name" in str(w.message) for w in caught) == 2

@@ -376,7 +376,7 @@ def test_an_installed_plugin_kernel_is_found_through_its_entry_point(tmp_path, m
         "broken = plugin_kernel:Missing\n"
     )
     monkeypatch.syspath_prepend(str(site))
-    kernel_registry._found.cache_clear()
+    kernel_registry.KERNELS.cache_clear()
     try:
         with pytest.warns(KernelPluginWarning, match="'broken' .* left out: it does not load"):
             names = kernel_names()
@@ -384,5 +384,5 @@ def test_an_installed_plugin_kernel_is_found_through_its_entry_point(tmp_path, m
         assert Scene(dx=0.5, kernel="plugin-quintic").cutoff == pytest.approx(3 * 0.5 * Scene.default("h_factor"))
     finally:
         monkeypatch.undo()
-        kernel_registry._found.cache_clear()
+        kernel_registry.KERNELS.cache_clear()
     assert kernel_names() == BUILTIN

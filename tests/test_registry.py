@@ -24,6 +24,7 @@ from pcabench.run import run
 from pcabench.spec import RunSpec
 from solvers import ENTRY_POINT_GROUP, Scene, registry
 from solvers.interface import Solver
+from solvers.registry import SOLVERS
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -59,9 +60,9 @@ def site(tmp_path, monkeypatch):
     path = tmp_path / "site"
     path.mkdir()
     monkeypatch.syspath_prepend(str(path))
-    registry.cache_clear()
+    SOLVERS.cache_clear()
     yield path
-    registry.cache_clear()
+    SOLVERS.cache_clear()
     for name in [m for m in sys.modules if m in ("argsort_solver", "broken_solver")]:
         del sys.modules[name]
 

@@ -6,6 +6,7 @@ from .base import Kernel
 from .registry import (
     DEFAULT_KERNEL,
     ENTRY_POINT_GROUP,
+    KERNELS,
     KernelPluginWarning,
     kernel_named,
     kernel_names,
@@ -19,6 +20,7 @@ __all__ = [
     "Kernel",
     "DEFAULT_KERNEL",
     "ENTRY_POINT_GROUP",
+    "KERNELS",
     "KernelPluginWarning",
     "kernel_named",
     "kernel_names",

@@ -3,6 +3,15 @@
 from __future__ import annotations
 
 from .base import BOUNDARY_KINDS, SceneKind
-from .registry import DEFAULT_SCENE, ENTRY_POINT_GROUP, scene_kind, scene_names, scenes
+from .registry import DEFAULT_SCENE, ENTRY_POINT_GROUP, SCENES, scene_kind, scene_names, scenes
 
-__all__ = ["BOUNDARY_KINDS", "SceneKind", "DEFAULT_SCENE", "ENTRY_POINT_GROUP", "scene_kind", "scene_names", "scenes"]
+__all__ = [
+    "BOUNDARY_KINDS",
+    "SceneKind",
+    "DEFAULT_SCENE",
+    "ENTRY_POINT_GROUP",
+    "SCENES",
+    "scene_kind",
+    "scene_names",
+    "scenes",
+]
