@@ -45,7 +45,7 @@ def run_recipe(tmp_path, monkeypatch):
     monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # the recipe's mkdtemp() lands in the test's folder
     solvers_before, scenes_before = dict(registry()), scene_names()
-    sections_before, presets_before = sections.SECTIONS, presets.PRESETS.all()
+    sections_before, presets_before = sections.SECTIONS.all(), presets.PRESETS.all()
 
     def execute(title: str) -> dict:
         namespace = {"__name__": "__recipe__"}
@@ -55,7 +55,7 @@ def run_recipe(tmp_path, monkeypatch):
     yield execute
     # each recipe unregisters what it registered
     assert dict(registry()) == solvers_before and scene_names() == scenes_before
-    assert sections.SECTIONS is sections_before or sections.SECTIONS == sections_before
+    assert sections.SECTIONS.all() == sections_before
     assert presets.PRESETS.all() == presets_before
 
 
@@ -124,10 +124,10 @@ def test_the_scene_recipe_registers_a_scene_with_finite_initial_fields(run_recip
 
 
 def test_the_section_recipe_adds_its_section_to_the_report(run_recipe):
-    before = [s.name for s in sections.SECTIONS]
+    before = [s.name for s in sections.in_order()]
     ns = run_recipe("Add a report section")
     assert isinstance(ns["mine"], sections.Section) and ns["mine"].name not in before
-    assert [s.name for s in sections.SECTIONS] == before  # unregistered once its block ended
+    assert [s.name for s in sections.in_order()] == before  # unregistered once its block ended
     report = (ns["folder"] / "reports" / "my-laptop" / "report.md").read_text()
     assert report.rstrip().split("\n## ")[-1].startswith("Figures")  # the report's own end
     table = report.split("## Runs by status")[1].split("\n## ")[0]

@@ -2,7 +2,7 @@
 
 The quick study's figures are drawn from records made from the quick preset's own run specs (the
 times and errors synthetic, the runs exactly those `study --quick` makes), so that the report of a
-quick study holds every section of the report's section registry (pcabench/reports/sections.py,
+quick study holds every section of the report's section registry (pcabench/reports/sections/,
 ``SECTIONS``) with every figure that section declares, each passing the checks: the list of sections
 and figures is the registry's, never one kept here. The committed reference's figures pass them too.
 """
@@ -117,7 +117,8 @@ def quick_report(tmp_path_factory):
         store.append(rec, tmp / "store" / f"{PROFILE}.jsonl")
     texts, drawn = {}, {}
     with pytest.MonkeyPatch.context() as patch, record() as found:
-        patch.setattr(sections, "SECTIONS", tuple(recorded(s, texts, drawn) for s in sections.SECTIONS))
+        recorded_sections = [recorded(s, texts, drawn) for s in sections.in_order()]
+        patch.setattr(sections, "in_order", lambda: recorded_sections)
         write_reports(tmp / "store", tmp / "reports")
     return tmp / "reports", found, texts, drawn
 
@@ -127,9 +128,9 @@ def test_a_quick_study_writes_every_section_and_figure_of_the_registry(quick_rep
     declares; one with none (Table 6 needs a GPU's runs) writes and draws nothing. Every PNG is a section's."""
     out, found, texts, drawn = quick_report
     report = (out / PROFILE / "report.md").read_text()
-    written = [s for s in sections.SECTIONS if texts.get(s.name)]
-    assert len(written) > len(sections.SECTIONS) // 2, [s.name for s in written]  # the quick study's purpose
-    for section in sections.SECTIONS:
+    written = [s for s in sections.in_order() if texts.get(s.name)]
+    assert len(written) > len(sections.in_order()) // 2, [s.name for s in written]  # the quick study's purpose
+    for section in sections.in_order():
         lines, paths = texts.get(section.name), drawn.get(section.name, [])
         if not lines:
             assert not any(paths), (section.name, paths)  # no rows: no figure either

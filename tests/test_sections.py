@@ -7,6 +7,8 @@ import pytest
 from pcabench import store
 from pcabench.reports import sections, write_reports
 from pcabench.reports import tables as T
+from pcabench.reports.sections import long_runs as long_runs_section
+from pcabench.reports.sections import stability as stability_section
 
 from .test_study import fixture_rows
 
@@ -48,8 +50,8 @@ def test_a_new_section_is_one_entry_with_its_rows_text_and_figure(tmp_path, monk
         path.write_bytes(b"")
         return path
 
-    monkeypatch.setattr(sections, "SECTIONS", (*sections.SECTIONS, sections.Section("mine", rows, text, (figure,))))
-    write_reports(_results(tmp_path), tmp_path / "out")
+    with sections.SECTIONS.registered(sections.Section("mine", rows, text, (figure,))):
+        write_reports(_results(tmp_path), tmp_path / "out")
     report = (tmp_path / "out" / "machine-a" / "report.md").read_text()
     assert "## My table" in report and "runs on machine-a" in report and "![my_figure](my_figure.png)" in report
 
@@ -102,7 +104,7 @@ def test_the_stability_summary_agrees_with_the_prediction_and_the_map(tmp_path, 
     points, limits = T.stability(_stability_frame(tmp_path), 0.2)
     for p in points:  # at or past the predicted 4.97 a run is unstable, blown up or by prediction
         assert (p["class"] in ("unstable", "unstable by prediction")) == (p["cfl"] >= 4.97), p
-    lines = sections._stability_text((points, limits), None)
+    lines = stability_section.text((points, limits), None)
     text = "\n".join(lines)
     summary = next(line for line in lines if line.startswith("- **verlet** (t = 10 s)"))
     assert "stable up to CFL 4.8 as long runs on this scene measured" in summary, summary  # the free ends
@@ -199,6 +201,6 @@ def test_the_long_run_table_measures_each_models_limit_below_its_first_blow_up(t
     assert lin["blew_up_from"] == 5.0 and lin["e_foldings"] < 1e-9 and lin["held"] is None
     assert fixed["bounded_to"] == 4.6 and fixed["blew_up_from"] == 4.7 and fixed["first_step"] == 236  # not 4.8
     assert fixed["held"] == 4.75  # pcabench/stability.py's MEASURED_LIMITS: fixed on the 2D pulse
-    text = "\n".join(sections._long_runs_text(list(rows.values()), None))
+    text = "\n".join(long_runs_section.text(list(rows.values()), None))
     assert "**fixed** on acoustic-pulse blew up below the predicted 4.97, from CFL 4.7" in text
     assert "**linear** blew up below" not in text

@@ -18,7 +18,7 @@ import pytest  # noqa: E402
 
 from pcabench import presets, store  # noqa: E402
 from pcabench.reports import frame, sections  # noqa: E402
-from pcabench.reports import walls as W  # noqa: E402
+from pcabench.reports.sections import walls as W  # noqa: E402
 from solvers import Scene, kernel_names, scenes  # noqa: E402
 from solvers.dispersion import predict, stable_cfl  # noqa: E402
 from solvers.method import Method
@@ -163,7 +163,7 @@ def test_the_section_renders_the_stores_numbers_and_findings(tmp_path):
 def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):
     from types import SimpleNamespace
 
-    (section,) = [s for s in sections.SECTIONS if s.name == "walls"]
+    (section,) = [s for s in sections.in_order() if s.name == "walls"]
     assert section.all_scenes  # it reads every scene's runs, not the paper's scene's only
     data = W.rows(frame.load(_store(tmp_path / "store" / "m.jsonl").parent))
     with record() as found:

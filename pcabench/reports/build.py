@@ -1,6 +1,6 @@
 """Write the Markdown reports: one per measured profile, the card comparison, and the index.
 
-reports/<profile>/report.md   every section of ``sections.SECTIONS`` with its figures
+reports/<profile>/report.md   every section of the registry ``sections.SECTIONS`` with its figures
 reports/cards.md              Table 6 and Fig. 14 across systems, GPU cards side by side
 reports/README.md             the index
 """
@@ -43,7 +43,7 @@ def report_for(ctx: Context) -> Path:
     out, df = ctx.out, ctx.df_scenes if ctx.df_scenes is not None else ctx.df
     own_folder(out, "report folder", within=out.parent)  # a link is refused: nothing written or deleted there
     body, figs = [], []
-    for section in sections.SECTIONS:  # read at each report: a section appended to the registry is in it
+    for section in sections.in_order():  # read at each report: a section registered since is in it
         if ctx.df.empty and not section.all_scenes:
             continue  # this machine ran other scenes only
         rows = section.rows(ctx)

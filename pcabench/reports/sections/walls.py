@@ -1,4 +1,4 @@
-"""Rows of the report's "Sound at a rigid wall" section (``pcabench study --walls``): the error at the wall against
+"""The report's "Sound at a rigid wall" section (``pcabench study --walls``): the error at the wall against
 its prediction, the stable CFL at the wall over long runs beside the free scenes' own, and the time per step with
 and without the wall at the same N.
 
@@ -14,9 +14,11 @@ from pcabench.presets import FREE_COUNTERPART, LONG_T_END, WALLS, cost_round
 from pcabench.spec import scene_from_row
 from solvers import Scene, scenes
 
-from .md import fmt, md_table
+from .. import figures as F
+from ..md import fmt, md_table
+from ..tables import is_paper_method, latest, long_run_limits
+from .base import Section
 from .scenes import T_FINAL
-from .tables import is_paper_method, latest, long_run_limits
 
 
 def wall_scenes() -> tuple[str, ...]:
@@ -476,3 +478,13 @@ def text(data, ctx) -> list[str]:
         "",
         *body,
     ]
+
+
+SECTION = Section(
+    "walls",
+    lambda ctx: rows(ctx.df_scenes if ctx.df_scenes is not None else ctx.df),
+    text,
+    (lambda d, ctx: F.wall_errors(d["accuracy"], ctx.out, ctx.name) if d else None,),
+    all_scenes=True,
+    order=150,
+)

@@ -1,4 +1,4 @@
-"""Rows of the report's per-scene sections: time to accuracy on every scene, and which model each scene needs.
+"""The report's per-scene section: time to accuracy on every scene, and which model each scene needs.
 
 Every finished run at t = 10 s of every scene (solvers/scenes/), scored by
 its scene's own primary error (u for the plane pulse, drho for the 2D
@@ -17,9 +17,12 @@ import numpy as np
 
 from pcabench.spec import scene_from_row
 from pcabench.stability import past_limit, stable_limit
-from solvers import DEFAULT_SCENE, Scene
+from solvers import DEFAULT_SCENE, Scene, scene_kind
 
-from .tables import is_paper_method, latest, numerics_label
+from .. import figures as F
+from ..md import fmt, md_table, pct
+from ..tables import is_paper_method, latest, numerics_label
+from .base import Section
 
 TARGETS = (0.10, 0.05, 0.02)  # relative RMS errors of the primary field
 T_FINAL = 10.0  # s
@@ -229,3 +232,169 @@ def front_shifts(points_, most: int = 12) -> list[dict]:
             }
         )
     return out
+
+
+def rows(ctx):
+    df = ctx.df_scenes if ctx.df_scenes is not None else ctx.df
+    if df.empty or set(df.scene) == {Scene.default("name")} and not (df.mach != Scene.default("mach")).any():
+        return None  # the paper's scene only, at its amplitude: the sections above say it all
+    pts = points(df)
+    rows = time_to_accuracy(df)
+    methods = {}
+    for r in rows:
+        for p in (r["best"], r["paper"]):
+            if p is not None:
+                methods.setdefault(
+                    (p["kernel"], p["h_factor"], p["cfl"]),
+                    {
+                        "kernel": p["kernel"],
+                        "h_factor": p["h_factor"],
+                        "cfl": p["cfl"],
+                        "dx": 0.25,
+                        "label": f"{p['method']}" + (" (paper's)" if p["paper_method"] else ""),
+                    },
+                )
+    return {
+        "points": pts,
+        "fastest": rows,
+        "needs": model_needs(df),
+        "phase": phase_directions(list(methods.values())),
+        "fronts": front_shifts(pts),
+    }
+
+
+def text(data, ctx) -> list[str]:
+    if not data:
+        return []
+    rows = [
+        [
+            r["scene"],
+            r["model"],
+            pct(r["target"]),
+            r["best"]["method"],
+            fmt(r["best"]["dx"], "g"),
+            fmt(r["best"]["seconds"], ".3g"),
+            pct(r["best"]["error"]),
+            pct(r["predicted"]),
+            f"{r['best']['cfl'] / r['best']['stable_cfl']:.2f}" if r["best"]["stable_cfl"] else "-",
+            fmt(r["paper"]["dx"], "g") if r["paper"] else "-",
+            fmt(r["paper"]["seconds"], ".3g") if r["paper"] else "-",
+            fmt(r["speedup"], ".3g") if r["speedup"] else "-",
+        ]
+        for r in data["fastest"]
+    ]
+    lines = [
+        "## Time to accuracy on each scene",
+        "",
+        f"Every finished run at t = {T_FINAL:g} s of every scene (solvers/scenes/; `pcabench study --front "
+        "--scene NAME`), at the scene's default amplitude, Mach 0.05. The error is the scene's primary field "
+        "(u for the plane pulse, drho for the 2D acoustic pulse), relative RMS, against the exact linear "
+        "solution for `linear` and the isothermal solution for `lagrangian`. A run at or past its predicted "
+        "stable CFL is never picked, whatever its error (it was too short for round-off to grow). The "
+        "prediction (`pcabench accuracy --scene NAME`) is exact for `linear` on a periodic scene; for "
+        "`lagrangian` it is the linear part only. Times on this machine, serial unless labelled.",
+        "",
+        md_table(
+            [
+                "scene",
+                "model",
+                "target",
+                "fastest method",
+                "dx",
+                "time (s)",
+                "error",
+                "predicted",
+                "CFL / stable",
+                "paper's method: dx",
+                "time (s)",
+                "paper / fastest",
+            ],
+            rows,
+        )
+        if rows
+        else "No run of a scene at t = 10 s reaches 10 %.",
+        "",
+    ]
+    by_target = {}
+    for r in data["fastest"]:
+        if scene_kind(r["scene"]).walls:
+            continue  # the question is the free pulse's, plane against 2D; the walls have a section of their own
+        by_target.setdefault((r["model"], r["target"]), {})[r["scene"]] = r["best"]["method"]
+    both = {k: v for k, v in by_target.items() if len(v) > 1}
+    if both:
+        differ = [
+            f"{m} to {pct(t)} ({'; '.join(f'{s}: {meth}' for s, meth in sorted(v.items()))})"
+            for (m, t), v in sorted(both.items())
+            if len(set(v.values())) > 1
+        ]
+        lines += [
+            f"Does the method fastest on the plane pulse stay fastest in 2D? In {len(both) - len(differ)} of "
+            f"{len(both)} (model, target) pairs both scenes name the same method"
+            + (f"; they differ for {', '.join(differ)}." if differ else "."),
+            "",
+        ]
+    needs = [
+        [
+            r["scene"],
+            fmt(r["mach"], "g"),
+            pct(r["target"]),
+            pct(r["floor"]),
+            *(
+                (
+                    "-"
+                    if r.get(model) is None
+                    else f"{fmt(r[model]['seconds'], '.3g')} s (dx {fmt(r[model]['dx'], 'g')})"
+                    if r[model]["reaches"]
+                    else f"not reached (best {pct(r[model]['best'])})"
+                )
+                for model in ("linear", "lagrangian")
+            ),
+            "linear suffices"
+            if r["floor"] is not None and r["floor"] < r["target"]
+            else "lagrangian (linear's floor is above the target)",
+        ]
+        for r in data["needs"]
+    ]
+    if needs:
+        lines += [
+            "### Which model this scene needs",
+            "",
+            "The paper's method (Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet) at several amplitudes, every "
+            "model scored against the isothermal physics (the equations the paper's moving particles "
+            "solve): the cheapest run within the target, or the smallest error its runs reached. `linear`'s "
+            "floor is the distance between the exact linear and the isothermal solutions at t = 10 s (no "
+            "dx removes it; it grows with the amplitude and the time): where it is below the target the "
+            "linear model is all the scene needs.",
+            "",
+            md_table(["scene", "Mach", "target", "linear's floor", "linear", "lagrangian", "the scene needs"], needs),
+            "",
+        ]
+    if data["phase"]:
+        spread = [abs(c["error"][0] - c["error"][-1]) for c in data["phase"]]
+        short = [abs(c["short"][0] - c["short"][-1]) for c in data["phase"]]
+        lines += [
+            "The lattice's phase error depends on the direction of travel. `phase_direction.png` draws, for "
+            "the methods of the table, the predicted phase speed error (lattice and step together) at the "
+            "2D pulse's wavenumber 1/b from the lattice's axis (0 degrees) to its diagonal (45 degrees) at "
+            f"dx = 0.25 m: axis and diagonal differ by at most {100 * max(spread):.3g} % of c0 there, far "
+            "less than the lag itself; for a short wave of 8 particles per wavelength by up to "
+            f"{100 * max(short):.3g} %. Beside it, the 2D runs' wave front speed error along the axis and "
+            "along the diagonal (the outgoing peak of drho against the exact one's, over c0 t), measured "
+            "against the same measure on the predicted fields; each run also stores its relative RMS error "
+            "along the axes and the diagonals apart (`err_axis_rms`, `err_diagonal_rms`).",
+            "",
+        ]
+    return lines
+
+
+SECTION = Section(
+    "scenes",
+    rows,
+    text,
+    (
+        lambda d, ctx: F.scene_fronts(d["points"], ctx.out, ctx.name) if d else None,
+        lambda d, ctx: F.phase_direction(d["phase"], d["fronts"], ctx.out, ctx.name) if d else None,
+    ),
+    all_scenes=True,
+    order=140,
+)
