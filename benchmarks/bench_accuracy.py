@@ -12,12 +12,12 @@ from .common import Prepared, Scene, large, thinnest_strip
 
 
 def run(scene, solver):
-    """pcabench.run.run, imported when called: discovery imports every module, and at a commit without
+    """pcabench.execute.run.run, imported when called: discovery imports every module, and at a commit without
     the harness's package (bf587a5) HEAD's pcabench does not import with that commit's solvers. Runs take
     a RunSpec from 2026-11-30 on, a scene and a solver name before."""
     import inspect
 
-    from pcabench.run import run
+    from pcabench.execute.run import run
 
     if "spec" in inspect.signature(run).parameters:
         from pcabench.spec import RunSpec

@@ -42,8 +42,21 @@ def _solver_package():
 solvers = _solver_package()
 
 Scene, make_solver = solvers.Scene, solvers.make_solver
-analytic_errors = import_module(f"{solvers.__name__}.analytic").errors
-step_program = import_module(f"{solvers.__name__}.integrators").step_program
+
+
+def _module(*names: str):
+    """The first of ``names`` (under the solver package) that imports: where a module lives in this commit's
+    layout (solvers/reference/, solvers/physics/ since issue 40; the package's root before)."""
+    for name in names:
+        try:
+            return import_module(f"{solvers.__name__}.{name}")
+        except ImportError:
+            continue
+    raise ImportError(f"none of {', '.join(names)} in {solvers.__name__}")
+
+
+analytic_errors = _module("reference.analytic", "analytic").errors
+step_program = _module("physics.integrators", "integrators").step_program
 
 
 def solver_names(device: str | None = None) -> list:

@@ -1,7 +1,7 @@
 """pcabench: benchmarking harness and study suite for SPH acoustics.
 
-Data flow: scene -> solver (the package ``solvers``) -> stage clock (pcabench.clock)
--> run record (pcabench.record) -> results store (pcabench.store)
+Data flow: scene -> solver (the package ``solvers``) -> stage clock (pcabench.execute.clock)
+-> run record (pcabench.store.record) -> results store (pcabench.store)
 -> reports (pcabench.reports).
 """
 

@@ -11,10 +11,9 @@ from __future__ import annotations
 import math
 import shlex
 
+from pcabench.parameters import METHOD, PRECISION_MODEL, PROBLEM, number_word
+from pcabench.spec import SERIAL, RunSpec
 from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, kernel_named, resolve_pair_loop
-
-from .parameters import METHOD, PRECISION_MODEL, PROBLEM, number_word
-from .spec import SERIAL, RunSpec
 
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
 NO_OPTION = ("rho0", "c0", "blowup_factor")  # Scene parameters a command line does not set

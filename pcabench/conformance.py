@@ -39,18 +39,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from solvers import (
-    INTEGRATORS,
-    MODELS,
-    PRECISIONS,
-    Scene,
-    SceneError,
-    SolverUnavailable,
-    kernel_names,
-    solver_class,
-)
-from solvers.integrators import step_program
+from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError, SolverUnavailable, kernel_names, solver_class
 from solvers.interface import STAGES, Solver
+from solvers.physics.integrators import step_program
 from solvers.registry import SOLVERS
 
 REFERENCE = "allpair-cpu"  # the all-pair search: every pair tested, no cell list to get wrong
@@ -453,12 +444,12 @@ def threads(subject: Subject) -> str:
 
 @check
 def stages(subject: Subject) -> str:
-    """Run through the harness (pcabench.run.run), the six stages are booked and SNP, PI and SU take time
+    """Run through the harness (pcabench.execute.run.run), the six stages are booked and SNP, PI and SU take time
     (> 0); a run that blows up (forward Euler at CFL 5 on the linear model, 200 steps) is recorded as
     ``unstable`` at the step where its amplitude passes the bound, the same step as the all-pair
     reference's, not as an error."""
-    from .run import run
-    from .spec import RunSpec
+    from pcabench.execute.run import run
+    from pcabench.spec import RunSpec
 
     cls, problems = subject.cls, []
     if not cls.name:

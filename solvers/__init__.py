@@ -8,9 +8,9 @@ The SPH kernels are found the same way (solvers/kernels/, ``pcabench.kernels``).
 
 from __future__ import annotations
 
-from .interface import STAGES, Fields, Solver, SolverUnavailable
-from .kernels import DEFAULT_KERNEL, Kernel, kernel_named, kernel_names
-from .registry import (
+from solvers.interface import STAGES, Fields, Solver, SolverUnavailable
+from solvers.kernels import DEFAULT_KERNEL, Kernel, kernel_named, kernel_names
+from solvers.registry import (
     DEFAULT_SOLVER,
     ENTRY_POINT_GROUP,
     check_pair_loop,
@@ -20,8 +20,8 @@ from .registry import (
     solver_class,
     solver_names,
 )
-from .scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
-from .scenes import DEFAULT_SCENE, SceneKind, scene_kind, scene_names, scenes
+from solvers.scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
+from solvers.scenes import DEFAULT_SCENE, SceneKind, scene_kind, scene_names, scenes
 
 __all__ = [
     "Scene",

@@ -2,7 +2,7 @@
 
 SNP is empty: the pair loop itself tests every pair against the cutoff, as
 the paper's all-pair code does. Same pair physics as the cell list
-(solvers/pairs.py), with the minimum image in y instead of a cell stencil.
+(solvers/physics/pairs.py), with the minimum image in y instead of a cell stencil.
 """
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ from __future__ import annotations
 import time
 from functools import lru_cache
 
-from .backend import COMPILED, cpu_loops, cpu_updates
-from .interface import Solver, across_x, tiny_scene
+from solvers.interface import Solver, across_x, tiny_scene
+from solvers.physics.backend import COMPILED, cpu_loops, cpu_updates
 
 
 @lru_cache(maxsize=None)

@@ -1,7 +1,7 @@
 """The common solver interface: the paper's six stages as primitives.
 
 A solver holds the particle state and offers the primitives that a step is
-made of. The integrator (solvers/integrators.py) composes them into a step
+made of. The integrator (solvers/physics/integrators.py) composes them into a step
 program of (stage, operation) pairs, and the stage clock times every
 operation from outside, the same way for every solver:
 
@@ -14,7 +14,7 @@ operation from outside, the same way for every solver:
 
 The state lives in arrays of the array module ``xp`` (NumPy on the CPU,
 CuPy on the GPU). The system update and the sweeps' coefficients are
-per-particle functions written once (solvers/pairs.py), which each solver
+per-particle functions written once (solvers/physics/pairs.py), which each solver
 launches (:meth:`Solver.launch`) on its own device and threads.
 All per-particle arrays sit in ``self.arrays`` so that a neighbour search
 that reorders particles can permute all of them together.
@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kernel
-from .kernels import kernel_names
-from .scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
+from solvers.kernels import constants as kernel
+from solvers.kernels import kernel_names
+from solvers.scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
 
 STAGES = ("input", "init", "snp", "pi", "su", "output")
 STATE = ("lx", "ly", "sx", "sy", "u", "v", "drho")
@@ -198,7 +198,7 @@ class Solver(abc.ABC):
     @abc.abstractmethod
     def launch(self, name: str, *args):
         """Run kernel ``name`` over every particle on this solver's device and threads: at least the
-        per-particle ones of solvers/pairs.py (coefficients, kick, advance)."""
+        per-particle ones of solvers/physics/pairs.py (coefficients, kick, advance)."""
 
     @abc.abstractmethod
     def _sweep(self, continuity: bool, momentum: bool) -> None:
@@ -317,7 +317,7 @@ def cell_grid(scene: Scene) -> tuple:
 
 def across_x(scene: Scene) -> bool:
     """Whether the pair sums of ``scene`` reach across an x edge: a periodic seam or a rigid wall
-    (the pair functions' compile-time ``across``, solvers/pairs.py)."""
+    (the pair functions' compile-time ``across``, solvers/physics/pairs.py)."""
     return bool(scene.periodic_x or scene.walls)
 
 

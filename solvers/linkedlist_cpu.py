@@ -13,7 +13,7 @@ one cutoff tall in y (a whole number of rows fills the periodic height).
 threads, as the honest multi-core peer.
 
 Two pair loops (``pair_loop``): ``gather``, the paper's, visits every
-particle's 3x3 stencil in every sweep; ``list`` (solvers/pairlist.py) lists
+particle's 3x3 stencil in every sweep; ``list`` (solvers/search/pairlist.py) lists
 each pair once per search with its kernel factors and updates both sides,
 which is several times faster but takes memory. ``auto`` (the default) takes
 the list where it fits in memory and the gather loop where it does not.
@@ -26,11 +26,11 @@ from functools import lru_cache
 import numba
 import numpy as np
 
-from . import pairlist
-from .backend import COMPILED, cpu_loops, cpu_sorting, cpu_updates, use_threads
-from .celllist import CellListSolver
-from .interface import across_x
-from .scene import SceneError
+from solvers.interface import across_x
+from solvers.physics.backend import COMPILED, cpu_loops, cpu_sorting, cpu_updates, use_threads
+from solvers.scene import SceneError
+from solvers.search import pairlist
+from solvers.search.celllist import CellListSolver
 
 
 def counting_sort(cell, ncells, begin, order, sorted_cell) -> None:

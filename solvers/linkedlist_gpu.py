@@ -1,7 +1,7 @@
 """Linked-list GPU solver: every stage on the device, float32 or float64 from one source.
 
 Device arrays are CuPy's; the kernels are numba-cuda, built from the same
-pair physics as the CPU solvers (solvers/pairs.py). One thread per particle,
+pair physics as the CPU solvers (solvers/physics/pairs.py). One thread per particle,
 every launch on the solver's own stream.
 
 The per-particle arrays are the rows of one 2D block (and a spare block of
@@ -15,7 +15,7 @@ order is that of the atomics, so sums may differ from run to run in the last
 bits. The system update writes the sweeps' coefficients as it updates drho,
 so a lagrangian Verlet step is 8 launches: kick, continuity, advance, the
 three of SNP, momentum, kick. Nothing is allocated inside a step, so a step
-can be captured once as a CUDA graph and replayed (solvers/gpu_graph.py).
+can be captured once as a CUDA graph and replayed (solvers/gpu/graph.py).
 
 Without a GPU, ``NUMBA_ENABLE_CUDASIM=1`` runs the same kernels in numba's
 CUDA simulator with NumPy in place of CuPy (small scenes only): that is how
@@ -26,9 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .celllist import CellListSolver
-from .gpu_device import device_backend, simulated
-from .scene import SceneError
+from solvers.gpu.device import device_backend, simulated
+from solvers.scene import SceneError
+from solvers.search.celllist import CellListSolver
 
 THREADS_PER_BLOCK = 256
 
@@ -108,14 +108,14 @@ class LinkedListGPU(CellListSolver):
 
     def launch(self, name, *args, grid=None):
         """Kernel ``name`` on the solver's stream: one thread per particle, or ``grid`` = (blocks, threads)."""
-        from .gpu_kernels import kernels  # numba.cuda only once a device (or the simulator) is known
+        from solvers.gpu.cuda_kernels import kernels  # numba.cuda only once a device (or the simulator) is known
 
         blocks, threads = grid or (self.blocks, self.threads_per_block)
         kernels(self.scene.precision, self.scene.kernel)[name][blocks, threads, self.launch_stream](*args)
 
     def sort_cells(self) -> None:
         """Counting sort by cell in three launches; the spare block becomes the current one."""
-        from .gpu_kernels import scan_block
+        from solvers.gpu.cuda_kernels import scan_block
 
         a = self.arrays
         lx, ly, sx, sy, cell, *grid = self.grid_arguments(a["lx"], a["ly"], a["sx"], a["sy"], self.cell)
@@ -171,7 +171,7 @@ class LinkedListGPU(CellListSolver):
     def count_neighbours(self) -> int:
         """On a cell list of its own (the same three launches as SNP), over a copy of the positions
         scattered into its cell order: the particle blocks and the solver's cell list untouched."""
-        from .gpu_kernels import scan_block
+        from solvers.gpu.cuda_kernels import scan_block
 
         a, xp, n = self.arrays, self.xp, self.scene.n_particles
         src = xp.stack([a["lx"], a["ly"], a["sx"], a["sy"]])  # a copy: the kernel may wrap it

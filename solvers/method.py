@@ -34,8 +34,8 @@ class Method:
     def of(cls, values) -> "Method":
         """The method of a Scene or of a stored row (a dict, a DataFrame row: the fields of :data:`FIELDS`; one a
         row predates at Scene's default)."""
-        from .kernels import truncated
-        from .scene import Scene
+        from solvers.kernels import truncated
+        from solvers.scene import Scene
 
         def get(name):
             value = getattr(values, name, None) if not hasattr(values, "get") else values.get(name)
@@ -55,7 +55,7 @@ class Method:
     @classmethod
     def paper(cls) -> "Method":
         """The paper's method: Scene's defaults (the Gaussian at h = 2.13 dx, cut at 3h, CFL 0.2, Verlet)."""
-        from .scene import Scene
+        from solvers.scene import Scene
 
         return cls.of({name: Scene.default(name) for name in FIELDS})
 
@@ -75,10 +75,10 @@ class Method:
 
     def stable_cfl(self) -> float:
         """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion
-        relation's, solvers/dispersion.py; the same at every dx, so dx = 1 stands for all; 0 where the
+        relation's, solvers/reference/dispersion.py; the same at every dx, so dx = 1 stands for all; 0 where the
         integrator grows at any step)."""
-        from .dispersion import stable_cfl
-        from .scene import Scene
+        from solvers.reference.dispersion import stable_cfl
+        from solvers.scene import Scene
 
         return stable_cfl(Scene(dx=1.0, t_end=1.0, model="linear", **{**self.scene_fields(), "cfl": 0.2}))
 

@@ -19,12 +19,12 @@ does not name a Solver subclass with a ``name`` of its own is left out with one
 
 from __future__ import annotations
 
-from .interface import Solver
-from .plugins import NAME, PluginWarning, Registry, declares_a_name
-from .scene import SceneError
+from solvers.interface import Solver
+from solvers.plugins import NAME, PluginWarning, Registry, declares_a_name
+from solvers.scene import SceneError
 
 ENTRY_POINT_GROUP = "pcabench.solvers"
-SOLVER_NAME = NAME  # the record's solver field (pcabench/schema.py): the one name rule
+SOLVER_NAME = NAME  # the record's solver field (pcabench/store/schema.py): the one name rule
 DEFAULT_SOLVER = "linkedlist-cpu"  # what a study runs when no solver is named: the paper's cell list, on the CPU
 
 SOLVERS = Registry(

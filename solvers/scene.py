@@ -13,7 +13,7 @@ A scene states its particle count and memory before anything is allocated
 the parameter and the allowed range (:class:`SceneError`). It is a pure value:
 it checks its arrays against ``memory_limit_bytes`` when it states one and
 never reads the machine (the harness sets that limit to the memory available,
-pcabench/memory.py, before any work).
+pcabench/machine/memory.py, before any work).
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, replace
 
-from .kernels import DEFAULT_KERNEL, Kernel, kernel_named
-from .scenes import DEFAULT_SCENE, scene_kind
+from solvers.kernels import DEFAULT_KERNEL, Kernel, kernel_named
+from solvers.scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
 INTEGRATORS = ("verlet", "kdk1", "euler", "rk2")
@@ -346,7 +346,7 @@ class Scene:
     # ------------------------------------------------------------ memory
     def memory_limit(self) -> int | None:
         """Memory a run of this scene may use, bytes: ``memory_limit_bytes``; None where the scene states
-        no limit (a scene never reads the machine: the harness, pcabench.memory.bounded, sets the limit
+        no limit (a scene never reads the machine: the harness, pcabench.machine.memory.bounded, sets the limit
         to what is available before any work)."""
         return self.memory_limit_bytes
 

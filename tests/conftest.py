@@ -13,7 +13,7 @@ import pytest
 
 from benchmarks.common import gpu_available
 from pcabench import cli
-from pcabench.run import run
+from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
 
@@ -54,7 +54,7 @@ def requires_gpu():
 
 def run_children(pid: int) -> list[int]:
     """The run children among the descendants of ``pid``: forked by the sweep's forkserver (named
-    pcabench-run, pcabench/forkserver.py) or fresh interpreters (``python -m pcabench.child``)."""
+    pcabench-run, pcabench/execute/forkserver.py) or fresh interpreters (``python -m pcabench.execute.child``)."""
     found, todo = [], [pid]
     while todo:
         out = subprocess.run(["pgrep", "-P", str(todo.pop())], capture_output=True, text=True).stdout.split()
@@ -65,7 +65,7 @@ def run_children(pid: int) -> list[int]:
                 cmdline = open(f"/proc/{child}/cmdline", "rb").read()
             except OSError:
                 continue
-            if comm == b"pcabench-run" or b"pcabench.child" in cmdline:
+            if comm == b"pcabench-run" or b"pcabench.execute.child" in cmdline:
                 found.append(child)
     return found
 

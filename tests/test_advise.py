@@ -7,10 +7,10 @@ import json
 import pytest
 
 from pcabench import store
-from pcabench.advise import advise
+from pcabench.cli.advise import advise
+from pcabench.execute.sweep import failed_record
 from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
-from pcabench.sweep import failed_record
 from solvers import Scene
 
 from .conftest import cli_main
@@ -170,7 +170,7 @@ def test_advise_json_is_strict_and_the_paper_configuration_is_not_compared_with_
 
 
 def test_a_moving_model_past_its_long_run_limit_is_never_advised(tmp_path, capsys):
-    from pcabench import stability
+    from pcabench.predict import stability
 
     path = tmp_path / "results" / store.store_name("m", "h")
     path.parent.mkdir()

@@ -106,7 +106,7 @@ def test_a_local_cluster_listens_on_loopback_only():
 
     import psutil
 
-    from pcabench.cluster import connect
+    from pcabench.execute.cluster import connect
 
     with ExitStack() as stack:
         client = connect("local:1", stack)

@@ -19,8 +19,8 @@ import pytest
 
 from pcabench import presets, store
 from pcabench.conformance import registered
+from pcabench.execute.run import run
 from pcabench.reports import sections
-from pcabench.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene, registry, solver_names
 from solvers.scenes import SCENES, scene_names

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from pcabench import device_payload as dp
+from pcabench.gpu import payload as dp
 
 ROOT = Path(__file__).resolve().parent.parent
 

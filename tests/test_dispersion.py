@@ -1,4 +1,4 @@
-"""The predicted error and stable step (solvers/dispersion.py) against runs of the same scene.
+"""The predicted error and stable step (solvers/reference/dispersion.py) against runs of the same scene.
 
 The prediction is exact linear algebra of the `linear` model's discrete operator and the integrator's own
 step program on an unbounded lattice, so a run must agree with it to many digits while the pulse and its
@@ -11,10 +11,10 @@ import json
 
 import pytest
 
-from pcabench.run import run
+from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
-from solvers.dispersion import largest_stable_z, predict, stable_cfl
+from solvers.reference.dispersion import largest_stable_z, predict, stable_cfl
 
 from .conftest import cli_main
 

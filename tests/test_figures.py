@@ -19,8 +19,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 
 from pcabench import paths, presets, store  # noqa: E402
-from pcabench.record import RunRecord  # noqa: E402
 from pcabench.reports import sections, write_reports  # noqa: E402
+from pcabench.store.record import RunRecord  # noqa: E402
 
 from .figure_check import problems, record  # noqa: E402
 

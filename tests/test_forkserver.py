@@ -1,4 +1,4 @@
-"""A sweep's runs forked from the warm server (pcabench/forkserver.py): the same record as a fresh
+"""A sweep's runs forked from the warm server (pcabench/execute/forkserver.py): the same record as a fresh
 interpreter's, the same budget, and a fresh interpreter wherever the environment differs."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import time
 
 import pytest
 
-from pcabench import forkserver
+from pcabench.execute import forkserver
+from pcabench.execute.sweep import run_child
 from pcabench.spec import RunSpec
-from pcabench.sweep import run_child
 from solvers import Scene
 from tests.conftest import run_children
 

@@ -22,7 +22,7 @@ from .conftest import in_simulator, run_fields
 SIM_SCRIPT = r"""
 import json, sys, tempfile, numpy as np
 from pathlib import Path
-from pcabench.run import run
+from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
 precision, model, steps, integrator, kernel = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
@@ -129,8 +129,8 @@ LAUNCH_SCRIPT = r"""
 import json, numpy as np
 from numba.cuda.simulator.kernel import FakeCUDAKernel
 from solvers import Scene, make_solver
-from solvers.integrators import step_program
-from solvers.gpu_kernels import kernels, scan_block
+from solvers.physics.integrators import step_program
+from solvers.gpu.cuda_kernels import kernels, scan_block
 
 launches = []
 plain_call = FakeCUDAKernel.__call__
@@ -200,7 +200,7 @@ def test_simulated_gpu_integrators_match_cpu(integrator):
 @pytest.mark.parametrize("precision,tol", [("float64", 1e-12), ("float32", 1e-4)])
 def test_gpu_graph_replays_the_plain_step(requires_gpu, precision, tol):
     """The captured step (CUDA graph) advances the state as the plain launches do, from one state."""
-    from pcabench.gpu_check import graph_vs_plain
+    from pcabench.gpu.check import graph_vs_plain
 
     row = graph_vs_plain(0.25, precision, steps=10, rounds=1, scene_overrides={})
     assert row["max_rel_diff_u"] < tol, row
@@ -211,7 +211,7 @@ def test_gpu_graph_replays_the_plain_step(requires_gpu, precision, tol):
 def test_gpu_walls_match_cpu(requires_gpu, tmp_path):
     """The GPU check's walls stage on the card: plane-wall and pulse-wall (mirror particles), linear and
     lagrangian, float64 and float32, against linkedlist-cpu."""
-    from pcabench.gpu_check import FULL, agrees, walls_against_cpu
+    from pcabench.gpu.check import FULL, agrees, walls_against_cpu
 
     rows = walls_against_cpu(FULL, tmp_path)
     assert len(rows) == len(FULL.wall_scenes) * 2 * len(FULL.wall_models) and agrees(rows), rows

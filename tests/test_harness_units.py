@@ -9,10 +9,10 @@ import numba
 import pytest
 
 from pcabench import store
-from pcabench.clock import HostClock
+from pcabench.execute.clock import HostClock
 from pcabench.predict import CACHED_JIT, COLD_JIT, START_UP, jit_seconds, predicted_seconds, step_model
-from pcabench.record import STEP_STAGES, RunRecord, step_seconds
 from pcabench.spec import ALL_CORES, OptionError, RunSpec, identity, resolve_threads, row_identity, usable_cores
+from pcabench.store.record import STEP_STAGES, RunRecord, step_seconds
 from solvers import STAGES, Scene
 
 
@@ -122,11 +122,11 @@ def test_step_seconds_is_the_step_stages_per_step():
 
 
 def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
-    """The GPU check's stages (pcabench/gpu_check.py STAGES): a stage that raises is recorded as failed, one
+    """The GPU check's stages (pcabench/gpu/check.py STAGES): a stage that raises is recorded as failed, one
     the budget cannot start is recorded as not run, and the stages after them still run."""
     from pathlib import Path
 
-    from pcabench import gpu_check as G
+    from pcabench.gpu import check as G
 
     ran = []
 
@@ -150,8 +150,8 @@ def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
 def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows():
     """The walls stage (GPU against CPU on the walled scenes) fails on a row past its precision's tolerance or
     on no rows, and the check's tables list its rows; the rehearsal's walled scenes are check-solver's tiny ones."""
-    from pcabench import gpu_check as G
     from pcabench.conformance import SCENES
+    from pcabench.gpu import check as G
     from solvers import Scene
 
     row = {"scene": "pulse-wall", "N": 182, "precision": "float32", "model": "lagrangian", "dx": 1.0, "steps": 3}

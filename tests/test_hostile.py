@@ -16,11 +16,13 @@ import warnings
 
 import pytest
 
-from pcabench import cli, profiles, provenance, schema, store
-from pcabench import sweep as sweep_module
-from pcabench.record import RunRecord
+from pcabench import cli, store
+from pcabench.execute import sweep as sweep_module
+from pcabench.execute.sweep import sweep
+from pcabench.machine import profiles
 from pcabench.spec import RunSpec
-from pcabench.sweep import sweep
+from pcabench.store import provenance, schema
+from pcabench.store.record import RunRecord
 from solvers import Scene
 
 from .conftest import cli_main
@@ -422,7 +424,7 @@ def test_gpu_check_out_link_is_refused(tmp_path, capsys):
 
 
 def test_gpu_check_writes_files_in_its_folder_without_following_links(tmp_path):
-    from pcabench.gpu_check import write_file
+    from pcabench.gpu.check import write_file
 
     out, target = tmp_path / "out", tmp_path / "precious.txt"
     out.mkdir()
@@ -446,7 +448,7 @@ def test_advise_quotes_every_command_for_the_shell():
 def test_a_full_disk_during_report_names_the_path_and_leaves_no_partial_file(tmp_path, capsys, monkeypatch):
     from matplotlib.figure import Figure
 
-    from pcabench import safeio
+    from pcabench.store import safeio
 
     results, out = _report_results(tmp_path), tmp_path / "out"
 

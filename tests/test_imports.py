@@ -150,3 +150,55 @@ def test_no_private_imports():
         if names and t != m
     ]
     assert found == []
+
+
+# The layers of the house, lowest first: a module imports from its own layer or one below, never one above (the
+# data flow of ARCHITECTURE.md: scene -> solver -> stage clock -> run record -> store -> reports). A module's
+# layer is that of the longest prefix here that names it.
+LAYERS = (
+    ("solvers.plugins", "solvers.kernels", "solvers.jitcache"),  # the registry mechanism, the kernels, the cache
+    ("solvers.physics",),  # the rates per pair and the integrators, for every backend
+    ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method"),  # the problem
+    ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops
+    ("solvers.allpair_cpu", "solvers.linkedlist_cpu", "solvers.linkedlist_gpu", "solvers.registry"),  # solvers
+    ("solvers",),  # the package's face
+    ("pcabench", "pcabench.errors", "pcabench.paths", "pcabench.jsonout", "pcabench.parameters", "pcabench.parser"),
+    ("pcabench.spec", "pcabench.commands"),  # what one run is, and the command that makes it again
+    ("pcabench.store",),  # the run record, its schema and the results store
+    ("pcabench.machine",),  # this machine's profile and memory
+    ("pcabench.predict",),  # wall time, stability and the fastest methods, predicted
+    ("pcabench.execute",),  # the stage clock, a run, its child, the sweep
+    ("pcabench.conformance", "pcabench.presets"),  # what every solver must do; the studies
+    ("pcabench.reports",),  # tables, sections, figures
+    ("pcabench.bench",),  # asv
+    ("pcabench.gpu",),  # the GPU check
+    ("pcabench.cli", "pcabench.launch"),  # the command line, and the console script that imports it
+)
+
+
+def layer_of(module: str) -> int | None:
+    best = max(
+        ((len(p), i) for i, layer in enumerate(LAYERS) for p in layer if module == p or module.startswith(p + ".")),
+        default=None,
+    )
+    return None if best is None else best[1]
+
+
+def test_every_module_of_the_house_has_a_layer():
+    assert [m for m in MODULES if m.split(".")[0] in ("pcabench", "solvers") and layer_of(m) is None] == []
+
+
+def test_no_module_imports_from_a_layer_above_its_own():
+    up = [
+        f"{m} ({LAYERS[layer_of(m)][0]}) imports {t} ({LAYERS[layer_of(t)][0]})"
+        for m, ts in GRAPH.items()
+        if layer_of(m) is not None
+        for t in ts
+        if layer_of(t) is not None and layer_of(t) > layer_of(m)
+    ]
+    assert up == []
+
+
+def test_an_upward_arrow_is_found():
+    assert layer_of("pcabench.store.record") < layer_of("pcabench.reports.sections.walls")
+    assert layer_of("solvers.scene") < layer_of("solvers.search.celllist") < layer_of("pcabench.spec")

@@ -1,4 +1,4 @@
-"""The radial isothermal Euler reference of the 2D pulse (solvers.isothermal_radial): its own convergence,
+"""The radial isothermal Euler reference of the 2D pulse (solvers.reference.isothermal_radial): its own convergence,
 its small-Mach limit (the linear open-domain solution), its nonlinearity at Ma = 0.05, and mass."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import time
 
 import numpy as np
 
-from solvers.isothermal_radial import isothermal_pulse_radial, isothermal_pulse_radial_cached
-from solvers.pulse2d import open_domain
+from solvers.reference.isothermal_radial import isothermal_pulse_radial, isothermal_pulse_radial_cached
+from solvers.reference.pulse2d import open_domain
 
 T, B, RHO0, C0, R_MAX = 10.0, 3.0, 1.0, 1.0, 40.0
 

@@ -70,7 +70,7 @@ PLUGIN = textwrap.dedent(
     """
     import math
     import numpy as np
-    from solvers.kernel import GRAD0, INV_H2
+    from solvers.kernels.constants import GRAD0, INV_H2
     from solvers.kernels import Kernel
 
     class Plugin(Kernel):
@@ -123,14 +123,14 @@ def test_an_edit_to_a_plugin_kernel_recompiles_and_undoing_it_restores_the_machi
 
 def test_the_key_covers_the_pair_physics_numba_and_the_target(monkeypatch):
     text = jitcache.render("solvers.loops.allpair", {"P": "cpu_pairs('float64', 'gaussian')"}, {})
-    base = jitcache.key(text, ("solvers.pairs",))
-    assert base == jitcache.key(text, ("solvers.pairs",))  # a key is a function of its inputs
-    assert base != jitcache.key(text, ("solvers.pairs", "solvers.kernel"))  # another source
+    base = jitcache.key(text, ("solvers.physics.pairs",))
+    assert base == jitcache.key(text, ("solvers.physics.pairs",))  # a key is a function of its inputs
+    assert base != jitcache.key(text, ("solvers.physics.pairs", "solvers.kernels.constants"))  # another source
     other = jitcache.render("solvers.loops.allpair", {"P": "cpu_pairs('float32', 'gaussian')"}, {})
-    assert base != jitcache.key(other, ("solvers.pairs",))  # another precision
-    assert "solvers.kernel" in jitcache.imports_of(jitcache.render("solvers.loops.cells", {}, {}))
+    assert base != jitcache.key(other, ("solvers.physics.pairs",))  # another precision
+    assert "solvers.kernels.constants" in jitcache.imports_of(jitcache.render("solvers.loops.cells", {}, {}))
     monkeypatch.setattr(jitcache, "target", lambda: "numba0.0-py0-othercpu-0")
-    assert base != jitcache.key(text, ("solvers.pairs",))  # another numba or CPU
+    assert base != jitcache.key(text, ("solvers.physics.pairs",))  # another numba or CPU
 
 
 def test_two_processes_filling_the_cache_at_once_agree(tmp_path):
@@ -261,7 +261,7 @@ def test_loads_only_loads_what_is_cached_and_compiles_nothing(tmp_path, monkeypa
 WARM = textwrap.dedent(
     """
     import json, sys
-    from pcabench.preload import warm
+    from pcabench.execute.preload import warm
     from pcabench.spec import RunSpec
     from solvers import Scene, jitcache
     cached = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=2)).resolved()
@@ -282,7 +282,7 @@ WARM = textwrap.dedent(
 
 
 def test_the_forkservers_warm_loads_the_cached_configurations_and_compiles_none(tmp_path):
-    """pcabench/preload.py: what a sweep's server loads before it forks the runs (a child then loads nothing)."""
+    """pcabench/execute/preload.py: what a sweep's server loads before it forks the runs (a child loads nothing)."""
     environ = {**os.environ, "PCABENCH_CACHE": str(tmp_path)}
     subprocess.run([sys.executable, "-c", WARM, "fill"], check=True, cwd=ROOT, env=environ, capture_output=True)
     out = subprocess.run([sys.executable, "-c", WARM], capture_output=True, text=True, cwd=ROOT, env=environ)

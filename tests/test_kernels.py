@@ -22,17 +22,18 @@ import pytest
 from scipy import integrate
 
 from pcabench import cli
-from pcabench.methods import fastest
+from pcabench.execute.run import run
+from pcabench.predict.methods import fastest
 from pcabench.presets import front_axes, matrix
-from pcabench.run import run
 from pcabench.spec import RunSpec, identity, row_identity, scene_from_row
-from solvers import Scene, SceneError, kernel, kernel_named, kernel_names, registry
-from solvers.backend import cpu_pairs
-from solvers.dispersion import predict, stable_cfl
-from solvers.kernel import GRAD0, INV_H2
+from solvers import Scene, SceneError, kernel_named, kernel_names, registry
 from solvers.kernels import Kernel, KernelPluginWarning, register, unregister
+from solvers.kernels import constants as kernel
 from solvers.kernels import registry as kernel_registry
+from solvers.kernels.constants import GRAD0, INV_H2
 from solvers.method import Method
+from solvers.physics.backend import cpu_pairs
+from solvers.reference.dispersion import predict, stable_cfl
 
 from .conftest import run_fields
 from .test_gpu import _max_rel, _simulate

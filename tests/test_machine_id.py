@@ -1,5 +1,5 @@
 """One machine, one id: on a GPU machine the store's name, every record (CPU runs too), resume, the report
-folder and Table 6's same-machine test all use :func:`pcabench.profiles.machine_id`, GPU included.
+folder and Table 6's same-machine test all use :func:`pcabench.machine.profiles.machine_id`, GPU included.
 
 The GPU is faked (``PCABENCH_FAKE_GPU``) in this process and, through the environment, in every child.
 """
@@ -12,13 +12,14 @@ import sys
 import pytest
 
 from benchmarks.common import gpu_available
-from pcabench import cli, profiles, store
-from pcabench.provenance import git_commit
+from pcabench import cli, store
+from pcabench.execute.sweep import run_child
+from pcabench.machine import profiles
 from pcabench.reports import tables as T
 from pcabench.reports import write_reports
 from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
-from pcabench.sweep import run_child
+from pcabench.store.provenance import git_commit
 from solvers import Scene
 
 from .conftest import cli_main

@@ -1,4 +1,4 @@
-"""The memory check lives in the harness (pcabench/memory.py); a Scene is a pure value; an
+"""The memory check lives in the harness (pcabench/machine/memory.py); a Scene is a pure value; an
 out-of-memory is recognised by the exception's type, not its text."""
 
 from __future__ import annotations
@@ -10,8 +10,9 @@ import types
 
 import pytest
 
-from pcabench import cli, memory
-from pcabench.run import run
+from pcabench import cli
+from pcabench.execute.run import run
+from pcabench.machine import memory
 from pcabench.spec import RunSpec
 from solvers import Scene, SceneError
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 import pytest
 
 from pcabench import store
-from pcabench.record import RunRecord
 from pcabench.reports import frame
 from pcabench.reports.tables import default_numerics, is_paper_method, numerics_label
 from pcabench.spec import RunSpec, scene_from_row
+from pcabench.store.record import RunRecord
 from solvers import Scene
 from solvers.method import Method
 
@@ -55,7 +55,7 @@ def test_a_row_that_predates_a_parameter_reads_it_at_its_default(missing):
 
 
 def test_the_stable_cfl_is_the_dispersion_relations_for_the_method():
-    from solvers.dispersion import stable_cfl
+    from solvers.reference.dispersion import stable_cfl
 
     for scene in (
         Scene(dx=0.25, t_end=1.0, model="linear"),

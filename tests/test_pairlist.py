@@ -6,8 +6,10 @@ import numba
 import numpy as np
 import pytest
 
-from solvers import Scene, compress, denormals, make_solver, pairlist, resolve_pair_loop
-from solvers.integrators import step_program
+from solvers import Scene, make_solver, resolve_pair_loop
+from solvers.physics import denormals
+from solvers.physics.integrators import step_program
+from solvers.search import compress, pairlist
 
 from .conftest import strip_for
 

@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcabench.run import run
+from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
-from solvers.isothermal1d import isothermal_pulse
-from solvers.kernel import make_exp_neg_table
+from solvers.kernels.constants import make_exp_neg_table
+from solvers.reference.isothermal1d import isothermal_pulse
 
 from .conftest import run_fields, strip_for
 
@@ -115,7 +115,7 @@ def test_lagrangian_converges_to_isothermal_not_linear(tmp_path):
 
 
 def test_isothermal_reference_differs_from_linear_pulse_by_5_percent():
-    from solvers.analytic import pulse_velocity
+    from solvers.reference.analytic import pulse_velocity
 
     scene = Scene(dx=0.5)
     x, u = isothermal_pulse(scene, 5.0)

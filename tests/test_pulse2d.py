@@ -1,4 +1,4 @@
-"""Exact references of the 2D acoustic pulse (solvers.pulse2d): the periodic spectral solution, its
+"""Exact references of the 2D acoustic pulse (solvers.reference.pulse2d): the periodic spectral solution, its
 Taylor evaluation off the lattice, and the open-domain Hankel integral, against each other."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solvers.pulse2d import bessel_j0_j1, gaussian_pulse, open_domain, periodic_linear
+from solvers.reference.pulse2d import bessel_j0_j1, gaussian_pulse, open_domain, periodic_linear
 
 B, MACH, RHO0, C0 = 3.0, 0.05, 1.0, 1.0
 AMP = RHO0 * MACH  # rho0 Ma, kg/m^3

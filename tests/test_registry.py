@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import solvers
-from pcabench.run import run
+from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import ENTRY_POINT_GROUP, Scene, registry
 from solvers.interface import Solver

@@ -8,13 +8,13 @@ import json
 import numpy as np
 import pytest
 
+from pcabench.execute.run import run
 from pcabench.reports.frame import frame
-from pcabench.run import run
 from pcabench.spec import RunSpec, identity, scene_from_row
 from solvers import DEFAULT_SCENE, Scene, SceneError, make_solver, scene_names
-from solvers.dispersion import predict, predicted_fields_2d, stable_cfl
-from solvers.integrators import step_program
 from solvers.linkedlist_cpu import LinkedListCPU
+from solvers.physics.integrators import step_program
+from solvers.reference.dispersion import predict, predicted_fields_2d, stable_cfl
 
 from .conftest import cli_main, in_simulator
 
@@ -100,7 +100,7 @@ def test_moving_particles_cross_the_x_seam_and_keep_their_neighbours():
 SIM_SCRIPT = r"""
 import json, sys, numpy as np
 from solvers import Scene, make_solver
-from solvers.integrators import step_program
+from solvers.physics.integrators import step_program
 out = {}
 for precision, model in (("float64", "lagrangian"), ("float32", "linear")):
     # 13 x 13 particles, h = 1.3 dx: the x and y seams cut every stencil (3 cells a side) at a simulator's cost
@@ -218,7 +218,7 @@ def test_the_accuracy_command_predicts_a_scene(capsys):
 def test_the_fast_methods_come_from_the_prediction():
     """The front's fast methods on the paper's scene are the cheapest the prediction says reach the paper's
     configuration's error, one per kernel, within the model's margin of the predicted stable CFL."""
-    from pcabench.methods import MARGIN, fastest
+    from pcabench.predict.methods import MARGIN, fastest
     from pcabench.presets import fast_methods
 
     paper = predict(Scene(dx=0.05, t_end=10.0, model="linear")).predicted_error

@@ -8,10 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from solvers import Scene, kernel
-from solvers.backend import cpu_pairs
-from solvers.integrators import step_program
+from solvers import Scene
+from solvers.kernels import constants as kernel
 from solvers.linkedlist_cpu import counting_sort
+from solvers.physics.backend import cpu_pairs
+from solvers.physics.integrators import step_program
 
 
 def test_each_named_slot_holds_what_the_pair_code_reads():

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from pcabench import store
+from pcabench.execute.run import run
 from pcabench.reports.frame import load as load_frame
-from pcabench.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
 

@@ -14,12 +14,14 @@ import warnings
 
 import pytest
 
-from pcabench import cli, memory, store, study
-from pcabench import sweep as sweep_module
-from pcabench.profiles import machine_id
-from pcabench.record import RunRecord
+from pcabench import cli, store
+from pcabench.cli import study
+from pcabench.execute import sweep as sweep_module
+from pcabench.execute.sweep import exit_status, sweep
+from pcabench.machine import memory
+from pcabench.machine.profiles import machine_id
 from pcabench.spec import RunSpec
-from pcabench.sweep import exit_status, sweep
+from pcabench.store.record import RunRecord
 from solvers import Scene, SceneError
 from tests.conftest import run_children
 
@@ -306,7 +308,7 @@ def test_a_write_cut_short_by_a_full_file_system_leaves_the_store_as_it_was(tmp_
     script = f"""
 import resource, signal, sys
 from pcabench import store
-from pcabench.record import RunRecord
+from pcabench.store.record import RunRecord
 from pcabench.spec import RunSpec
 from solvers import Scene
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
@@ -441,7 +443,7 @@ def test_a_run_given_twice_is_run_and_stored_once(tmp_path):
 
 # ---------------------------------------------------------------- locks before any work, every executor
 def test_a_cluster_sweep_locks_its_results_folder_before_any_work(tmp_path, monkeypatch):
-    from pcabench import cluster
+    from pcabench.execute import cluster
 
     def no_work(*args, **kw):
         raise AssertionError("the cluster sweep started work without the lock")
@@ -481,7 +483,7 @@ def test_the_memory_check_sees_a_nested_cgroup_v1_limit_and_its_oom_kills(tmp_pa
 
 
 def test_pair_loop_list_is_checked_against_the_memory_available(monkeypatch, capsys):
-    from solvers.pairlist import list_bytes
+    from solvers.search.pairlist import list_bytes
 
     scene = Scene(dx=0.1, steps=2)
     monkeypatch.setattr(memory, "available_memory_bytes", lambda: scene.memory_bytes() + list_bytes(scene) // 2)

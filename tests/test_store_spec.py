@@ -18,11 +18,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcabench import provenance, store
-from pcabench.record import RunRecord
-from pcabench.run import run
+from pcabench import store
+from pcabench.execute.run import run
+from pcabench.execute.sweep import run_child, sweep
 from pcabench.spec import RunSpec
-from pcabench.sweep import run_child, sweep
+from pcabench.store import provenance
+from pcabench.store.record import RunRecord
 from solvers import Scene
 
 from .conftest import cli_main
@@ -432,7 +433,7 @@ def test_run_fields_that_name_no_file_are_one_line(name, tmp_path, capsys, monke
 
 
 def test_a_full_disk_writing_fields_names_the_path_and_leaves_no_partial_file(tmp_path, capsys, monkeypatch):
-    from pcabench import safeio
+    from pcabench.store import safeio
 
     real = safeio._write_all
 

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from pcabench import store
-from pcabench.record import RunRecord
 from pcabench.reports import frame, write_reports
 from pcabench.reports import tables as T
+from pcabench.store.record import RunRecord
 from solvers import Scene
 
 SWEEP = ["--dx", "1", "0.5", "--solver", "linkedlist-cpu", "allpair-cpu", "--steps", "3", "--no-report"]
@@ -299,10 +299,10 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
 
 
 def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):
-    from pcabench.profiles import machine_id
-    from pcabench.provenance import host_id
+    from pcabench.execute.sweep import sweep
+    from pcabench.machine.profiles import machine_id
     from pcabench.spec import RunSpec
-    from pcabench.sweep import sweep
+    from pcabench.store.provenance import host_id
 
     path = tmp_path / "s.jsonl"
     for dx, ms in ((1.0, 10.0), (0.5, 160.0)):  # all-pair: 16x per 4x particles, on this host
@@ -319,8 +319,8 @@ def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):
 
 
 def test_a_run_cut_by_the_sweep_budget_is_not_stored(tmp_path):
+    from pcabench.execute.sweep import sweep
     from pcabench.spec import RunSpec
-    from pcabench.sweep import sweep
 
     path = tmp_path / "s.jsonl"
     spec = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=20000, model="linear"))

@@ -9,10 +9,11 @@ import subprocess
 
 import pytest
 
-from pcabench import __version__, cli, paths, runs, store
+from pcabench import __version__, cli, paths, store
+from pcabench.execute.sweep import sweep
 from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
-from pcabench.sweep import sweep
+from pcabench.store import runs
 from solvers import Scene
 
 from .conftest import cli_main
@@ -205,7 +206,7 @@ def test_runs_compare_takes_a_machine_prefix_and_prints_no_index(tmp_path, capsy
 # ---------------------------------------------------------------- asv's smoke run
 def test_asv_smoke_config_writes_only_to_ignored_scratch_and_selects_few_benchmarks(tmp_path):
     asv_util = pytest.importorskip("asv.util")
-    from pcabench import asv_smoke
+    from pcabench.bench import asv_smoke
 
     root = asv_smoke.ROOT
     if not (root / ".git").exists():

@@ -7,12 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pcabench.run import run
+from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene, SceneError, make_solver
-from solvers.dispersion import predict
-from solvers.integrators import step_program
 from solvers.linkedlist_cpu import LinkedListCPU
+from solvers.physics.integrators import step_program
+from solvers.reference.dispersion import predict
 
 from .conftest import cli_main, in_simulator
 
@@ -167,7 +167,7 @@ def test_energy_is_conserved_with_a_wall_to_the_integrators_accuracy():
 SIM_SCRIPT = r"""
 import json, numpy as np
 from solvers import Scene, make_solver
-from solvers.integrators import step_program
+from solvers.physics.integrators import step_program
 out = {}
 for name, precision, model in (("pulse-wall", "float64", "lagrangian"), ("plane-wall", "float32", "linear")):
     # ~200 particles, h = 1.3 dx: every stencil of the wall's column is mirrored, at a simulator's cost

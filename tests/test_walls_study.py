@@ -20,8 +20,8 @@ from pcabench import presets, store  # noqa: E402
 from pcabench.reports import frame, sections  # noqa: E402
 from pcabench.reports.sections import walls as W  # noqa: E402
 from solvers import Scene, kernel_names, scenes  # noqa: E402
-from solvers.dispersion import predict, stable_cfl  # noqa: E402
 from solvers.method import Method
+from solvers.reference.dispersion import predict, stable_cfl  # noqa: E402
 
 from .figure_check import record  # noqa: E402
 from .test_study import row  # noqa: E402
@@ -224,7 +224,7 @@ def test_advise_searches_the_prediction_on_a_wall_scene(tmp_path, capsys):
     def error(dx):
         return predict(Scene(dx=dx, name="plane-wall", t_end=10.0, model="linear")).predicted_error
 
-    from pcabench.advise import SEARCH_DX
+    from pcabench.cli.advise import SEARCH_DX
     from solvers import SceneError
 
     coarser = []

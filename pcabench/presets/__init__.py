@@ -3,7 +3,7 @@ matrix built from command-line options (:func:`matrix`)."""
 
 from __future__ import annotations
 
-from .base import (
+from pcabench.presets.base import (
     DEFAULT_PRESET,
     ENTRY_POINT_GROUP,
     MATRIX_BUDGET,
@@ -17,9 +17,25 @@ from .base import (
     size_text,
     spec_of,
 )
-from .front import FRONT, FRONT_2D, FRONT_T_END, PAPER_SCENE_DX, fast_methods, front, front_axes, model_needs
-from .stability import INACCURATE_ABOVE, LONG_MODELS, LONG_SCENES, LONG_T_END, STABILITY_CFL, STABILITY_DX
-from .walls import (
+from pcabench.presets.front import (
+    FRONT,
+    FRONT_2D,
+    FRONT_T_END,
+    PAPER_SCENE_DX,
+    fast_methods,
+    front,
+    front_axes,
+    model_needs,
+)
+from pcabench.presets.stability import (
+    INACCURATE_ABOVE,
+    LONG_MODELS,
+    LONG_SCENES,
+    LONG_T_END,
+    STABILITY_CFL,
+    STABILITY_DX,
+)
+from pcabench.presets.walls import (
     FREE_COUNTERPART,
     WALL_COST_DX,
     WALL_COST_ROUNDS,

@@ -13,11 +13,10 @@ import dataclasses
 import itertools
 from typing import Callable
 
+from pcabench.spec import SERIAL, RunSpec
 from solvers import DEFAULT_SOLVER, Scene, solver_class
 from solvers.plugins import Registry
 from solvers.scenes import DEFAULT_SCENE
-
-from ..spec import SERIAL, RunSpec
 
 MATRIX_BUDGET = 900.0  # s per run of a matrix of options (--dx ...), not a preset (--run-budget overrides)
 DEFAULT_PRESET = "quick"  # what `pcabench study` runs with no preset flag and no matrix

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import itertools
 
+from pcabench.presets.base import Preset, spec_of
+from pcabench.spec import RunSpec
 from solvers import Scene, kernel_names, scene_kind
 from solvers.scenes import DEFAULT_SCENE
-
-from ..spec import RunSpec
-from .base import Preset, spec_of
 
 # The speed-accuracy front at t = 10 s on the strip, serial: kernel x h/dx x CFL x dx x precision x model, the
 # kernels every registered one (:func:`front_axes`). CFL 6 is past every configuration's predicted stable step:
@@ -33,16 +32,16 @@ FRONT_T_END = 10.0
 
 
 # The paper's own scene (dx = 0.05, full domain, t = 10 s): its method, and the methods the prediction names as
-# the cheapest to its accuracy (pcabench/methods.py: one per kernel, CFL at most MARGIN of the predicted stable).
+# the cheapest to its accuracy (pcabench/predict/methods.py: one per kernel, CFL at most MARGIN of the predicted
+# stable).
 PAPER_SCENE_DX = 0.05
 
 
 def fast_methods(model: str) -> tuple[dict, ...]:
     """The cheapest methods predicted to reach the paper's configuration's accuracy on its scene at t = 10 s
     (the prediction is of the linear part; a moving model keeps a wider stability margin)."""
-    from solvers.dispersion import predict
-
-    from ..methods import fastest
+    from pcabench.predict.methods import fastest
+    from solvers.reference.dispersion import predict
 
     paper = predict(Scene(dx=PAPER_SCENE_DX, t_end=FRONT_T_END, model="linear"))
     return tuple(

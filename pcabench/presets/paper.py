@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ..spec import ALL_CORES, RunSpec
-from .base import Preset, spec_of
+from pcabench.presets.base import Preset, spec_of
+from pcabench.spec import ALL_CORES, RunSpec
 
 
 def paper() -> list[RunSpec]:

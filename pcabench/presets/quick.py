@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
+from pcabench.presets.base import Preset, spec_of
+from pcabench.presets.stability import STABILITY_DX
+from pcabench.spec import RunSpec
 from solvers import Scene
-
-from ..spec import RunSpec
-from .base import Preset, spec_of
-from .stability import STABILITY_DX
 
 QUICK_CFL = (0.2, 2.0, 5.0, 7.0)  # the quick map: stable, stable, just past the predicted 4.97, far past it
 

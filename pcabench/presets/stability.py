@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from ..spec import ALL_CORES, RunSpec
-from .base import Preset, spec_of
+from pcabench.presets.base import Preset, spec_of
+from pcabench.spec import ALL_CORES, RunSpec
 
 # The stability preset's scene: the design's dx = 0.25 on a strip, the linear model
 # (exactly the linear wave equation, so growth is the integrator's, not the physics').

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 
+from pcabench.presets.base import Preset, spec_of
+from pcabench.presets.front import FRONT_T_END
+from pcabench.presets.stability import LONG_MODELS, LONG_T_END, STABILITY_DX
+from pcabench.spec import RunSpec
 from solvers import Scene
-
-from ..spec import RunSpec
-from .base import Preset, spec_of
-from .front import FRONT_T_END
-from .stability import LONG_MODELS, LONG_T_END, STABILITY_DX
 
 # The walls preset (issue 34, ``pcabench study --walls``): sound at a rigid wall, in three parts.
 WALLS = "walls"
@@ -47,7 +46,7 @@ def cost_round(preset_name: str) -> int | None:
 def walls() -> list[RunSpec]:
     """Accuracy, stability and cost at a rigid wall (WALL_*): 64 runs, 34 min on one busy core of the reference
     machine (about 30 s of each run is its JIT compilation)."""
-    from solvers.dispersion import stable_cfl
+    from solvers.reference.dispersion import stable_cfl
 
     runs = [
         spec_of(name=name, dx=dx, t_end=FRONT_T_END, model=model, strip=WALL_STRIP[name])

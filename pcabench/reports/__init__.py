@@ -8,6 +8,6 @@ and ``reports/README.md`` as the index.
 
 from __future__ import annotations
 
-from .build import summary, write_reports
+from pcabench.reports.build import summary, write_reports
 
 __all__ = ["summary", "write_reports"]

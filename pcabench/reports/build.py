@@ -9,17 +9,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from pcabench import profiles, store
+from pcabench import store
 from pcabench.errors import NoResults
-from pcabench.safeio import own_folder, write_file
+from pcabench.machine import profiles
+from pcabench.reports import figures as F
+from pcabench.reports import frame, sections
+from pcabench.reports import paper as P
+from pcabench.reports import tables as T
+from pcabench.reports.md import fmt, md_table
+from pcabench.reports.sections import Context, table6_md
+from pcabench.store.safeio import own_folder, write_file
 from solvers import DEFAULT_SCENE
-
-from . import figures as F
-from . import frame, sections
-from . import paper as P
-from . import tables as T
-from .md import fmt, md_table
-from .sections import Context, table6_md
 
 
 def _machine(pid: str) -> str:

@@ -19,12 +19,11 @@ from pathlib import Path
 import numpy as np
 from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
-from pcabench.safeio import save_figure
-from pcabench.stability import UNSTABLE_BY_PREDICTION
+from pcabench.predict.stability import UNSTABLE_BY_PREDICTION
+from pcabench.reports import paper as P
+from pcabench.reports import tables as T
+from pcabench.store.safeio import save_figure
 from solvers import kernel_names, scene_kind
-
-from . import paper as P
-from . import tables as T
 
 CLASS_STYLE = {
     "stable": ("tab:green", "o"),

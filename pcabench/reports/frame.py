@@ -17,8 +17,8 @@ import numpy as np
 import pandas as pd
 
 from pcabench import store
-from pcabench.record import STEP_STAGES
 from pcabench.spec import stored_parameters
+from pcabench.store.record import STEP_STAGES
 from solvers import registry
 
 SCENE_COLUMNS = (

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from pcabench import profiles
+from pcabench.machine import profiles
 
 SYSTEMS = ("paper-system-1", "paper-system-2", "paper-system-3")
 TABLE6_STEPS = 100  # Table 6's "Number of timesteps"

@@ -14,16 +14,15 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from pcabench import profiles
-from pcabench.record import STEP_STAGES
+from pcabench.machine import profiles
+from pcabench.reports import paper as P
+from pcabench.store.record import STEP_STAGES
 from solvers import DEFAULT_KERNEL, STAGES, Scene
 from solvers.kernels import truncated
 from solvers.method import Method
 
-from . import paper as P
-
 # The scene's numerics unless a study varies them (Scene's defaults: Verlet, CFL, h/dx, cutoff).
-# The exact isothermal solution at Ma = 0.05 against the linear pulse (design 1b; solvers/isothermal1d.py).
+# The exact isothermal solution at Ma = 0.05 against the linear pulse (design 1b; solvers/reference/isothermal1d.py).
 ISOTHERMAL_VS_LINEAR = {5.0: 0.051, 10.0: 0.098}
 # What makes two runs the same measurement: a newest-run choice is made within one of these.
 PROTOCOL = ["protocol", "domain", "loop", "threads"]
@@ -469,9 +468,9 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
     from before that was measured are left out). The front of a model at a
     time holds the runs no faster run of that model beats in error, among the runs below their method's
     predicted stable CFL (``past_limit``: at or past it, a run is unstable by prediction whatever its error,
-    pcabench/stability.py; it is drawn and listed as such, never on the front).
+    pcabench/predict/stability.py; it is drawn and listed as such, never on the front).
     """
-    from pcabench.stability import assess
+    from pcabench.predict.stability import assess
 
     accuracy_runs = df.preset != "stability-long"  # runs to t = 300 s to measure a stable step, not an error
     pts = latest(
@@ -530,7 +529,7 @@ def fronts(points) -> list[dict]:
 def unstable_on_front(points) -> list[dict]:
     """The runs past their predicted stable CFL that a front of every run, stable or not, would hold: what
     ignoring the prediction would have picked. Each with ``e_foldings``: its most unstable mode's growth."""
-    from pcabench.stability import e_foldings
+    from pcabench.predict.stability import e_foldings
 
     return [{**p, "e_foldings": e_foldings(p, p["steps"])} for p in fronts(points) if p["past_limit"]]
 
@@ -542,8 +541,9 @@ def comparable(a, b) -> bool:
 
 
 def predicted_error(p: dict) -> float:
-    """The error the dispersion relation predicts for front point ``p`` (its linear part; solvers/dispersion.py)."""
-    from solvers.dispersion import predict
+    """The error the dispersion relation predicts for front point ``p`` (its linear part;
+    solvers/reference/dispersion.py)."""
+    from solvers.reference.dispersion import predict
 
     scene = Method.of(p).scene_fields()
     strip = p.get("strip_height")
@@ -665,7 +665,7 @@ def classify(r, inaccurate_above: float, past_limit: bool = False) -> str:
     """stable (below its predicted stable CFL, bounded, accurate) / inaccurate (the same, error above the bar) /
     unstable (it blew up) / unstable by prediction (at or past the predicted limit, ended bounded: too few
     steps for round-off to grow), or the failed run's status."""
-    from pcabench.stability import UNSTABLE_BY_PREDICTION
+    from pcabench.predict.stability import UNSTABLE_BY_PREDICTION
 
     if r["status"] == "ok":
         if past_limit:
@@ -694,14 +694,14 @@ def cfl_ranges(cfls, swept) -> str:
 def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
     """The stability map's points and one summary per configuration, both from the same classes.
 
-    Built from the prediction (pcabench/stability.py): a run at or past its
+    Built from the prediction (pcabench/predict/stability.py): a run at or past its
     method's predicted stable CFL is unstable, by its blow-up or, where it
     ended bounded, by prediction (``e_foldings``: how far its most unstable
     mode grew in its steps, too little for round-off to show). The runs of the
     stability preset, and a quick study's CFL sweep (three CFLs or more of one
     method).
     """
-    from pcabench.stability import UNSTABLE_BY_PREDICTION, assess, e_foldings
+    from pcabench.predict.stability import UNSTABLE_BY_PREDICTION, assess, e_foldings
 
     runs = latest(
         df[
@@ -780,14 +780,14 @@ def _fold(x: float) -> float:
 
 def long_run_limits(df, preset: str = "stability-long") -> list[dict]:
     """Each model's stable CFL measured by the long runs of ``preset`` (``pcabench study --stability long``; the
-    walls preset's at the wall) beside the prediction of its linear part and the limit pcabench/stability.py
+    walls preset's at the wall) beside the prediction of its linear part and the limit pcabench/predict/stability.py
     holds for it (what advise uses).
 
     Per model and method: the CFLs run, the largest that ended bounded below the first blow-up, the smallest
     that blew up (and its step), the steps run, and the e-foldings of the most unstable linear mode over the
     run at the largest bounded CFL (0 below the predicted limit).
     """
-    from pcabench.stability import assess, e_foldings, measured_limit
+    from pcabench.predict.stability import assess, e_foldings, measured_limit
 
     runs = latest(df[df.preset == preset]) if "preset" in df else df.iloc[:0]
     keys = [

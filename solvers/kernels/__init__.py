@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from .base import Kernel
-from .registry import (
+from solvers.kernels.base import Kernel
+from solvers.kernels.registry import (
     DEFAULT_KERNEL,
     ENTRY_POINT_GROUP,
     KERNELS,

@@ -10,7 +10,7 @@ entry-point group ``pcabench.kernels``) with a ``name``. It states
   integrates to 1 over the plane (dimensionless);
 * :meth:`value` and :meth:`gradient`, the reference forms in NumPy (float64);
 * :meth:`compiled_gradient`: G(r^2, k) for the pair loops, a plain function of
-  the squared distance and the constant tuple ``k`` (solvers/kernel.py), in
+  the squared distance and the constant tuple ``k`` (solvers/kernels/constants.py), in
   the solver's float type throughout, which every backend compiles
   (numba's CPU target, numba-cuda, the CUDA simulator as Python).
 
@@ -48,7 +48,7 @@ class Kernel(abc.ABC):
         """G(r2, k) for the pair loops, 1/m^4, in ``dtype`` throughout (to be compiled by the caller).
 
         ``r2`` is the squared distance (m^2, within the cutoff: the loops test it first), ``k`` the constant
-        tuple (solvers/kernel.py: ``k[GRAD0]`` = G(0), ``k[INV_H2]`` = 1/h^2); ``exp_neg(x) = exp(-x)`` is
+        tuple (solvers/kernels/constants.py: ``k[GRAD0]`` = G(0), ``k[INV_H2]`` = 1/h^2); ``exp_neg(x) = exp(-x)`` is
         the caller's compiled exp for kernels that need one. Float constants must be ``dtype`` scalars made
         here, so that float32 loops never promote to float64; the function must not reach ``self``.
         """

@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import math
 
-from ..plugins import NAME, PluginWarning, Registry
-from .base import Kernel
+from solvers.kernels.base import Kernel
+from solvers.plugins import NAME, PluginWarning, Registry
 
 ENTRY_POINT_GROUP = "pcabench.kernels"
 DEFAULT_KERNEL = "gaussian"  # the paper's: what every run uses unless --kernel says otherwise
-KERNEL_NAME = NAME  # the record's kernel field (pcabench/schema.py): the one name rule
+KERNEL_NAME = NAME  # the record's kernel field (pcabench/store/schema.py): the one name rule
 
 KernelPluginWarning = PluginWarning  # the one warning of every registry
 

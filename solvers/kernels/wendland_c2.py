@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from ..kernel import GRAD0, INV_H2
-from .base import Kernel
+from solvers.kernels.base import Kernel
+from solvers.kernels.constants import GRAD0, INV_H2
 
 
 class WendlandC2(Kernel):

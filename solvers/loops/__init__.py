@@ -6,10 +6,10 @@ A template's free names are set to ``None`` here with a comment saying what bind
 imports absolutely (its specialisations are written out beside no package), and every first-party module
 it imports is part of the key of its cache. Each template is read by one solver module:
 
-    updates.py   the per-particle loops (coefficients, kick, advance, gather)   solvers/backend.py
+    updates.py   the per-particle loops (coefficients, kick, advance, gather)   solvers/physics/backend.py
     sorting.py   the cell sort (counting sort, x-sort within cells)            solvers/linkedlist_cpu.py, pairlist.py
     cells.py     the linked-list sweeps over the 3x3 cell stencil              solvers/linkedlist_cpu.py
     allpair.py   the all-pair sweeps                                           solvers/allpair_cpu.py
-    pairlist.py  the pair list's build and its two sweeps                      solvers/pairlist.py
-    gpu.py       the GPU solver's device kernels (numba-cuda)                  solvers/gpu_kernels.py
+    pairlist.py  the pair list's build and its two sweeps                      solvers/search/pairlist.py
+    gpu.py       the GPU solver's device kernels (numba-cuda)                  solvers/gpu/cuda_kernels.py
 """

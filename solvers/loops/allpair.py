@@ -1,7 +1,7 @@
 """The all-pair CPU solver's interaction loops, serial as in the paper. A template of solvers.jitcache,
 specialised by solvers.allpair_cpu.sweeps."""
 
-P = None  # the pair functions for numba's CPU target (solvers.backend.cpu_pairs), bound by solvers.jitcache
+P = None  # the pair functions for numba's CPU target (solvers.physics.backend.cpu_pairs), bound by solvers.jitcache
 
 
 def continuity(lx, ly, sx, sy, u, v, vol, drho, out, k):

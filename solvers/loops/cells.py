@@ -3,9 +3,9 @@ pool. A template of solvers.jitcache, specialised by solvers.linkedlist_cpu.swee
 
 from numba import prange
 
-from solvers.kernel import NONLIN, RHO0
+from solvers.kernels.constants import NONLIN, RHO0
 
-P = None  # the pair functions for numba's CPU target (solvers.backend.cpu_pairs), bound by solvers.jitcache
+P = None  # the pair functions for numba's CPU target (solvers.physics.backend.cpu_pairs), bound by solvers.jitcache
 
 
 def continuity(cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, out, k):

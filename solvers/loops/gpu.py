@@ -1,12 +1,12 @@
 """The GPU solver's device kernels (numba-cuda), from the shared pair physics. A template of solvers.jitcache,
-specialised by solvers.gpu_kernels.kernels: on a GPU compiled by numba-cuda with its cache (per compute
+specialised by solvers.gpu.cuda_kernels.kernels: on a GPU compiled by numba-cuda with its cache (per compute
 capability), in numba's CUDA simulator run as Python. ``cuda`` is a module global on purpose: the simulator
 swaps the module global named ``cuda`` for its own, which a closure variable would hide from it."""
 
 from numba import cuda, int32
 
-P = None  # the pair functions as device functions (solvers.gpu_kernels.device_pairs), bound by solvers.jitcache
-scan_threads = None  # threads of the one cell_begin block (solvers.gpu_kernels.scan_block), bound by jitcache
+P = None  # the pair functions as device functions (solvers.gpu.cuda_kernels.device_pairs), bound by solvers.jitcache
+scan_threads = None  # threads of the one cell_begin block (solvers.gpu.cuda_kernels.scan_block), bound by jitcache
 SCAN_ITEMS = 4  # cells per thread in one pass of the cellBegin scan
 
 

@@ -1,20 +1,23 @@
 """The CPU pair list's build (with the kernel's G) and its two sweeps, serial or on numba's threads (see
-solvers/pairlist.py for the method). A template of solvers.jitcache, specialised by solvers.pairlist.kernels."""
+solvers/search/pairlist.py for the method). A template of solvers.jitcache, specialised by
+solvers.search.pairlist.kernels."""
 
 import numba
 import numpy as np
 from numba import prange
 
-from solvers.compress import compress_within
-from solvers.denormals import flush_off, flush_on
-from solvers.kernel import NONLIN, NX, NY, RC2, RHO0, SPACING
+from solvers.kernels.constants import NONLIN, NX, NY, RC2, RHO0, SPACING
+from solvers.physics.denormals import flush_off, flush_on
+from solvers.search.compress import compress_within
 
 # Loop indices are unsigned (U): numba then drops its negative-index wraparound, which otherwise
 # turns every contiguous load into a gather and keeps the distance pass from vectorising
 # (measured here: 163 -> 27 ns for 120 candidates in float64, 17 ns in float32).
 U = np.uint64
-P = None  # the pair functions for numba's CPU target (solvers.backend.cpu_pairs), bound by solvers.jitcache
-flush = None  # True in float32: subnormals flushed to zero in the loops (solvers/denormals.py), bound by jitcache
+P = None  # the pair functions for numba's CPU target (solvers.physics.backend.cpu_pairs), bound by solvers.jitcache
+flush = (
+    None  # True in float32: subnormals flushed to zero in the loops (solvers/physics/denormals.py), bound by jitcache
+)
 
 
 @numba.njit(inline="always")

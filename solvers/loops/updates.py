@@ -1,11 +1,11 @@
 """The per-particle loops of a CPU solver, serial or on numba's threads: the sweeps' coefficients, the
 system update (kick, advance) and the gather that reorders an array (``parts`` ranges). A template of
-solvers.jitcache, specialised by solvers.backend.cpu_updates."""
+solvers.jitcache, specialised by solvers.physics.backend.cpu_updates."""
 
 import numba
 from numba import prange
 
-P = None  # the pair functions for numba's CPU target (solvers.backend.cpu_pairs), bound by solvers.jitcache
+P = None  # the pair functions for numba's CPU target (solvers.physics.backend.cpu_pairs), bound by solvers.jitcache
 
 
 @numba.njit(nogil=True)

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from .base import BOUNDARY_KINDS, SceneKind
-from .registry import DEFAULT_SCENE, ENTRY_POINT_GROUP, SCENES, scene_kind, scene_names, scenes
+from solvers.scenes.base import BOUNDARY_KINDS, SceneKind
+from solvers.scenes.registry import DEFAULT_SCENE, ENTRY_POINT_GROUP, SCENES, scene_kind, scene_names, scenes
 
 __all__ = [
     "BOUNDARY_KINDS",

@@ -5,10 +5,10 @@ centre (``pulse_center``, the middle of the y range), b = ``pulse_width``
 (3 m), in a square periodic in x and y (40 m by default, so that by t = 10 s
 only the pulse's tail has wrapped). Its exact linear reference on the
 periodic square evolves every Fourier mode of the sampled initial field with
-the exact dispersion w = c0 |k| (solvers/pulse2d.py: exact to round-off,
+the exact dispersion w = c0 |k| (solvers/reference/pulse2d.py: exact to round-off,
 wrapped waves included, checked against the open-domain Bessel integral). The
 lagrangian model is scored against the radially symmetric isothermal solution
-(solvers/isothermal_radial.py), which is the open-domain one: the wrapped
+(solvers/reference/isothermal_radial.py), which is the open-domain one: the wrapped
 tail is not in it, so that score is given only while the wave front and three
 widths of its tail (0.2 % of the peak) are inside the square's half side.
 
@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from .base import SceneKind
+from solvers.scenes.base import SceneKind
 
 LN2 = math.log(2.0)
 
@@ -128,8 +128,8 @@ class AcousticPulse(SceneKind):
         return scene.nx, ()
 
     def reference(self, scene, t: float):
-        """The exact linear solution on the reference lattice at ``t`` (solvers/pulse2d.py)."""
-        from ..pulse2d import periodic_linear
+        """The exact linear solution on the reference lattice at ``t`` (solvers/reference/pulse2d.py)."""
+        from solvers.reference.pulse2d import periodic_linear
 
         xc, yc = centre(scene)
         columns, images = self.reference_lattice(scene)
@@ -150,7 +150,7 @@ class AcousticPulse(SceneKind):
         )
 
     def exact_fields(self, scene, t: float):
-        from ..interface import Fields
+        from solvers.interface import Fields
 
         ref = self.reference(scene, t)
         x, y = np.meshgrid(ref.x, ref.y)
@@ -165,7 +165,7 @@ class AcousticPulse(SceneKind):
         return measures(scene, fields.x, fields.y, fields.drho, fields.u, fields.v, values)
 
     def isothermal_errors(self, scene, fields) -> float | None:
-        from ..isothermal_radial import isothermal_pulse_radial_cached
+        from solvers.reference.isothermal_radial import isothermal_pulse_radial_cached
 
         half_side = 0.5 * min(scene.x_max - scene.x_min, scene.y_max - scene.y_min)
         if scene.c0 * fields.t + 3.0 * scene.pulse_width > half_side:
@@ -187,7 +187,7 @@ class AcousticPulse(SceneKind):
         return _relative(d, ref) if np.all(np.isfinite(d)) else float("nan")
 
     def predict(self, scene):
-        from ..dispersion import predict_2d
+        from solvers.reference.dispersion import predict_2d
 
         return predict_2d(scene, self)
 

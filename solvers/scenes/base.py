@@ -6,7 +6,7 @@ the entry-point group ``pcabench.scenes``) with a ``name``. It states
 * ``summary``: one line for --help;
 * ``periodic``: the axes that are periodic ("x", "y"); the others have free
   edges, except the x edges named in ``walls`` ("x_min", "x_max"), which are
-  rigid walls (mirror particles, solvers/pairs.py). :meth:`boundaries` turns
+  rigid walls (mirror particles, solvers/physics/pairs.py). :meth:`boundaries` turns
   them into the boundary kinds a solver must support (``free-x``,
   ``periodic-x``, ``periodic-y``, ``wall-x``);
 * ``domain``: its default domain (x_min, x_max, y_min, y_max, m), where it
@@ -118,7 +118,7 @@ class SceneKind:
         return self.isothermal_errors(scene, self.exact_fields(scene, scene.t_final))
 
     def predict(self, scene):
-        """The linear model's predicted errors from the dispersion relation (solvers/dispersion.py)."""
+        """The linear model's predicted errors from the dispersion relation (solvers/reference/dispersion.py)."""
         raise NotImplementedError
 
     def mirror_extension(self, scene, u, v, drho) -> tuple:
@@ -126,7 +126,7 @@ class SceneKind:
         solution is this scene's, and the slice of its columns that is the scene's lattice. With rigid walls,
         the even extension across them: the mirror image beside the fields, the normal velocity reversed (with
         walls at both x edges the doubled lattice is periodic: its seam is the other wall); without, the
-        fields themselves (the prediction's lattice, solvers/dispersion.py)."""
+        fields themselves (the prediction's lattice, solvers/reference/dispersion.py)."""
         import numpy as np
 
         nx = u.shape[-1]

@@ -4,7 +4,7 @@ u = c0 Ma exp(-((x - x_c - c0 t)/w)^2), v = 0, drho = rho0 u / c0 on
 x in [-10, 40] m, y in [-10, 10] m, periodic in y, free left and right
 edges. The fields do not depend on y, so a y-periodic strip gives the same
 answer. Scored on u (the paper's eq. 11); the lagrangian model also against
-the 1D isothermal solution (solvers/isothermal1d.py), which steepens into a
+the 1D isothermal solution (solvers/reference/isothermal1d.py), which steepens into a
 shock at t_b = w / (c0 Ma sqrt(2/e)) (70 s at the defaults).
 """
 
@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import math
 
-from ..analytic import errors as analytic_errors
-from .base import SceneKind
+from solvers.reference.analytic import errors as analytic_errors
+from solvers.scenes.base import SceneKind
 
 
 class PlanePulse(SceneKind):
@@ -33,8 +33,8 @@ class PlanePulse(SceneKind):
     def exact_fields(self, scene, t: float):
         import numpy as np
 
-        from ..analytic import pulse_velocity
-        from ..interface import Fields
+        from solvers.interface import Fields
+        from solvers.reference.analytic import pulse_velocity
 
         x = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx
         u = pulse_velocity(scene, x, t)
@@ -51,13 +51,13 @@ class PlanePulse(SceneKind):
     def isothermal_errors(self, scene, fields) -> float | None:
         """None once the pulse and four widths of its tail have left by the free right end: there is then no
         pulse to score (against the linear pulse the relative error is NaN then: its reference is zero)."""
-        from ..isothermal1d import isothermal_errors
+        from solvers.reference.isothermal1d import isothermal_errors
 
         if scene.pulse_center + scene.c0 * fields.t - 4.0 * scene.pulse_width > scene.x_max:
             return None
         return isothermal_errors(scene, fields.x, fields.u, fields.t).mse
 
     def predict(self, scene):
-        from ..dispersion import predict_plane
+        from solvers.reference.dispersion import predict_plane
 
         return predict_plane(scene)

@@ -12,10 +12,10 @@ the pulse plus its mirror image, a left-travelling pulse from 2 x_w - x_c:
 
 which is also the initial field (so that the image's tail, 2 % of the peak at
 the wall at t = 0 for the defaults, is in it and u = 0 at the wall at all
-times). The wall acts through mirror particles (solvers/pairs.py); the
+times). The wall acts through mirror particles (solvers/physics/pairs.py); the
 lattice ends half a spacing from it, so the `linear` model's run is the even
 extension of a free one and the dispersion prediction holds for it exactly
-(solvers/dispersion.py). Scored on u against the reflected solution, over the
+(solvers/reference/dispersion.py). Scored on u against the reflected solution, over the
 domain and apart near the wall (within a cutoff: the particles that have
 mirror neighbours) and in the bulk. There is no isothermal reference: two
 simple waves crossing are not one.
@@ -23,9 +23,9 @@ simple waves crossing are not one.
 
 from __future__ import annotations
 
-from ..analytic import pulse_velocity, relative_errors
-from .base import wall_measures
-from .plane_pulse import PlanePulse
+from solvers.reference.analytic import pulse_velocity, relative_errors
+from solvers.scenes.base import wall_measures
+from solvers.scenes.plane_pulse import PlanePulse
 
 DEFAULT_WALL = 6.0  # m: the wall of plane-wall and pulse-wall by default, two pulse widths right of the pulse
 
@@ -86,7 +86,7 @@ class PlaneWall(PlanePulse):
     def exact_fields(self, scene, t: float):
         import numpy as np
 
-        from ..interface import Fields
+        from solvers.interface import Fields
 
         x = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx
         a, b = pulse_velocity(scene, x, t), pulse_velocity(scene, image_x(scene, x), t)

@@ -7,12 +7,12 @@ the domain's right edge ``--wall-x`` (6 m), a second rigid wall at the left
 edge x_min = -14 m, periodic in y over 20 m. Walls at both ends make the
 problem's even extension across them periodic with period twice the width,
 so the exact linear reference is the periodic FFT reference
-(solvers/pulse2d.py) of the pulse plus its mirror image across the wall on
+(solvers/reference/pulse2d.py) of the pulse plus its mirror image across the wall on
 that doubled lattice, cropped to the domain: exact at every time, the
 reflections from both walls included. The initial field is that reference at
 t = 0 (the image's tail is in it). The `linear` model's run is the same
 problem on the doubled periodic lattice, so the dispersion prediction holds
-for it exactly (solvers/dispersion.py).
+for it exactly (solvers/reference/dispersion.py).
 
 Scored like the free 2D pulse (drho, velocity, along axis and diagonal; not
 the front's speed along a ray, which the reflections cross), and apart near
@@ -25,9 +25,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .acoustic_pulse import LN2, AcousticPulse, centre, measures
-from .base import wall_measures
-from .plane_wall import DEFAULT_WALL, wall_check
+from solvers.scenes.acoustic_pulse import LN2, AcousticPulse, centre, measures
+from solvers.scenes.base import wall_measures
+from solvers.scenes.plane_wall import DEFAULT_WALL, wall_check
 
 
 def _wrap(xp, d, period: float):
@@ -63,7 +63,7 @@ class PulseWall(AcousticPulse):
         return 2 * scene.nx, self.image_centres(scene)[1:]
 
     def exact_fields(self, scene, t: float):
-        from ..interface import Fields
+        from solvers.interface import Fields
 
         ref = self.reference(scene, t)
         x, y = np.meshgrid(ref.x[: scene.nx], ref.y)

@@ -10,8 +10,8 @@ left out with one :class:`~solvers.plugins.PluginWarning`: the one
 
 from __future__ import annotations
 
-from ..plugins import PluginWarning, Registry
-from .base import SceneKind
+from solvers.plugins import PluginWarning, Registry
+from solvers.scenes.base import SceneKind
 
 ENTRY_POINT_GROUP = "pcabench.scenes"
 DEFAULT_SCENE = "plane-pulse"  # the paper's scene: what every run is unless --scene says otherwise

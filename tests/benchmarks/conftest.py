@@ -4,7 +4,7 @@ from __future__ import annotations
 
 
 def pytest_benchmark_update_machine_info(config, machine_info):
-    from pcabench.profiles import capture
+    from pcabench.machine.profiles import capture
 
     machine_info["pcabench_profile"] = capture()
 

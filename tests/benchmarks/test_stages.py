@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from benchmarks.common import Prepared, Unsupported, solver_names
-from pcabench.profiles import machine_id
+from pcabench.machine.profiles import machine_id
 from solvers import Scene, make_solver
 
 SIZES = (1.0, 0.5)  # 1,000 and 4,000 particles
@@ -159,9 +159,9 @@ def test_scene_step(benchmark, scene):
     """One Verlet step of each scene (linked list, float64, linear, 400 to 1,000 particles), and its primary
     error after 10 steps against the scene's exact solution, which must be the prediction's (exact for the
     linear model while the pulse is clear of the ends): a change that breaks a scene shows."""
-    from pcabench.run import run
+    from pcabench.execute.run import run
     from pcabench.spec import RunSpec
-    from solvers.integrators import step_program
+    from solvers.physics.integrators import step_program
 
     s = Scene(name=scene, steps=10, model="linear", **SCENE_CASES[scene])
     solver = make_solver("linkedlist-cpu")
@@ -189,6 +189,6 @@ def test_scene_step(benchmark, scene):
             "profile_id": machine_id(),
         }
     )
-    from solvers.dispersion import predict
+    from solvers.reference.dispersion import predict
 
     assert record.status == "ok" and record.mse == pytest.approx(predict(s).predicted_error, rel=SCENE_AGREEMENT[scene])

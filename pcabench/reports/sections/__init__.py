@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .base import ENTRY_POINT_GROUP, SECTIONS, Context, Section, in_order
-from .table6 import table6_md
+from pcabench.reports.sections.base import ENTRY_POINT_GROUP, SECTIONS, Context, Section, in_order
+from pcabench.reports.sections.table6 import table6_md
 
 __all__ = ["ENTRY_POINT_GROUP", "SECTIONS", "Context", "Section", "in_order", "table6_md"]

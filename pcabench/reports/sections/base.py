@@ -16,9 +16,8 @@ from typing import Any, Callable
 
 import pandas as pd
 
+from pcabench.reports import tables as T
 from solvers.plugins import Registry
-
-from .. import tables as T
 
 ENTRY_POINT_GROUP = "pcabench.sections"
 

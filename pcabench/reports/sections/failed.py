@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import tables as T
-from ..md import first_words, fmt, md_table
-from .base import Section
+from pcabench.reports import tables as T
+from pcabench.reports.md import first_words, fmt, md_table
+from pcabench.reports.sections.base import Section
 
 
 def rows(ctx):

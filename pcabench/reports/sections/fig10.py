@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from .. import figures as F
-from .. import paper as P
-from .. import tables as T
-from .base import Section
+from pcabench.reports import figures as F
+from pcabench.reports import paper as P
+from pcabench.reports import tables as T
+from pcabench.reports.sections.base import Section
 
 
 def text(rows, ctx) -> list[str]:

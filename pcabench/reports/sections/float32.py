@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from .. import tables as T
-from .base import Section
+from pcabench.reports import tables as T
+from pcabench.reports.sections.base import Section
 
 
 def text(rows, ctx) -> list[str]:

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 from functools import lru_cache
 
+from pcabench.reports import figures as F
+from pcabench.reports import tables as T
+from pcabench.reports.md import fmt, md_table, pct
+from pcabench.reports.sections.base import Section, limit_words
 from solvers import Scene
-
-from .. import figures as F
-from .. import tables as T
-from ..md import fmt, md_table, pct
-from .base import Section, limit_words
 
 
 def rows(ctx):
@@ -91,7 +90,7 @@ def predicted_by_model(predicted) -> list[str]:
 @lru_cache(maxsize=1)
 def why_the_paper_method() -> list[str]:  # pure: cached, as every report shows it
     """Why the paper's h and dt sit where they do, from the prediction at its own scene's dx."""
-    from solvers.dispersion import lattice_offsets, predict
+    from solvers.reference.dispersion import lattice_offsets, predict
 
     base = Scene(dx=0.1, t_end=10.0, model="linear")
     rows = []
@@ -178,7 +177,7 @@ def text(data, ctx) -> list[str]:
         "particles than the full domain for the same answer; on a strip each method runs on the thinnest "
         "strip its support allows, so a compact kernel's strip is thinner). Errors are against what each model "
         "converges to: the linear "
-        "pulse for `linear`, the isothermal solution (solvers/isothermal1d.py) for `lagrangian` (its error "
+        "pulse for `linear`, the isothermal solution (solvers/reference/isothermal1d.py) for `lagrangian` (its error "
         "against the linear pulse never falls below the two equations' 9.8 % difference at t = 10 s; "
         "lagrangian runs from before this was measured are left out). `fixed` solves neither and is in the "
         "cost of the simplifications below. A quick study runs the paper's method only (every ratio is then "
@@ -204,7 +203,7 @@ def text(data, ctx) -> list[str]:
         ),
         "",
         "The front (the runs no faster run of the same model beats in error), with the error the dispersion "
-        "relation predicts for each (`pcabench accuracy`, solvers/dispersion.py: the lattice's SPH operator "
+        "relation predicts for each (`pcabench accuracy`, solvers/reference/dispersion.py: the lattice's SPH operator "
         "and the integrator's own step on every wavenumber of the pulse, no simulation). For `linear` the "
         "two agree to many digits while the pulse's error waves stay clear of the domain's ends (tested to "
         "1e-8 on a longer strip); where they part here, at coarse dx and large steps, those waves have "

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from .. import tables as T
-from ..md import fmt, md_table
-from .base import Section, limit_words
+from pcabench.reports import tables as T
+from pcabench.reports.md import fmt, md_table
+from pcabench.reports.sections.base import Section, limit_words
 
 
 def text(rows, ctx) -> list[str]:
@@ -42,7 +42,7 @@ def text(rows, ctx) -> list[str]:
         "is how far the most unstable mode of the periodic lattice grew at the largest bounded CFL over the "
         "run (0 below the predicted limit; round-off needs about 37 to reach the pulse's size). The last "
         "column is the limit advise, the front and the tables use for that scene and model "
-        "(pcabench/stability.py: its MEASURED_LIMITS, where lower than the prediction).",
+        "(pcabench/predict/stability.py: its MEASURED_LIMITS, where lower than the prediction).",
         "",
         md_table(
             [

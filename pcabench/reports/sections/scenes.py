@@ -4,7 +4,7 @@ Every finished run at t = 10 s of every scene (solvers/scenes/), scored by
 its scene's own primary error (u for the plane pulse, drho for the 2D
 pulse): ``mse`` against the exact linear solution for `linear`, and
 ``mse_isothermal`` against the isothermal solution for `lagrangian`. A run at
-or past its predicted stable CFL (solvers/dispersion.py) is never the
+or past its predicted stable CFL (solvers/reference/dispersion.py) is never the
 fastest to an accuracy, whatever its error: it ended bounded because it was
 too short for round-off to grow.
 """
@@ -15,14 +15,13 @@ from functools import lru_cache
 
 import numpy as np
 
+from pcabench.predict.stability import past_limit, stable_limit
+from pcabench.reports import figures as F
+from pcabench.reports.md import fmt, md_table, pct
+from pcabench.reports.sections.base import Section
+from pcabench.reports.tables import is_paper_method, latest, numerics_label
 from pcabench.spec import scene_from_row
-from pcabench.stability import past_limit, stable_limit
 from solvers import DEFAULT_SCENE, Scene, scene_kind
-
-from .. import figures as F
-from ..md import fmt, md_table, pct
-from ..tables import is_paper_method, latest, numerics_label
-from .base import Section
 
 TARGETS = (0.10, 0.05, 0.02)  # relative RMS errors of the primary field
 T_FINAL = 10.0  # s
@@ -30,7 +29,7 @@ MODEL_TARGET = 0.02  # "which model this scene needs": the error against the iso
 
 
 def stable_cfl_of(r) -> float:
-    """The largest stable CFL of row ``r``'s method (pcabench/stability.py: the prediction, or the lower limit
+    """The largest stable CFL of row ``r``'s method (pcabench/predict/stability.py: the prediction, or the lower limit
     long runs measured for a moving model)."""
     return stable_limit(r)
 
@@ -131,8 +130,8 @@ def time_to_accuracy(df) -> list[dict]:
 
 
 def predicted(r) -> float:
-    """The linear prediction of row ``r``'s primary error (solvers/dispersion.py; exact for `linear`)."""
-    from solvers.dispersion import predict
+    """The linear prediction of row ``r``'s primary error (solvers/reference/dispersion.py; exact for `linear`)."""
+    from solvers.reference.dispersion import predict
 
     return predict(scene_from_row(r).replace(model="linear")).predicted_error
 
@@ -178,7 +177,7 @@ def phase_directions(methods, angles=np.linspace(0.0, np.pi / 4, 19)) -> list[di
     """The predicted phase speed error (with the step) against the direction of travel for each method
     (dicts of kernel, h_factor, cfl, dx), at the 2D pulse's wavenumber 1 / b and at a short wave of
     ``SHORT_WAVE`` particles per wavelength, where the lattice's anisotropy shows."""
-    from solvers.dispersion import phase_errors
+    from solvers.reference.dispersion import phase_errors
 
     out = []
     for m in methods:
@@ -220,7 +219,7 @@ def front_shifts(points_, most: int = 12) -> list[dict]:
     )[:most]
     out = []
     for p in runs:
-        from solvers.dispersion import predict
+        from solvers.reference.dispersion import predict
 
         measures = predict(scene_from_row(p["row"]).replace(model="linear")).measures or {}
         out.append(

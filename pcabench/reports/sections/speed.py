@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from .. import tables as T
-from ..md import fmt, md_table
-from .base import Section
+from pcabench.reports import tables as T
+from pcabench.reports.md import fmt, md_table
+from pcabench.reports.sections.base import Section
 
 
 def text(rows, ctx) -> list[str]:

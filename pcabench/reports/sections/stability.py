@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 from pcabench.presets import INACCURATE_ABOVE
+from pcabench.reports import figures as F
+from pcabench.reports import tables as T
+from pcabench.reports.md import md_table, pct
+from pcabench.reports.sections.base import Section, limit_words
 from solvers import Scene
-
-from .. import figures as F
-from .. import tables as T
-from ..md import md_table, pct
-from .base import Section, limit_words
 
 
 def e_fold_words(bounded) -> str:

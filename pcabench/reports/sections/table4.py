@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from .. import figures as F
-from .. import paper as P
-from .. import tables as T
-from ..md import fmt, md_table
-from .base import Section
+from pcabench.reports import figures as F
+from pcabench.reports import paper as P
+from pcabench.reports import tables as T
+from pcabench.reports.md import fmt, md_table
+from pcabench.reports.sections.base import Section
 
 
 def paper_cell(r) -> str:

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from .. import figures as F
-from ..md import fmt, md_table
-from .base import Section
+from pcabench.reports import figures as F
+from pcabench.reports.md import fmt, md_table
+from pcabench.reports.sections.base import Section
 
 
 def table6_md(rows, across: bool = False, gpu_column: bool = False) -> str:

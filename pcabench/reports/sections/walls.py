@@ -11,14 +11,13 @@ from __future__ import annotations
 import numpy as np
 
 from pcabench.presets import FREE_COUNTERPART, LONG_T_END, WALLS, cost_round
+from pcabench.reports import figures as F
+from pcabench.reports.md import fmt, md_table
+from pcabench.reports.sections.base import Section
+from pcabench.reports.sections.scenes import T_FINAL
+from pcabench.reports.tables import is_paper_method, latest, long_run_limits
 from pcabench.spec import scene_from_row
 from solvers import Scene, scenes
-
-from .. import figures as F
-from ..md import fmt, md_table
-from ..tables import is_paper_method, latest, long_run_limits
-from .base import Section
-from .scenes import T_FINAL
 
 
 def wall_scenes() -> tuple[str, ...]:
@@ -34,9 +33,9 @@ def _err(r, name: str) -> float | None:
 def accuracy(df) -> list[dict]:
     """Every finished run of a wall scene at t = 10 s with the paper's method at the default amplitude (newest of
     each): its relative RMS error over the domain, near the walls (``wall_rms``: within a cutoff of a wall) and in
-    the bulk, beside the same three predicted for the `linear` model (solvers/dispersion.py on the mirror
+    the bulk, beside the same three predicted for the `linear` model (solvers/reference/dispersion.py on the mirror
     extension; for a moving model its linear part), and ``gap``, measured over predicted minus 1."""
-    from solvers.dispersion import predict
+    from solvers.reference.dispersion import predict
 
     d = df[
         (df.status == "ok")
@@ -153,7 +152,7 @@ def _gap_words(gap: float) -> str:
 ROUND_OFF_GAP = 1e-9  # |measured / predicted - 1| below this is round-off (the linear runs reach 1e-14)
 # The plane-wall's free left end moved 20 m away (x_min = -30 m, the same lattice otherwise): the largest
 # |measured / predicted - 1| of its linear runs at t = 10 s, dx 0.5 and 0.25 (serial linked list; the runs at
-# x_min = -10 m differed by 1.3e-5 and 8.6e-6). Measured 2026-12-01 with pcabench.run.run, not stored;
+# x_min = -10 m differed by 1.3e-5 and 8.6e-6). Measured 2026-12-01 with pcabench.execute.run.run, not stored;
 # tests/test_walls.py checks it (below 1e-9 at dx 0.5).
 FREE_END_MOVED = (-30.0, 2.04e-14)
 
@@ -312,7 +311,7 @@ def _stability_text(rows) -> list[str]:
         "the same model and method's long runs on the free counterpart (`--stability long`: the plane pulse's "
         "strip with free ends, the 2D pulse's periodic square) where they were made. 'e-foldings': how far the "
         "most unstable mode of the periodic lattice grew at the largest bounded CFL (0 below the prediction). "
-        "The last column is the limit advise and the tables use (pcabench/stability.py's MEASURED_LIMITS, "
+        "The last column is the limit advise and the tables use (pcabench/predict/stability.py's MEASURED_LIMITS, "
         "keyed by scene, where lower than the prediction).",
         "",
         md_table(
@@ -471,7 +470,7 @@ def text(data, ctx) -> list[str]:
     return [
         "## Sound at a rigid wall",
         "",
-        "A rigid wall by mirror particles (solvers/pairs.py), on two scenes: `plane-wall`, the paper's plane "
+        "A rigid wall by mirror particles (solvers/physics/pairs.py), on two scenes: `plane-wall`, the paper's plane "
         "pulse reflected by a wall at x = 6 m (free left end), and `pulse-wall`, the 2D acoustic pulse two "
         "widths from a wall in a duct walled at both x ends. `pcabench study --walls` makes every run below; "
         "`walls_error.png` draws the error near the wall and in the bulk against dx.",

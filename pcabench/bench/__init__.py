@@ -1,0 +1,1 @@
+"""asv across commits: the machine description asv records and its smoke run."""

@@ -1,0 +1,347 @@
+"""``pcabench advise``: the fastest stored run that reaches an error at a physical time.
+
+A researcher wants an answer of a given accuracy at a given physical time in
+the least time. Among one machine's finished runs at that time (and model),
+the fastest by time to solution (init + steps, JIT apart) whose relative RMS
+error of u is at most the target; beside it, the fastest run of the paper's
+configuration (Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet) that reaches the
+same error, and the ratio. The margin to instability comes from the
+dispersion relation (solvers/reference/dispersion.py, pcabench/predict/stability.py): a run at or
+past its method's predicted stable CFL is never advised, however small its
+error (it ended bounded only because its run was too short for round-off to
+grow). Where no stored run reaches the target, the prediction names the sweep
+that would.
+"""
+
+from __future__ import annotations
+
+import itertools
+import shlex
+
+import numpy as np
+
+from pcabench.predict.stability import assess, e_foldings
+from pcabench.reports.tables import comparable, default_numerics, error_column, latest, numerics_label
+from pcabench.spec import scene_from_row
+from solvers import DEFAULT_KERNEL, DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind
+from solvers.reference.dispersion import predict, stable_cfl
+
+# The configurations the prediction searches when no stored run reaches a target (a small, cheap grid), for
+# every registered kernel.
+SEARCH_H = (1.3, 1.6, 2.13)
+SEARCH_DX = (1.0, 0.5, 0.4, 0.25, 0.2, 0.125, 0.1, 0.05, 0.025)
+SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
+# A 2D scene's prediction evolves every mode of its lattice (seconds at dx = 0.125): a coarser grid, and the
+# longest step only (the leapfrog's phase lead offsets the lattice's lag: the longest stable step is the most
+# accurate and the cheapest).
+SEARCH_DX_2D = (0.5, 0.25, 0.2, 0.125)
+SEARCH_CFL_SHARE_2D = (0.8,)
+
+
+def scene_of(r) -> dict:
+    """A stored run's method and domain (the frame has brought rows that predate a parameter to its default)."""
+    return {
+        "kernel": r["kernel"],
+        "h_factor": r["h_factor"],
+        "cutoff_factor": r["cutoff_factor"],
+        "cfl": r["cfl"],
+        "integrator": r["integrator"],
+        "dx": r["dx"],
+        "strip_height": r["strip_height"],
+    }
+
+
+def command(r, t_end: float | None = None) -> str:
+    """The ``pcabench run`` command line that makes stored run ``r`` (a row of the reports' frame) again, from
+    its whole stored scene (:mod:`pcabench.commands`: every parameter away from its default, quoted for the
+    shell). ``t_end`` is the run's own (kept for callers)."""
+    from pcabench.commands import line_of, words_of
+
+    scene = scene_from_row(r)
+    return line_of(*words_of(str(r["solver"]), scene, int(r["threads"]), str(r.get("pair_loop") or "")))
+
+
+def reaching(df, t_end: float, model: str):
+    """Finished runs of ``model`` that ended at ``t_end`` (the newest of each configuration), fastest first."""
+    d = df[(df.status == "ok") & (df.model == model) & df.t_final.notna()]
+    d = d[np.isclose(d.t_final.astype(float), t_end, rtol=1e-6)]
+    return latest(d).sort_values("t_solution") if not d.empty else d
+
+
+def paper_configuration(df):
+    """Rows of the paper's numerics: default integrator, CFL, h/dx and cutoff, and the Gaussian kernel."""
+    d = default_numerics(df)
+    return d[d["kernel"] == DEFAULT_KERNEL] if "kernel" in d else d
+
+
+def _unstable_row(r, column: str) -> dict:
+    """A run that reached the error past its predicted stable CFL: what it was, never advised."""
+    a = assess(r)
+    return {
+        "method": numerics_label(r),
+        "dx": float(r.dx),
+        "cfl": float(r.cfl),
+        "stable_cfl": a["stable_cfl"],
+        "limit_from": a["limit_from"],
+        "error": float(r[column]),
+        "seconds": float(r.t_solution),
+        "steps": int(r.steps),
+        "e_foldings": e_foldings(r, int(r.steps)),
+    }
+
+
+def _unstable_rows(runs, column: str, most: int = 3) -> list[dict]:
+    """The fastest ``most`` methods (kernel, h/dx, cutoff, CFL, dx) of ``runs`` (fastest first), once each."""
+    rows, seen = [], set()
+    for _, r in runs.iterrows():
+        row = _unstable_row(r, column)
+        if (row["method"], row["dx"]) not in seen and len(rows) < most:
+            seen.add((row["method"], row["dx"]))
+            rows.append(row)
+    return rows
+
+
+def advise(
+    df, error: float, t_end: float, model: str = "linear", domain: str | None = None, scene: str = Scene.default("name")
+) -> dict:
+    """The fastest stored run of ``scene`` reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``,
+    if given) below its predicted stable CFL, the fastest run of the paper's configuration reaching it that compares
+    with it, and the ratio. Like is compared with like (``tables.comparable``): the same kind of domain (a
+    strip holds fewer particles than the full domain; on a strip each method runs on the thinnest strip its
+    support allows), the same threads and the same commit. A run at or past its method's predicted stable
+    CFL (pcabench/predict/stability.py) is never advised, whatever its error: ``unstable_by_prediction`` lists those
+    faster than the advice (or all of them, fastest first, where none below the limit reaches the error)."""
+    runs = reaching(df, t_end, model)
+    if domain is not None and not runs.empty:
+        runs = runs[runs.domain == domain]
+    column = error_column(model)
+    hits = runs[runs[column] <= error] if not runs.empty else runs
+    past = np.array([assess(r)["past_limit"] for _, r in hits.iterrows()], bool)
+    unstable, hits = hits[past], hits[~past]
+    out = {
+        "error_target": error,
+        "t_end": t_end,
+        "model": model,
+        "runs_considered": int(len(runs)),
+        "error_against": "the isothermal solution"
+        if column == "mse_isothermal"
+        else "the linear pulse"
+        if scene == Scene.default("name")
+        else "the exact linear solution",
+    }
+    if hits.empty:
+        out["found"] = False
+        out["unstable_by_prediction"] = _unstable_rows(unstable, column)
+        out["suggestion"] = suggest(error, t_end, model, scene)
+        return out
+    best = hits.iloc[0]
+    faster = unstable[unstable.t_solution < best.t_solution]
+    limit = assess(best)
+    stable = limit["stable_cfl"]
+    paper = paper_configuration(hits[[comparable(r, best) for _, r in hits.iterrows()]])
+    paper_best = paper.iloc[0] if not paper.empty else None
+    out.update(
+        found=True,
+        command=command(best, t_end),
+        error=float(best[column]),
+        seconds=float(best.t_solution),
+        machine=str(best.machine),
+        solver=str(best.solver),
+        domain=str(best.domain),
+        precision=str(best.precision),
+        commit=str(best.commit)[:12],
+        threads=int(best.threads),
+        n_particles=int(best.n_particles),
+        steps=int(best.steps),
+        **scene_of(best),
+        stable_cfl=stable,
+        cfl_fraction=float(best.cfl) / stable,
+        limit_from=limit["limit_from"],
+        paper_seconds=None if paper_best is None else float(paper_best.t_solution),
+        paper_error=None if paper_best is None else float(paper_best[column]),
+        paper_command=None if paper_best is None else command(paper_best, t_end),
+        unstable_by_prediction=_unstable_rows(faster, column),
+    )
+    out["is_paper_configuration"] = paper_best is not None and out["paper_command"] == out["command"]
+    out["speedup_over_paper"] = out["paper_seconds"] / out["seconds"] if out["paper_seconds"] else None
+    return out
+
+
+def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFAULT_SCENE) -> dict:
+    """From the prediction: the cheapest configuration of a small grid predicted to reach ``error`` at ``t_end``
+    on ``scene`` (cost ~ particles x steps x neighbours: on the thinnest strip where a strip serves the scene,
+    else on its own domain, with SEARCH_DX_2D and SEARCH_CFL_SHARE_2D), and the paper configuration's dx."""
+    kind = scene_kind(scene)
+    dxs, shares = (SEARCH_DX, SEARCH_CFL_SHARE) if kind.strip else (SEARCH_DX_2D, SEARCH_CFL_SHARE_2D)
+    best, paper = None, None
+    for kern, h in itertools.product(kernel_names(), SEARCH_H):
+        for share in shares:
+            for dx in sorted(dxs, reverse=True):  # coarse to fine: the first that reaches is this method's cheapest
+                try:
+                    base = Scene(
+                        dx=dx,
+                        name=scene,
+                        t_end=t_end,
+                        model="linear",
+                        kernel=kern,
+                        h_factor=h,
+                    )
+                except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
+                    continue
+                limit = stable_cfl(base)
+                if not limit > 0:
+                    break
+                trial = base.replace(cfl=round(share * limit, 2))
+                p = predict(trial)
+                if p.predicted_error > error:
+                    continue
+                cost = (1 / dx) ** (1 if kind.strip else 2) * trial.n_steps * (trial.cutoff / dx) ** 2
+                if best is None or cost < best[0]:
+                    best = (cost, trial, p)
+                break
+    for dx in sorted(dxs, reverse=True):  # the coarsest dx at which the paper's configuration reaches the error
+        try:
+            candidate = Scene(dx=dx, name=scene, t_end=t_end, model="linear")
+        except Exception:  # noqa: BLE001 - a dx the scene refuses (its wall inside the support) is not searched
+            continue
+        if predict(candidate).predicted_error <= error:
+            paper = candidate
+            break
+    out = {
+        "paper_dx": None if paper is None else paper.dx,
+        "smallest_dx_searched": min(dxs),
+        "note": "predicted from the dispersion relation of the linear part",
+    }
+    if best is not None:
+        _, s, p = best
+        out.update(
+            kernel=s.kernel,
+            h_factor=s.h_factor,
+            cfl=s.cfl,
+            dx=s.dx,
+            predicted_error=p.predicted_error,
+            study=shlex.join(
+                [
+                    "pcabench",
+                    "study",
+                    "--solver",
+                    DEFAULT_SOLVER,
+                    "--model",
+                    model if scene_kind(scene).has_isothermal else "linear",  # else no lagrangian run is scored
+                    "--t-end",
+                    f"{t_end:g}",
+                    *([] if scene == DEFAULT_SCENE else ["--scene", scene]),
+                    *(["--strip"] if kind.strip else []),
+                    "--kernel",
+                    s.kernel,
+                    "--h-factor",
+                    f"{s.h_factor:g}",
+                    "--cfl",
+                    f"{s.cfl:g}",
+                    "--dx",
+                    f"{s.dx:g}",
+                    f"{s.dx / 2:g}",
+                ]
+            ),
+        )
+    return out
+
+
+def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene: str) -> tuple[str, bool]:
+    """``pcabench advise``'s answer in words: the text for :func:`advise`'s result ``out``, and whether a run
+    reached the error."""
+    lines = []
+    primary = scene_kind(scene).primary
+    scene_words = "" if scene == DEFAULT_SCENE else f"{scene}, "
+    no_reference = out["error_against"] == "the isothermal solution" and not scene_kind(scene).has_isothermal
+    against = "the isothermal solution, which this scene does not have" if no_reference else out["error_against"]
+    head = (
+        f"{scene_words}{model} to a relative RMS error of {primary} <= {error:g} "
+        f"(against {against}) at "
+        f"t = {t_end:g} s on {out['machine']}" + (f", {domain} domain" if domain else "")
+    )
+    if not out["found"]:
+        s = out["suggestion"]
+        lines.append(
+            f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL."
+        )
+        lines += unstable_lines(out["unstable_by_prediction"], "runs that reach it")
+        if no_reference:
+            lines.append(
+                f"no {model} run of {scene} can be scored (no isothermal solution is known there); the "
+                "prediction below is of the linear part, the method to try with --model linear"
+            )
+        if "study" not in s:
+            lines.append("no method of the searched grid is predicted to reach it")
+        else:
+            lines.append(
+                f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, "
+                f"CFL {s['cfl']:g}, dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); "
+                f"run:\n  {s['study']}"
+            )
+        lines.append(
+            f"the paper's configuration needs dx <= {s['paper_dx']:g} m (predicted)"
+            if s["paper_dx"]
+            else f"the paper's configuration needs dx below {s['smallest_dx_searched']:g} m (the smallest searched)"
+        )
+        return "\n".join(lines), False
+    lines.append(
+        f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
+        f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
+        + (
+            f"stable {out['stable_cfl']:.3g} measured over long runs"
+            if out["limit_from"] == "long runs"
+            else f"predicted stable {out['stable_cfl']:.3g}{'' if model == 'linear' else ' (its linear part)'}"
+        )
+        + f", dx {out['dx']:g}, "
+        f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
+        f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
+        f"commit {out['commit'][:7]})\n  {out['command']}"
+    )
+    if out["is_paper_configuration"]:
+        lines.append(
+            f"  this is the paper's configuration: none of the {out['runs_considered']} stored runs reaching t = "
+            f"{t_end:g} s is faster"
+            + (
+                ""
+                if scene == DEFAULT_SCENE
+                else f" (`{shlex.join(['pcabench', 'study', '--front', '--scene', scene])}` runs other methods)"
+            )
+        )
+    elif out["paper_seconds"]:
+        lines.append(
+            f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
+            f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}"
+        )
+    else:
+        other = {"strip": "full", "full": "strip"}[out["domain"]]
+        lines.append(
+            f"  no stored run of the paper's configuration on the {out['domain']} domain with the same "
+            f"threads and commit reaches it; `pcabench advise --domain {other}` looks at the {other} "
+            "domain's runs"
+        )
+    lines += unstable_lines(out["unstable_by_prediction"], "faster runs")
+    return "\n".join(lines), True
+
+
+def unstable_lines(rows, what: str) -> list[str]:
+    """The lines naming advise's runs past their predicted stable CFL that reached the error: never advised."""
+    lines = []
+    if rows:
+        lines.append(
+            f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a "
+            "longer run or a finer dx grows them without bound)"
+        )
+    for r in rows:
+        which = (
+            f"predicted stable {r['stable_cfl']:.3g}"
+            if r["limit_from"] == "prediction"
+            else f"stable {r['stable_cfl']:.3g} measured over long runs"
+        )
+        limit = f"CFL {r['cfl']:g} is past the {which}" if r["stable_cfl"] > 0 else "its integrator grows at every CFL"
+        lines.append(
+            f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
+            f"bounded only because its {r['steps']} steps gave the most unstable mode "
+            f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)"
+        )
+    return lines

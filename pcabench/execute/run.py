@@ -1,0 +1,163 @@
+"""Run one scene on one solver: the six timed stages, blow-up detection, errors.
+
+A run that blows up (non-finite fields, or max|u| past the scene's bound) stops
+at once and is recorded with status ``unstable`` and its step; a device
+out-of-memory is recorded as ``out-of-memory``. Neither is a crash.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import sys
+
+import numpy as np
+
+from pcabench.errors import StoreError
+from pcabench.execute.clock import clock_for
+from pcabench.machine.memory import is_out_of_memory
+from pcabench.spec import RunSpec
+from pcabench.store.record import RunRecord
+from solvers import SceneError, jitcache, make_solver
+from solvers.physics.integrators import step_program
+
+FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.interface.Fields), each one per particle
+
+
+def fields_problem(fields, n_particles: int) -> str:
+    """Why ``fields`` (solvers.interface.Fields) are not a run's result for ``n_particles`` ('' if they are): an
+    array of another length, or values that are not finite, or a time that is not."""
+    for name in FIELD_NAMES:
+        values = np.asarray(getattr(fields, name))
+        if values.shape != (n_particles,):
+            return f"its field {name} has shape {values.shape}, not ({n_particles},) (one value per particle)"
+        if not np.issubdtype(values.dtype, np.number) or not np.isfinite(values).all():
+            return f"its field {name} holds values that are not finite numbers"
+    if not math.isfinite(float(fields.t)) or fields.t < 0:
+        return f"its time t = {fields.t!r} is not a finite time >= 0"
+    return ""
+
+
+def score(record: RunRecord, scene, fields) -> RunRecord:
+    """Score a run that finished its steps (``record``, status not ``unstable``) by its final ``fields``
+    against the scene's exact solution: MSE, ME, the scene's other measures and the isothermal MSE, and the
+    status ``ok``; ``error`` naming the field if the fields are not one finite value per particle. The
+    harness does this, never the solver: a run's errors are computed, not reported."""
+    why = fields_problem(fields, scene.n_particles)
+    if why:
+        record.status, record.failed_step = "error", record.steps or None
+        record.message = (record.message + "\n" if record.message else "") + f"the run's result is not usable: {why}"
+        return record
+    record.t_end = float(fields.t)
+    record.status = "ok"
+    measures = dict(scene.kind.errors(scene, fields))  # against the scene's exact linear solution
+    record.mse, record.me = measures.pop("mse"), measures.pop("me")
+    record.errors = measures
+    if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
+        record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
+    return record
+
+
+def save_fields(fields, path) -> None:
+    """Write a run's final fields to the .npz ``path`` (safeio: whole or not at all, no link followed)."""
+    import io
+
+    from pcabench.store.safeio import write_file
+
+    buffer = io.BytesIO()
+    np.savez(buffer, **{name: getattr(fields, name) for name in FIELD_NAMES}, t=fields.t)
+    write_file(path, buffer.getvalue())
+
+
+def load_fields(path):
+    """The fields an .npz of :func:`save_fields` holds (solvers.interface.Fields); OSError or ValueError if it
+    is not one."""
+    from solvers.interface import Fields
+
+    with np.load(path, allow_pickle=False) as data:
+        return Fields(**{name: data[name] for name in FIELD_NAMES}, t=float(data["t"]))
+
+
+def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None, scored: bool = True) -> RunRecord:
+    """Run ``spec`` on machine ``machine`` (its :func:`~pcabench.machine.profiles.machine_id`); its record.
+
+    ``spec`` is resolved where the command or sweep starts (an unresolved one is resolved here, for
+    scripts). The final fields go to the .npz ``fields_path`` if given. Without ``scored`` a run that
+    finished its steps keeps status ``error`` and no errors: a sweep's child, whose parent scores the fields
+    it wrote (:func:`score`). Never raises for a failed run: bad input (SceneError) is the caller's to report."""
+    spec = spec.resolved()
+    scene = spec.scene
+    solver = make_solver(spec.solver, threads=spec.threads, pair_loop=spec.pair_loop)
+    record = RunRecord.from_spec(spec, machine)
+    step = 0
+    try:
+        clock = None
+        # JIT compilation and the first launch, on a tiny scene, outside the timed region.
+        solver.input(scene)
+        before = jitcache.counts()["compiled"]
+        record.jit_seconds = solver.warmup()
+        record.jit_cached = jitcache.counts()["compiled"] == before
+        solver = make_solver(spec.solver, threads=spec.threads, pair_loop=spec.pair_loop)
+        clock = clock_for(solver)
+        clock.time("input", solver.input, scene)
+        clock.time("init", solver.init)
+        bound = scene.blowup_factor * scene.mach * scene.c0
+        for step in range(1, scene.n_steps + 1):
+            for stage, op in step_program(scene.integrator, solver, first=(step == 1)):
+                clock.time(stage, op)
+            amp = solver.amplitude()
+            if not math.isfinite(amp) or amp > bound:
+                record.status, record.failed_step = "unstable", step
+                record.message = (
+                    f"max|u| = {amp:.3g} m/s at step {step} (bound {bound:.3g} = blowup_factor * mach * c0)"
+                )
+                break
+            if progress is not None:
+                progress(step, scene.n_steps)
+        record.steps = step
+        fields = clock.time("output", solver.output)
+        record.stages = clock.totals()
+        record.t_end = float(fields.t)
+        if fields_path is not None:
+            save_fields(fields, fields_path)
+        if record.status != "unstable":
+            record.mean_neighbours = solver.mean_neighbours()
+            if scored:
+                score(record, scene, fields)
+    except (SceneError, StoreError):
+        raise  # bad input, or a file that cannot be written (a full disk), is the caller's to report
+    except Exception as exc:  # noqa: BLE001 - a failed run is a result, not a crash
+        record.steps = step
+        record.failed_step = step or None
+        record.status = "out-of-memory" if is_out_of_memory(exc) else "error"
+        record.message = f"{type(exc).__name__}: {exc}"
+        if clock is not None:
+            try:
+                record.stages = clock.totals()
+            except Exception:  # noqa: BLE001
+                pass
+        if record.status == "error":
+            import traceback
+
+            record.message += "\n" + traceback.format_exc(limit=8)
+    return record
+
+
+@contextlib.contextmanager
+def solver_output_to_stderr(on: bool):
+    """With ``on``, whatever the run prints on stdout (Python's sys.stdout and file descriptor 1, so compiled
+    code too) goes to stderr: `run --json` prints exactly one object on stdout, whatever the solver prints."""
+    if not on:
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        with contextlib.redirect_stdout(sys.stderr):
+            yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)

@@ -1,0 +1,1 @@
+"""This machine: its hardware profile and its memory."""

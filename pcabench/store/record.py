@@ -1,0 +1,176 @@
+"""The run record: one run's parameters, stage times, errors, status and provenance."""
+
+from __future__ import annotations
+
+import datetime as _dt
+import uuid
+from dataclasses import MISSING, asdict, dataclass, field, fields
+
+from pcabench.store.schema import STATUSES, STEP_STAGES  # noqa: F401 - declared with the record's schema, re-exported here
+from solvers import STAGES
+
+
+def step_seconds(stages: dict, steps: int) -> float:
+    """Mean wall time of one step (SNP + PI + SU) from total stage times, s."""
+    return sum(stages[s] for s in STEP_STAGES) / max(steps or 0, 1)
+
+
+@dataclass
+class RunRecord:
+    """Everything a table or figure needs about one run. Times in s, errors of u."""
+
+    solver: str
+    precision: str
+    model: str
+    integrator: str
+    dx: float
+    n_particles: int
+    steps: int  # steps taken (fewer than asked if the run failed)
+    t_end: float  # physical time reached, s
+    stages: dict  # input, init, snp, pi, su, output -> total seconds
+    jit_seconds: float
+    mse: float  # relative RMS error of the scene's primary field (u for the paper's scene: the paper's "MSE")
+    me: float  # its max error, in its unit (m/s for u)
+    mean_neighbours: float
+    status: str
+    failed_step: int | None
+    threads: int = 1
+    pair_loop: str = ""  # how the solver visited pairs: list, gather (the paper's) or all-pairs
+    device: str = ""  # where the solver's pair loops ran (its class's ``device``: cpu or gpu); "" in older rows
+    steps_requested: int = 0
+    mse_isothermal: float | None = None  # relative RMS error of the primary field against the isothermal solution
+    # (every model since the scene registry; lagrangian only before)
+    errors: dict = field(default_factory=dict)  # the scene's other error measures (solvers/scenes/), by name
+    scene: dict = field(default_factory=dict)
+    message: str = ""
+    profile_id: str = ""
+    commit: str = ""
+    versions: dict = field(default_factory=dict)
+    preset: str = ""  # the study preset that asked for the run (quick, paper, stability, matrix), if any
+    host: str = ""  # provenance.host_id(): which computer of this hardware profile made the run
+    # True: no loop was compiled for this run (each loaded from the on-disk JIT cache, solvers/jitcache.py, or
+    # already in the process); False: at least one was compiled; None in rows older than the cache
+    jit_cached: bool | None = None
+    timestamp: str = field(default_factory=lambda: _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
+    run_id: str = field(default_factory=lambda: uuid.uuid4().hex[:16])  # this record, wherever it is copied
+
+    CONTRACT = (
+        "solver",
+        "precision",
+        "model",
+        "integrator",
+        "dx",
+        "n_particles",
+        "steps",
+        "t_end",
+        "stages",
+        "jit_seconds",
+        "mse",
+        "me",
+        "mean_neighbours",
+        "status",
+        "failed_step",
+    )
+
+    @classmethod
+    def from_spec(cls, spec, machine: str = "", status: str = "error", message: str = "") -> "RunRecord":
+        """The record of the resolved RunSpec ``spec`` on machine ``machine`` before any step: no times, no
+        errors, provenance filled."""
+        from pcabench.store.provenance import git_commit, host_id, package_versions
+        from solvers import solver_class
+
+        nan, scene = float("nan"), spec.scene
+        return cls(
+            solver=spec.solver,
+            device=solver_class(spec.solver).device,
+            precision=scene.precision,
+            model=scene.model,
+            integrator=scene.integrator,
+            dx=scene.dx,
+            n_particles=scene.n_particles,
+            steps=0,
+            t_end=0.0,
+            stages={s: 0.0 for s in STAGES},
+            jit_seconds=0.0,
+            mse=nan,
+            me=nan,
+            mean_neighbours=nan,
+            status=status,
+            failed_step=None,
+            threads=int(spec.threads),
+            pair_loop=spec.pair_loop,
+            steps_requested=scene.n_steps,
+            scene=scene.as_dict(),
+            message=message,
+            profile_id=machine,
+            commit=git_commit(),
+            versions=package_versions(),
+            preset=spec.preset,
+            host=host_id(),
+        )
+
+    @classmethod
+    def from_row(cls, row: dict) -> "RunRecord":
+        """The record of a stored row that passed the schema (:func:`pcabench.store.validate`): its known fields
+        only (a key the schema does not know stays out of every table and report), each one the row predates at
+        its default, the stages as the clock's six (s), the scene's other error measures as numbers."""
+        values = {}
+        for f in fields(cls):
+            value = row.get(f.name)
+            if value is None and f.name in ("timestamp", "run_id"):
+                value = ""  # never this moment's, nor a new id
+            elif value is None and f.default is not MISSING:
+                value = f.default
+            elif value is None and f.default_factory is not MISSING:
+                value = f.default_factory()
+            values[f.name] = value  # a contract field stored as null (an error never measured) stays None
+        values["stages"] = {s: float(row["stages"][s]) for s in STAGES}
+        values["errors"] = {k: v for k, v in (row.get("errors") or {}).items() if isinstance(v, (int, float))}
+        values["scene"] = dict(row["scene"])
+        values["versions"] = dict(row.get("versions") or {})
+        return cls(**values)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+    @property
+    def step_seconds(self) -> float:
+        """Mean wall time of one step (SNP + PI + SU), s."""
+        return step_seconds(self.stages, self.steps)
+
+    def stage_table(self) -> str:
+        """The paper's stage table for this run: total s and ms per step."""
+        lines = [f"{'stage':<8}{'total (s)':>12}{'per step (ms)':>16}{'share of step':>15}"]
+        step_total = sum(self.stages[s] for s in STEP_STAGES) or float("nan")
+        for s in STAGES:
+            per = 1e3 * self.stages[s] / max(self.steps, 1) if s in STEP_STAGES else float("nan")
+            share = f"{100 * self.stages[s] / step_total:13.1f} %" if s in STEP_STAGES else ""
+            per_txt = f"{per:16.3f}" if s in STEP_STAGES else f"{'':16}"
+            lines.append(f"{s:<8}{self.stages[s]:12.4f}{per_txt}{share:>15}")
+        how = {True: "loaded from the JIT cache", False: "compiled"}.get(self.jit_cached, "compilation")
+        lines.append(f"{'jit':<8}{self.jit_seconds:12.4f}   ({how}, outside the timed stages)")
+        return "\n".join(lines)
+
+    def text(self, scene) -> str:
+        """``pcabench run``'s report of this run of ``scene``: the stage table, the run's size, its errors
+        (in the scene's primary field: u in m/s, drho in kg/m^3) and its status."""
+        primary = scene.kind.primary
+        unit = {"u": "m/s", "drho": "kg/m^3"}.get(primary, "")
+        lines = [
+            self.stage_table(),
+            f"particles        {self.n_particles:,}",
+            f"steps            {self.steps} (t = {self.t_end:.6g} s)",
+            f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
+            f"mean neighbours  {self.mean_neighbours:.2f}",
+            f"MSE (rel. RMS)   {self.mse:.6g}" + ("" if primary == "u" else f" of {primary}"),
+            f"ME (max)         {self.me:.6g} {unit}",
+        ]
+        lines += [f"{name.replace('_', ' '):<17}{value:.6g}" for name, value in self.errors.items()]
+        if self.mse_isothermal is not None:
+            lines.append(
+                f"MSE against the isothermal solution (the equations lagrangian solves) {self.mse_isothermal:.6g}"
+            )
+        lines.append(f"status           {self.status}" + (f" at step {self.failed_step}" if self.failed_step else ""))
+        if self.message:
+            lines.append(f"message          {self.message.splitlines()[0]}")
+        return "\n".join(lines)

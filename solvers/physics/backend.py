@@ -1,0 +1,99 @@
+"""The shared per-particle physics (solvers/physics/pairs.py) compiled for numba's CPU target."""
+
+from __future__ import annotations
+
+import threading
+from functools import lru_cache
+from types import ModuleType
+
+from solvers.kernels import DEFAULT_KERNEL
+
+_numba_threads = threading.local()  # the thread count this Python thread last gave numba through use_threads
+
+
+def use_threads(n: int, decided: bool = False) -> None:
+    """numba's thread count for the parallel loops launched from this Python thread (numba keeps it per
+    thread): set where a solver decides its count (``decided``: its input stage), and before a launch
+    only when another count was set since, as when two solvers alternate in one process; else nothing
+    but a thread-local read (numba.set_num_threads costs about 1 us a call)."""
+    if decided or getattr(_numba_threads, "n", None) != n:
+        import numba
+
+        numba.set_num_threads(n)
+        _numba_threads.n = n
+
+
+@lru_cache(maxsize=None)
+def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True):
+    """The pair functions for numba's CPU target in ``precision`` with ``kernel``'s G, inlined into the
+    sweeps that call them; ``across``: with the pairs across an x seam or wall (solvers/physics/pairs.py)."""
+    import numba
+
+    from solvers.kernels.constants import make_exp_neg_table
+    from solvers.physics.pairs import make_pairs
+
+    return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision, across)
+
+
+def pair_sources(kernel: str = DEFAULT_KERNEL) -> tuple:
+    """What the compiled pair functions are made of, for the cache's key (solvers/jitcache.py): the pair
+    physics, the constant tuple and exp(-x), this module, and the kernel's own file (a plug-in's too)."""
+    from solvers.kernels import kernel_named
+
+    return ("solvers.physics.pairs", "solvers.kernels.constants", "solvers.physics.backend", type(kernel_named(kernel)))
+
+
+def cpu_loops(
+    template: str, precision: str, kernel: str, parallel: bool | None, across: bool = True, **bind
+) -> ModuleType:
+    """The loops of ``template`` (solvers/loops/) over :func:`cpu_pairs` for ``precision``, ``kernel`` and
+    ``across``,
+    compiled with numba's CPU target (on its threads where ``parallel``; every function the template lists in
+    ``COMPILED``) and cached on disk once per machine (solvers/jitcache.py). ``bind``: more free names, as values."""
+    from solvers import jitcache
+
+    module = f"solvers.loops.{template}"
+    options = {"nogil": True} if parallel is None else {"nogil": True, "parallel": parallel}
+    options.update(LOOP_OPTIONS.get(template, {}))
+    names = COMPILED[template]
+    return jitcache.specialise(
+        module,
+        bind={"P": f"cpu_pairs({precision!r}, {kernel!r}, {across!r})", **{k: repr(v) for k, v in bind.items()}},
+        functions={name: ("numba.njit", options) for name in names},
+        imports=("import numba", "from solvers.physics.backend import cpu_pairs"),
+        depends=pair_sources(kernel),
+    )
+
+
+# The functions each CPU template compiles (the rest of a template is inlined helpers and constants), and
+# the options a template adds to nogil (and parallel where a solver runs threads).
+COMPILED = {
+    "updates": ("coefficients", "kick", "advance", "gather"),
+    "sorting": ("counting_sort", "sort_cells_by_x"),
+    "cells": ("continuity", "momentum", "neighbours", "wall_continuity", "wall_momentum", "cell_ids"),
+    "allpair": ("continuity", "momentum", "neighbours"),
+    "pairlist": ("build", "continuity", "momentum"),
+}
+LOOP_OPTIONS = {"pairlist": {"error_model": "numpy"}}
+
+
+@lru_cache(maxsize=None)
+def cpu_updates(precision: str, parallel: bool) -> dict:
+    """The per-particle loops of a CPU solver, serial or on numba's threads: the sweeps' coefficients,
+    the system update (kick, advance) and the gather that reorders an array (``parts`` ranges)."""
+    loops = cpu_loops("updates", precision, DEFAULT_KERNEL, parallel)  # they do not depend on the kernel
+    return {name: getattr(loops, name) for name in COMPILED["updates"]}
+
+
+@lru_cache(maxsize=None)
+def cpu_sorting() -> ModuleType:
+    """The serial cell sort (solvers/loops/sorting.py): ``counting_sort``, ``sort_cells_by_x``, compiled once."""
+    from solvers import jitcache
+
+    compiled = ("numba.njit", {"nogil": True})
+    return jitcache.specialise(
+        "solvers.loops.sorting",
+        bind={},
+        functions=dict.fromkeys(COMPILED["sorting"], compiled),
+        imports=("import numba",),
+    )

@@ -1,0 +1,1 @@
+"""What runs are scored against: the exact and reference solutions, and the dispersion prediction."""
