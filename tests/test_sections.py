@@ -119,7 +119,7 @@ def test_the_stability_summary_agrees_with_the_prediction_and_the_map(tmp_path, 
     scatter, plot, savefig = matplotlib.axes.Axes.scatter, matplotlib.axes.Axes.plot, matplotlib.figure.Figure.savefig
 
     def record_scatter(self, x, y, *args, label=None, **kw):
-        drawn[label] = sorted(zip(x, y))
+        drawn[label.split(" (")[0]] = sorted(zip(x, y))  # the class, without its explanation
         return scatter(self, x, y, *args, label=label, **kw)
 
     def record_plot(self, *args, **kw):

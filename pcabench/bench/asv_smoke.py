@@ -19,7 +19,7 @@ import sys
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]  # the checkout: pcabench/bench/ is two folders down
 RESULTS_LINE = '"results_dir": "reports/asv/results"'
 SCRATCH = Path(".asv") / "smoke" / "results"  # under the ignored .asv/
 # One benchmark of each kind, at the smallest size (asv matches "name(param, ...)"): a timed step of both CPU

@@ -240,7 +240,7 @@ def run_asv_gpu(
     Returns one row per commit: commit, sha, seconds, returncode, result (file or None), message.
     Never raises."""
     start, rows = time.monotonic(), []
-    root = Path(root or Path(__file__).resolve().parent.parent)
+    root = Path(root or Path(__file__).resolve().parents[2])
     out = Path(out)
 
     def row(commit, sha=None, seconds=0.0, returncode=None, result=None, message=""):
@@ -357,7 +357,7 @@ def device_command(commit: str, budget_s: float = 450.0) -> str:
 def main(argv=None) -> int:
     """``python -m pcabench.gpu.payload [BUDGET_S]``: prepare the payload here and print the device call."""
     argv = sys.argv[1:] if argv is None else argv
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     if _git(root, "status", "--porcelain", "--untracked-files=no", text=True).stdout.strip():
         print("commit first: the bundle and the results carry HEAD's commit", file=sys.stderr)
         return 2

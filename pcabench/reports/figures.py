@@ -107,6 +107,8 @@ def figure(
     yield axes
     handles = {}
     for ax in axes:
+        if not ax.axison:  # a panel turned into a key (its legend): no labels, no grid
+            continue
         if not ax.get_xlabel():
             ax.set_xlabel(xlabel)
         if not ax.get_ylabel() and ax.get_subplotspec().is_first_col():
@@ -227,6 +229,7 @@ def fig8(series, out: Path, pid: str):
                 [e for s in series if s["protocol"] == protocol for e in s["mse"]]
                 + ([mse_paper] if dx_paper in dxs else []),
             )
+            ax.set_ylabel("relative RMS error of u (paper's MSE)")  # every panel: their ranges differ
             ax.set_title(
                 protocol
                 + (" (fixed physical time)" if protocol.startswith("t =") else " (the paper's protocol)")
@@ -283,9 +286,10 @@ def fig9(rows, out: Path, pid: str):
                 a,
                 [r for r in pub if r["search"] == search],
                 marker,  # large and on top: never hidden
-                f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published)",
+                f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published; two sizes, not joined)",
                 ms=10,
                 zorder=4,
+                ls="none",  # the paper gives two sizes 2.4 decades apart: a line would invent the ones between
             )
         skipped = [r["N"] for r in rows if r["allpair_status"] == "skipped"]
         for n in skipped:
@@ -303,8 +307,8 @@ def fig9(rows, out: Path, pid: str):
             sorted(ap),
             [ap[n] / ll[n] for n in sorted(ap)],
             marker="D",
-            **PUBLISHED,
-            label="speedup eta (paper, published)",
+            **{**PUBLISHED, "ls": "none"},
+            label="speedup eta (paper, published; two sizes, not joined)",
         )
         b.set_ylabel("eta = t_all-pair / t_linked-list")
         b.set_title("speedup (eq. 12)", fontsize=9)
@@ -317,23 +321,32 @@ def _run_order(run: str):
     return (run.startswith("t ="), float(words[2] if run.startswith("t =") else words[0]))
 
 
+FIG10_SIZES = 2  # a panel is drawn where one of its series has this many sizes: a line against N, not a dot
+
+
 def fig10(series, out: Path, pid: str):
     """One step against N: a panel per run length, a colour per configuration (solver, precision, pair loop,
     threads), the paper's step times of the same kind in every panel."""
     if not series:
         return None
     path = out / "fig10_runtime_vs_N.png"
-    runs = sorted({s["run"] for s in series}, key=_run_order)
+    # a panel draws a line against N: a run length none of whose series has FIG10_SIZES sizes is left out
+    runs = sorted({s["run"] for s in series if len(s["N"]) >= FIG10_SIZES}, key=_run_order)
+    if not runs:
+        return None
+    series = [s for s in series if s["run"] in runs]
+    paper_panel = "100 steps" if "100 steps" in runs else runs[0]  # the paper's step times drawn once, here
     configs = sorted({(s["config"], s["loop"], s["threads"]) for s in series})
     colours = dict(zip(configs, palette(len(configs))))
     kinds = {(s["device"], s["search"]) for s in series if s["precision"] == "float64"}
     key = channels(colour=("configuration", configs), marker=("precision", [s["precision"] for s in series]))
     ncols = min(len(runs), 2)
     nrows = -(-len(runs) // ncols)
+    spare = nrows * ncols > len(runs)  # an empty slot holds the legend: the figure keeps its width
     with figure(
         path,
         f"Fig. 10: one step against N ({pid}, full domain), a panel per run length{key}; grey "
-        "dashed: the paper's, same kind",
+        f"dashed: the paper's, same kind ({paper_panel})",
         "particles N",
         "one step SNP+PI+SU (ms)",
         ncols=ncols,
@@ -341,7 +354,8 @@ def fig10(series, out: Path, pid: str):
         logx=True,
         logy=True,
         sharey=True,
-        size=(4.6 * ncols + 4.6, 3.4 * nrows + 0.6),
+        size=(4.6 * ncols + (0.6 if spare else 4.6), 3.4 * nrows + 0.6),
+        legend="none" if spare else "right",
     ) as axes:
         for ax in axes[len(runs) :]:
             ax.set_visible(False)
@@ -356,6 +370,12 @@ def fig10(series, out: Path, pid: str):
                     label=f"{s['config']}, {s['loop']}, {T.where(s['threads'], s['device'])}",
                 )
             ax.set_title(f"runs to t = {run[4:]}" if run.startswith("t =") else f"runs of {run}", fontsize=9)
+            sizes = [n for s in series if s["run"] == run for n in s["N"]]
+            if max(sizes) / min(sizes) < 100:  # under two decades: ticks at the sizes run, never 2x10^5
+                plain_log_ticks(ax, sizes, axis="x", spread=3.0)
+                ax.xaxis.set_minor_locator(NullLocator())
+            if run != paper_panel:
+                continue
             if ("cpu", "linked list") in kinds:
                 cpu = [
                     r
@@ -375,6 +395,15 @@ def fig10(series, out: Path, pid: str):
             if ("gpu", "linked list") in kinds:
                 pts = [r for r in P.step_times() if r["device"] == "gpu" and r["source"] == "Table 4"]
                 _published(ax, pts, "^", f"paper GPU, {pts[0]['processor']}, Table 4: one step (published)")
+        if spare:
+            handles = {}
+            for ax in axes[: len(runs)]:
+                for h, lab in zip(*ax.get_legend_handles_labels()):
+                    handles.setdefault(lab, h)
+            key_ax = axes[-1]
+            key_ax.set_visible(True)
+            key_ax.axis("off")
+            key_ax.legend(list(handles.values()), list(handles), loc="center", fontsize=7, frameon=False)
     return path
 
 
@@ -478,8 +507,8 @@ def fig13(rows, out: Path, pid: str):
         ]
     spread = max(r.get("init_spread", 1.0) for r in rows)
     noisy = (
-        f"; init is timed once per run, and stored reruns of one configuration differ in it by up to "
-        f"{spread:.1f}x: one slow init can dominate a row"
+        f"; init (timed once per run; stored reruns of one configuration differ in it by up to {spread:.1f}x) "
+        "is the shortest rerun's"
         if spread >= 1.5
         else ""
     )
@@ -601,7 +630,8 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
         return None
     here_all = [p for p in points if (p["t_final"], p["model"]) in panels]
     key = channels(
-        colour=("kernel", [p["kernel"] for p in here_all]), hollow=("float32", [p["precision"] for p in here_all])
+        colour=("kernel", [p["kernel"] for p in here_all]),
+        **{"hollow triangle": ("float32", [p["precision"] for p in here_all])},
     )
     path = out / "speed_vs_accuracy.png"
     with figure(
@@ -620,15 +650,18 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
                 [p for p in here if not p.get("past_limit")], ("kernel", "precision")
             ):
                 colour = kernel_colour(kern)
+                single = precision == "float32"  # a hollow triangle over the filled float64 circle: both show
                 ax.plot(
                     [p["seconds"] for p in pts],
                     [p["error"] for p in pts],
                     ls="none",
-                    marker="o",
-                    ms=4.5,
+                    marker="^" if single else "o",
+                    ms=6.5 if single else 4.5,
                     color=colour,
-                    mfc="none" if precision == "float32" else colour,
-                    alpha=0.75,
+                    mfc="none" if single else colour,
+                    mew=1.0,
+                    alpha=0.85 if single else 0.7,
+                    zorder=4 if single else 3,
                     label=f"{kern}, {precision}",
                 )
             past = [p for p in here if p.get("past_limit")]
@@ -665,14 +698,15 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
                 lw=1.3,
                 label="front: fastest run to each error",
             )
-            ax.plot(
+            ax.step(  # a dashed line, not marks: the runs under it stay in sight
                 [p["seconds"] for p in fp],
                 [T.predicted_error(p) for p in fp],
-                ls="none",
-                marker="x",
-                ms=6,
                 color="crimson",
-                label="front runs, predicted (dispersion relation, linear part)",
+                where="post",
+                lw=1.1,
+                ls="--",
+                zorder=2,
+                label="the front runs' error, predicted (dispersion relation, linear part)",
             )
             ax.set_title(f"{model}, t = {t_final:g} s ({len(here)} runs)", fontsize=9)
             # plain ticks: a narrow log range would label its minor ticks too, and they collide
@@ -690,15 +724,18 @@ def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
     path = out / "stability_map.png"
     with figure(
         path,
-        f"Stability map ({pid}): black bar: the stable CFL (predicted, or long runs where lower); "
-        "past it a run is unstable (a hollow X where it ended bounded: too few steps for round-off to grow); "
-        f"inaccurate = bounded but relative RMS > {100 * inaccurate_above:g} %; numbers: the step where a run "
-        "blew up",
+        f"Stability map ({pid}): each method's runs by CFL",  # the key is the legend's: a short title
         "CFL = dt c0 / dx",
         "",
         logx=True,
-        size=(11, 2.1 + 0.32 * len(configs)),
+        size=(11.5, max(3.0, 1.5 + 0.32 * len(configs))),
     ) as (ax,):
+        words = {
+            "inaccurate": f"inaccurate (bounded,\nrelative RMS > {100 * inaccurate_above:g} %)",
+            "unstable": "unstable (number: the step\nit blew up at)",
+            UNSTABLE_BY_PREDICTION: "unstable by prediction (past the stable\nCFL, ended bounded: too few steps\n"
+            "for round-off to grow)",
+        }
         for cls, (colour, marker) in CLASS_STYLE.items():
             pts = [p for p in points if p["class"] == cls]
             if pts:
@@ -711,7 +748,7 @@ def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
                     marker=marker,
                     s=40,
                     linewidths=1.2 if hollow else None,
-                    label=cls,
+                    label=words.get(cls, cls),
                     zorder=3,
                 )  # above the limit bar
         for p in points:
@@ -733,7 +770,7 @@ def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
                     color="black",
                     lw=1.5,
                     solid_capstyle="butt",
-                    label=None if drawn else "stable CFL (predicted; long runs where lower)",
+                    label=None if drawn else "the stable CFL (predicted;\nlong runs where lower)",
                 )
                 drawn = True
             else:
@@ -797,26 +834,46 @@ def cards_figure(rows, out: Path):
     return path
 
 
+FRONT_PANEL_RUNS = 8  # a scene's panel needs this many runs at the default amplitude: fewer draw no front
+
+
+def front_of(pts: list[dict]) -> list[dict]:
+    """The runs no faster run beats in error (the lower-left envelope), fastest first; runs past their stable
+    CFL are never on it."""
+    front, best = [], np.inf
+    for p in sorted((p for p in pts if not p["past_stable"]), key=lambda p: (p["seconds"], p["error"])):
+        if p["error"] < best:
+            front.append(p)
+            best = p["error"]
+    return front
+
+
 def scene_fronts(points, out: Path, pid: str):
-    """Time to solution against error, one panel per scene at its default amplitude (t = 10 s): each model a
-    colour, runs past their predicted stable CFL drawn as crosses (never on a front)."""
-    scenes = sorted({p["scene"] for p in points}, key=lambda s: (s != "plane-pulse", s))
+    """Time to solution against error, one panel per scene at its default amplitude (t = 10 s) with at least
+    FRONT_PANEL_RUNS runs: each model a colour, its front a step line, runs past their predicted stable CFL
+    drawn as crosses (never on a front). A scene with fewer runs (the walls: their own figure) has no panel."""
+    counts = {}
+    for p in points:
+        if np.isclose(p["mach"], 0.05):
+            counts[p["scene"]] = counts.get(p["scene"], 0) + 1
+    scenes = sorted((s for s, n in counts.items() if n >= FRONT_PANEL_RUNS), key=lambda s: (s != "plane-pulse", s))
     if len(scenes) < 2:
         return None
     path = out / "scene_fronts.png"
     past = " x: past the predicted stable CFL," if any(p["past_stable"] for p in points) else ""
-    ncols = min(len(scenes), 2)  # two panels a row: four scenes (the walls too) stay readable
+    ncols = min(len(scenes), 2)
     nrows = -(-len(scenes) // ncols)
     with figure(
         path,
-        f"Time to solution against error on each scene, t = 10 s, Mach 0.05 ({pid});{past} colour: model",
+        f"Time to solution against error on each scene, t = 10 s, Mach 0.05 ({pid});{past} colour: model; "
+        "each stepped line is a model's front (no faster run has a smaller error)",
         "time to solution, s",
         "relative RMS error",
         ncols=ncols,
         nrows=nrows,
         logx=True,
         logy=True,
-        size=(6.5 * ncols + 2.5, 3.9 * nrows),
+        size=(6.0 * ncols + 2.5, 4.3 * nrows),
     ) as axes:
         for ax in axes[len(scenes) :]:
             ax.set_visible(False)
@@ -833,14 +890,24 @@ def scene_fronts(points, out: Path, pid: str):
                         s=14 if not past else 22,
                         marker="x" if past else "o",
                         color=MODEL_COLOUR[model],
-                        alpha=0.8 if not past else 0.6,
+                        alpha=0.55 if not past else 0.5,
                         label=f"{model}" + (" (past the stable CFL)" if past else ""),
                     )
+                line = front_of([p for p in mine if p["model"] == model])
+                if len(line) > 1:
+                    ax.step(
+                        [p["seconds"] for p in line],
+                        [p["error"] for p in line],
+                        where="post",
+                        color=MODEL_COLOUR[model],
+                        lw=1.6,
+                        label=f"{model} front",
+                    )
             errors = [p["error"] for p in mine]
-            if errors:
-                nice_log_ticks(ax, errors)
-                nice_log_ticks(ax, [p["seconds"] for p in mine], axis="x")
-            ax.set_title(f"{scene} (error of {scene_kind(scene).primary})", fontsize=9)
+            nice_log_ticks(ax, errors)
+            nice_log_ticks(ax, [p["seconds"] for p in mine], axis="x")
+            ax.set_ylabel(f"relative RMS error of {scene_kind(scene).primary}")
+            ax.set_title(scene, fontsize=9)
     return path
 
 
@@ -848,11 +915,12 @@ def phase_direction(curves, fronts, out: Path, pid: str):
     """The lattice's anisotropy: the predicted phase speed error's change from its value along the axis, against
     the direction of travel, one colour per method, at the pulse's wavenumber and at a short wave (a panel
     each); where 2D runs stored it, their wave front speed error along the axis and the diagonal, measured
-    against predicted."""
+    against predicted, each run in its method's colour (grey: a method with no curve)."""
     if not curves:
         return None
     path = out / "phase_direction.png"
     colours = palette(len(curves))
+    colour_of = {c["label"].removesuffix(" (paper's)"): colour for c, colour in zip(curves, colours)}
     fronts = [f for f in fronts if f["predicted"][0] is not None]
     with figure(
         path,
@@ -860,36 +928,42 @@ def phase_direction(curves, fronts, out: Path, pid: str):
         "direction, degrees from the lattice's x axis",
         "phase speed error minus its value along the axis, %",
         ncols=3 if fronts else 2,
+        size=(15.5 if fronts else 11.0, 5.2),
     ) as axes:
         for ax, key, title in (
             (axes[0], "error", "the pulse's wavenumber k = 1/b"),
             (axes[1], "short", "a short wave, 8 particles per wavelength"),
         ):
-            for c, colour in zip(curves, colours):
+            for i, (c, colour) in enumerate(zip(curves, colours)):
                 values = 100 * np.asarray(c[key])
-                ax.plot(c["angles"], values - values[0], color=colour, label=c["label"])
+                style = ("-", "--", ":", "-.")[i % 4]  # a curve under another still shows
+                ax.plot(c["angles"], values - values[0], color=colour, ls=style, lw=1.8, label=c["label"])
             ax.set_xticks([0, 15, 30, 45])
-            ax.set_title(title, fontsize=9)
+            ax.set_title(title, fontsize=10)
         if fronts:
             ax = axes[2]
             ax.set_xlabel("predicted front speed error, %")
             ax.set_ylabel("measured front speed error, %")
-            ax.set_title("2D runs: the front along the axis (o) and the diagonal (^)", fontsize=9)
+            ax.set_title("2D runs: the front along the axis (o) and the diagonal (^)", fontsize=10)
             values = []
             for f in fronts:
+                colour = colour_of.get(f["method"], "0.5")
                 for k, marker in ((0, "o"), (1, "^")):
                     ax.scatter(
                         100 * f["predicted"][k],
                         100 * f["measured"][k],
                         marker=marker,
                         facecolors="none",
-                        edgecolors="tab:blue",
-                        s=28,
+                        edgecolors=colour,
+                        s=36,
+                        label=None if f["method"] in colour_of else "runs of other methods",
                     )
                     values += [100 * f["predicted"][k], 100 * f["measured"][k]]
             lo, hi = min(values), max(values)
             pad = 0.05 * (hi - lo or 1.0)
-            ax.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="0.6", lw=0.8, ls=":")
+            ax.plot(
+                [lo - pad, hi + pad], [lo - pad, hi + pad], color="0.6", lw=0.8, ls=":", label="measured = predicted"
+            )
     return path
 
 

@@ -180,8 +180,13 @@ def text(data, ctx) -> list[str]:
         "pulse for `linear`, the isothermal solution (solvers/reference/isothermal1d.py) for `lagrangian` (its error "
         "against the linear pulse never falls below the two equations' 9.8 % difference at t = 10 s; "
         "lagrangian runs from before this was measured are left out). `fixed` solves neither and is in the "
-        "cost of the simplifications below. A quick study runs the paper's method only (every ratio is then "
-        "1); `pcabench study --front` adds the other kernels, h/dx and steps.",
+        "cost of the simplifications below. "
+        + (
+            "These runs are all of the paper's method, so every ratio is 1 (a quick study's); `pcabench study "
+            "--front` adds the other kernels, h/dx and steps."
+            if all(p["paper_method"] for p in points)
+            else "The other kernels, h/dx and steps are `pcabench study --front`'s runs."
+        ),
         "",
         md_table(
             [
