@@ -63,3 +63,28 @@ def test_the_stable_cfl_is_the_dispersion_relations_for_the_method():
     ):
         assert Method.of(scene).stable_cfl() == pytest.approx(stable_cfl(scene), rel=1e-9)
     assert Method.of(Scene(dx=1.0, steps=2, integrator="euler")).stable_cfl() == 0
+
+
+def test_the_measured_limits_are_the_reference_stores_long_runs():
+    """Every row of pcabench/predict/measured_limits.csv whose long runs are in the reference store says what
+    those runs say (the smallest CFL that blew up, the largest bounded below it), and every limit the stored
+    long runs put below the prediction has its row: the data is the store's, not a copy that can drift."""
+    from pcabench import paths
+    from pcabench.predict.stability import measured_limits
+    from pcabench.reports import frame
+    from pcabench.reports import tables as T
+
+    df = frame.load(paths.reference_results())
+    data = {(s, m, k, h, i): v for (s, m, k, h, _c, i), v in measured_limits().items()}
+    checked = 0
+    for preset in ("stability-long", "walls"):
+        for r in T.long_run_limits(df, preset):
+            if r["kernel"] != "gaussian" or r["h_factor"] != 2.13 or r["blew_up_from"] is None:
+                continue
+            key = (r["scene"], r["model"], r["kernel"], r["h_factor"], "verlet")
+            if r["blew_up_from"] < r["predicted"]:
+                assert data.get(key) == (r["blew_up_from"], r["bounded_to"]), (key, r)
+                checked += 1
+            else:
+                assert key not in data, (key, r)  # no limit below the prediction where the runs found none
+    assert checked == len(data) == 8

@@ -200,7 +200,7 @@ def test_the_long_run_table_measures_each_models_limit_below_its_first_blow_up(t
     assert lin["predicted"] == pytest.approx(4.97, abs=0.01) and lin["bounded_to"] == 4.9
     assert lin["blew_up_from"] == 5.0 and lin["e_foldings"] < 1e-9 and lin["held"] is None
     assert fixed["bounded_to"] == 4.6 and fixed["blew_up_from"] == 4.7 and fixed["first_step"] == 236  # not 4.8
-    assert fixed["held"] == 4.75  # pcabench/predict/stability.py's MEASURED_LIMITS: fixed on the 2D pulse
+    assert fixed["held"] == 4.75  # pcabench/predict/measured_limits.csv: fixed on the 2D pulse
     text = "\n".join(long_runs_section.text(list(rows.values()), None))
     assert "**fixed** on acoustic-pulse blew up below the predicted 4.97, from CFL 4.7" in text
     assert "**linear** blew up below" not in text

@@ -4,7 +4,7 @@ The limit comes from the dispersion relation (solvers/reference/dispersion.py
 ``stable_cfl``): exact for the `linear` model on a periodic lattice; for
 `fixed` and `lagrangian` it is their linear part's (design section 4). Where
 long runs of a scene measured a lower one (free ends, or a moving model's
-nonlinear terms: :data:`MEASURED_LIMITS`), that one is used.
+nonlinear terms: :func:`measured_limits`), that one is used.
 A run at or past its predicted limit is unstable, whatever its error: if it
 ended bounded, its run was too short for round-off to grow, and
 :func:`e_foldings` says how far the most unstable mode had grown (round-off,
@@ -17,36 +17,32 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
 ROUND_OFF_E_FOLDINGS = math.log(1e16)  # ~37: from float64 round-off to the pulse's size
 UNSTABLE_BY_PREDICTION = "unstable by prediction"
 
-# Long runs (``pcabench study --stability long``: t = 300 s, dx = 0.25, the paper's method, serial), where the
-# prediction's periodic lattice is not the whole story: free ends (the paper's scene) and the moving models'
-# nonlinear terms can grow what the periodic linear lattice keeps bounded.
-# (scene, model, kernel, h/dx, cutoff/h, integrator) -> (the smallest CFL that blew up, the largest that stayed
-# bounded below it), where that is below the prediction (4.97 for this method). Measured 2026-12-01 (AMD EPYC):
-# on the plane pulse's strip (free ends, Mach 0.01) every model bounded at 4.75 and blew up from 4.8, the linear
-# one too, so that it is the free ends' limit; on the 2D pulse in a periodic 20 m square linear and lagrangian
-# bounded at 4.9 and blew up at 5 (the prediction), fixed blew up from 4.75 (bounded at 4.7).
-_PAPER_METHOD = ("gaussian", 2.13, 3.0, "verlet")
-MEASURED_LIMITS = {
-    ("plane-pulse", "linear", *_PAPER_METHOD): (4.8, 4.75),
-    ("plane-pulse", "fixed", *_PAPER_METHOD): (4.8, 4.75),
-    ("plane-pulse", "lagrangian", *_PAPER_METHOD): (4.8, 4.75),
-    ("acoustic-pulse", "fixed", *_PAPER_METHOD): (4.75, 4.7),
-    # At a rigid wall (``pcabench study --walls``, commit 15cd1e3, measured 2026-12-02, AMD EPYC), CFL 4.75, 4.9, 5:
-    # on plane-wall's strip (Mach 0.01, a free left end) every model bounded at 4.75 and blew up from 4.9, as the
-    # plane pulse's free ends; on pulse-wall (walls at both x ends) linear and lagrangian bounded at 4.9 and blew up
-    # at 5 (the prediction), fixed blew up from 4.9 (bounded at 4.75, where the periodic square's fixed run blew up):
-    # no wall lowered a limit below its free counterpart's.
-    ("plane-wall", "linear", *_PAPER_METHOD): (4.9, 4.75),
-    ("plane-wall", "fixed", *_PAPER_METHOD): (4.9, 4.75),
-    ("plane-wall", "lagrangian", *_PAPER_METHOD): (4.9, 4.75),
-    ("pulse-wall", "fixed", *_PAPER_METHOD): (4.9, 4.75),
-}
+MEASURED_LIMITS_FILE = Path(__file__).with_name("measured_limits.csv")  # data, with where each was measured
+
+
+@lru_cache(maxsize=1)
+def measured_limits() -> dict[tuple, tuple[float, float]]:
+    """(scene, model, kernel, h/dx, cutoff/h, integrator) -> (the smallest CFL that blew up, the largest that
+    stayed bounded below it), where long runs measured a limit below the prediction (:data:`MEASURED_LIMITS_FILE`,
+    each row with its date, machine and command)."""
+    import csv
+
+    with MEASURED_LIMITS_FILE.open(newline="", encoding="utf-8") as f:
+        rows = csv.DictReader(line for line in f if not line.startswith("#"))
+        return {
+            (r["scene"], r["model"], r["kernel"], float(r["h_factor"]), float(r["cutoff_factor"]), r["integrator"]): (
+                float(r["blew_up_from"]),
+                float(r["bounded_to"]),
+            )
+            for r in rows
+        }
 
 
 def _value(r, key, default=None):
@@ -56,24 +52,19 @@ def _value(r, key, default=None):
     return v
 
 
-def _scene(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, dx: float = 1.0):
-    from solvers import Scene
-    from solvers.kernels import truncated
-
-    method = {"kernel": kernel, "h_factor": h_factor, "integrator": integrator}
-    if truncated(kernel):  # a kernel of compact support (the Wendland kernels) is cut there
-        method["cutoff_factor"] = cutoff_factor
-    return Scene(dx=dx, t_end=1.0, model="linear", **method)
-
-
 @lru_cache(maxsize=1024)
 def _limits(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> tuple[float, float]:
-    """(stable CFL, largest c0 |D| dt per unit CFL) of one method. Both are the same at every dx (the
-    lattice's offsets are in units of dx, and dx |D| depends on h/dx only), so dx = 1 stands for all."""
-    from solvers.reference.dispersion import largest_symbol, stable_cfl
+    """(stable CFL, largest c0 |D| dt per unit CFL) of one method (:class:`solvers.method.Method`). Both are the
+    same at every dx (the lattice's offsets are in units of dx, and dx |D| depends on h/dx only), so dx = 1
+    stands for all."""
+    from solvers import Scene
+    from solvers.kernels import truncated
+    from solvers.method import Method
+    from solvers.reference.dispersion import largest_symbol
 
-    scene = _scene(kernel, h_factor, cutoff_factor, integrator)
-    return stable_cfl(scene), scene.dx * largest_symbol(scene)
+    method = Method(kernel, h_factor, cutoff_factor if truncated(kernel) else None, 1.0, integrator)
+    scene = Scene(dx=1.0, t_end=1.0, model="linear", **method.scene_fields())
+    return method.stable_cfl(), scene.dx * largest_symbol(scene)
 
 
 def method_of(r) -> tuple[str, float, float, str]:
@@ -88,14 +79,14 @@ def method_of(r) -> tuple[str, float, float, str]:
 
 
 def measured_limit(r) -> float | None:
-    """The smallest CFL at which long runs of ``r``'s scene, model and method blew up (:data:`MEASURED_LIMITS`),
+    """The smallest CFL at which long runs of ``r``'s scene, model and method blew up (:func:`measured_limits`),
     or None (a run without a scene is of the paper's)."""
     from solvers import DEFAULT_SCENE
     from solvers.kernels import truncated
 
     kernel, h, cut, integrator = method_of(r)
     mine = (str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", ""), kernel, integrator)
-    for (scene, model, k, hh, cc, integ), (limit, _bounded) in MEASURED_LIMITS.items():
+    for (scene, model, k, hh, cc, integ), (limit, _bounded) in measured_limits().items():
         if (scene, model, k, integ) == mine and math.isclose(h, hh) and (not truncated(k) or math.isclose(cut, cc)):
             return limit
     return None
@@ -103,7 +94,7 @@ def measured_limit(r) -> float | None:
 
 def stable_limit(r) -> float:
     """The largest stable CFL of run ``r``'s method: predicted (0: its integrator grows at any step), or the
-    limit long runs of its scene and model measured where that is lower (:data:`MEASURED_LIMITS`)."""
+    limit long runs of its scene and model measured where that is lower (:func:`measured_limits`)."""
     linear, measured = _limits(*method_of(r))[0], measured_limit(r)
     return linear if measured is None else min(linear, measured)
 

@@ -9,6 +9,7 @@ from pcabench.reports import paper as P
 from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.sections.base import Section
+from solvers import Scene
 
 
 def rows(ctx):
@@ -18,7 +19,7 @@ def rows(ctx):
 
 def lagrangian_note(s) -> str:
     t = s["t_final"][0] if len(set(np.round(s["t_final"], 6))) == 1 else None
-    ref = T.ISOTHERMAL_VS_LINEAR.get(round(t, 6)) if t else None
+    ref = T.linear_floor(Scene.default("name"), Scene.default("mach"), round(t, 6)) if t else None
     return (
         f"it {T.trend(s)} ({', '.join(pct(e) for e in s['mse'])} for dx = "
         f"{', '.join(f'{d:g}' for d in s['dx'])}). The lagrangian model solves the isothermal (nonlinear) "

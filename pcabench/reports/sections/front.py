@@ -77,8 +77,9 @@ def predicted_by_model(predicted) -> list[str]:
         "keeps rho = rho0 + drho in its coefficients and masses from the initial density, a first-order "
         "change in Ma of the operator, and no advection: it solves neither the linear nor the isothermal "
         "equations, so it parts from the prediction by several times. `lagrangian` moves its particles and "
-        "converges to the isothermal solution instead, whose distance from the linear pulse (9.8 % at "
-        "t = 10 s) its error against the pulse approaches; against the isothermal solution (last column) its "
+        "converges to the isothermal solution instead, whose distance from the linear pulse "
+        f"({pct(T.linear_floor(Scene.default('name'), Scene.default('mach'), 10.0))} at t = 10 s) its error "
+        "against the pulse approaches; against the isothermal solution (last column) its "
         "error follows the predicted linear part closely: the prediction describes its discretisation "
         "error, the pulse's Mach number the rest.",
         "",
@@ -178,7 +179,8 @@ def text(data, ctx) -> list[str]:
         "strip its support allows, so a compact kernel's strip is thinner). Errors are against what each model "
         "converges to: the linear "
         "pulse for `linear`, the isothermal solution (solvers/reference/isothermal1d.py) for `lagrangian` (its error "
-        "against the linear pulse never falls below the two equations' 9.8 % difference at t = 10 s; "
+        "against the linear pulse never falls below the two equations' "
+        f"{pct(T.linear_floor(Scene.default('name'), Scene.default('mach'), 10.0))} difference at t = 10 s; "
         "lagrangian runs from before this was measured are left out). `fixed` solves neither and is in the "
         "cost of the simplifications below. "
         + (

@@ -42,7 +42,7 @@ def text(rows, ctx) -> list[str]:
         "is how far the most unstable mode of the periodic lattice grew at the largest bounded CFL over the "
         "run (0 below the predicted limit; round-off needs about 37 to reach the pulse's size). The last "
         "column is the limit advise, the front and the tables use for that scene and model "
-        "(pcabench/predict/stability.py: its MEASURED_LIMITS, where lower than the prediction).",
+        "(pcabench/predict/measured_limits.csv, where lower than the prediction).",
         "",
         md_table(
             [
@@ -76,7 +76,7 @@ def text(rows, ctx) -> list[str]:
                 + (
                     f"; advise takes it as {r['held']:g}."
                     if r["held"] is not None
-                    else "; advise still uses the prediction for it (add it to MEASURED_LIMITS)."
+                    else "; advise still uses the prediction for it (add it to pcabench/predict/measured_limits.csv)."
                 )
             )
     return lines + [""]

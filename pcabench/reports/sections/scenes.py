@@ -11,15 +11,13 @@ too short for round-off to grow.
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
 from pcabench.predict.stability import past_limit, stable_limit
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.sections.base import Section
-from pcabench.reports.tables import is_paper_method, latest, numerics_label
+from pcabench.reports.tables import is_paper_method, latest, linear_floor, numerics_label
 from pcabench.spec import scene_from_row
 from solvers import DEFAULT_SCENE, Scene, scene_kind
 
@@ -134,14 +132,6 @@ def predicted(r) -> float:
     from solvers.reference.dispersion import predict
 
     return predict(scene_from_row(r).replace(model="linear")).predicted_error
-
-
-@lru_cache(maxsize=256)
-def linear_floor(name: str, mach: float, t_final: float) -> float | None:
-    """The `linear` model's error floor against the isothermal physics (exact linear against isothermal
-    solution, no discretisation) for scene ``name`` at ``mach`` and ``t_final``, on a 0.1 m lattice."""
-    scene = Scene(dx=0.1, name=name, mach=mach, t_end=t_final, model="linear")
-    return scene.kind.linear_floor(scene)
 
 
 def model_needs(df, target: float = MODEL_TARGET) -> list[dict]:

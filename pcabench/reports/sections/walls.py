@@ -8,6 +8,8 @@ without the wall: ``presets.FREE_COUNTERPART``) whose long runs and step times i
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from pcabench.presets import FREE_COUNTERPART, LONG_T_END, WALLS, cost_round
@@ -150,11 +152,15 @@ def _gap_words(gap: float) -> str:
 
 
 ROUND_OFF_GAP = 1e-9  # |measured / predicted - 1| below this is round-off (the linear runs reach 1e-14)
-# The plane-wall's free left end moved 20 m away (x_min = -30 m, the same lattice otherwise): the largest
-# |measured / predicted - 1| of its linear runs at t = 10 s, dx 0.5 and 0.25 (serial linked list; the runs at
-# x_min = -10 m differed by 1.3e-5 and 8.6e-6). Measured 2026-12-01 with pcabench.execute.run.run, not stored;
-# tests/test_walls.py checks it (below 1e-9 at dx 0.5).
-FREE_END_MOVED = (-30.0, 2.04e-14)
+
+
+def free_end_moved() -> tuple[float, float]:
+    """(x_min, the largest |measured / predicted - 1|) of plane-wall's linear runs with the free left end moved
+    20 m away: a measurement not in the store, kept as data with its command (walls_measured.json)."""
+    import json
+
+    data = json.loads(Path(__file__).with_name("walls_measured.json").read_text(encoding="utf-8"))["free_end_moved"]
+    return float(data["x_min"]), float(data["largest_gap"])
 
 
 def _span(values) -> str:
@@ -174,7 +180,7 @@ def _gap_note(scene: str, linear) -> str:
     if abs(worst["gap"]) < ROUND_OFF_GAP:
         return head + ": round-off; the mirror extension is exactly the run's problem."
     if "free-x" in scenes()[scene].boundaries() and at_wall and max(at_wall) < 0.1 * abs(worst["gap"]):
-        x_min, gap = FREE_END_MOVED
+        x_min, gap = free_end_moved()
         return (
             head + (f", near the wall by {max(at_wall):.2g}" if at_wall else "") + ": the difference is the "
             "free left end's, not the wall's. The run's particles at that end miss the neighbours beyond it, "
@@ -311,7 +317,7 @@ def _stability_text(rows) -> list[str]:
         "the same model and method's long runs on the free counterpart (`--stability long`: the plane pulse's "
         "strip with free ends, the 2D pulse's periodic square) where they were made. 'e-foldings': how far the "
         "most unstable mode of the periodic lattice grew at the largest bounded CFL (0 below the prediction). "
-        "The last column is the limit advise and the tables use (pcabench/predict/stability.py's MEASURED_LIMITS, "
+        "The last column is the limit advise and the tables use (pcabench/predict/measured_limits.csv, "
         "keyed by scene, where lower than the prediction).",
         "",
         md_table(
@@ -365,7 +371,7 @@ def _stability_text(rows) -> list[str]:
             + (
                 f"; advise takes it as {r['held']:g}."
                 if r["held"] is not None
-                else "; advise still uses the prediction for it (add it to MEASURED_LIMITS)."
+                else "; advise still uses the prediction for it (add it to pcabench/predict/measured_limits.csv)."
             )
         )
     if not not_the_wall:
