@@ -41,7 +41,7 @@ import numpy as np
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError, SolverUnavailable, kernel_names, solver_class
 from solvers.interface import STAGES, Solver
-from solvers.physics.integrators import step_program
+from solvers.physics.integrators import advance_steps, evolve
 from solvers.registry import SOLVERS
 
 REFERENCE = "allpair-cpu"  # the all-pair search: every pair tested, no cell list to get wrong
@@ -173,11 +173,8 @@ class Subject:
             solver = solver_class(REFERENCE)() if reference else self.make(threads, pair_loop)
             solver.input(scene)
             solver.init()
-            for step in range(1, scene.n_steps + 1):
-                for _stage, op in step_program(scene.integrator, solver, first=(step == 1)):
-                    op()
-                if between is not None:
-                    between(solver)
+            each = None if between is None else (lambda: between(solver))
+            advance_steps(solver, scene.integrator, scene.n_steps, each=each)
             result = (solver.output(), solver)
             if between is not None:
                 return result
@@ -411,11 +408,7 @@ def measure(subject: Subject, scene: Scene, pair_loop: str) -> int:
 
 
 def run_steps(solver: Solver, scene: Scene) -> None:
-    solver.input(scene)
-    solver.init()
-    for step in range(1, scene.n_steps + 1):
-        for _stage, op in step_program(scene.integrator, solver, first=(step == 1)):
-            op()
+    evolve(solver, scene)
 
 
 @check
@@ -556,6 +549,31 @@ def target_class(solver) -> type[Solver]:
     return solver_class(solver)
 
 
+def _availability(cls) -> str | None:
+    """Why ``cls`` cannot run here (None: it can)."""
+    try:
+        cls.available()
+    except SolverUnavailable as exc:
+        return str(exc)
+    return None
+
+
+def run_check(fn, subject: Subject, missing: str | None = None) -> CheckResult:
+    """One check on ``subject``: ok, skipped (the machine lacks what it needs) or failed (a crash included)."""
+    t0 = time.perf_counter()
+    if missing is not None:
+        return CheckResult(fn.__name__, "skipped", missing, 0.0)
+    try:
+        note, status = fn(subject), "ok"
+    except (Skip, SolverUnavailable) as exc:
+        note, status = str(exc), "skipped"
+    except AssertionError as exc:
+        note, status = str(exc), "failed"
+    except Exception as exc:  # noqa: BLE001 - a solver that crashes fails the check, it does not stop the suite
+        note, status = f"{type(exc).__name__}: {exc}", "failed"
+    return CheckResult(fn.__name__, status, note or "", time.perf_counter() - t0)
+
+
 def iter_checks(solver, quick: bool = False, only=None):
     """Run the checks on ``solver`` (a name or a Solver subclass) one at a time: a CheckResult each.
     ``only``: the names of the checks to run (default all, in :data:`CHECK_NAMES` order)."""
@@ -563,30 +581,57 @@ def iter_checks(solver, quick: bool = False, only=None):
     unknown = sorted(set(only or ()) - set(CHECK_NAMES))
     if unknown:
         raise SceneError(f"checks must be among {', '.join(CHECK_NAMES)} (got {', '.join(unknown)})")
-    subject = Subject(cls, quick)
-    try:
-        cls.available()
-        missing = None
-    except SolverUnavailable as exc:
-        missing = str(exc)
+    subject, missing = Subject(cls, quick), _availability(cls)
     for fn in CHECKS:
-        if only and fn.__name__ not in only:
-            continue
-        t0 = time.perf_counter()
-        if missing is not None:
-            yield CheckResult(fn.__name__, "skipped", missing, 0.0)
-            continue
-        try:
-            note, status = fn(subject), "ok"
-        except Skip as exc:
-            note, status = str(exc), "skipped"
-        except SolverUnavailable as exc:
-            note, status = str(exc), "skipped"
-        except AssertionError as exc:
-            note, status = str(exc), "failed"
-        except Exception as exc:  # noqa: BLE001 - a solver that crashes fails the check, it does not stop the suite
-            note, status = f"{type(exc).__name__}: {exc}", "failed"
-        yield CheckResult(fn.__name__, status, note or "", time.perf_counter() - t0)
+        if not only or fn.__name__ in only:
+            yield run_check(fn, subject, missing)
+
+
+class Check:
+    """One conformance check as a pytest case's callable (:func:`parametrize_with_checks`): ``check(solver)``
+    passes, raises AssertionError naming what failed, or skips the test where the machine lacks what it needs."""
+
+    def __init__(self, fn, quick: bool, subjects: dict):
+        self.fn, self.quick, self.subjects = fn, quick, subjects
+
+    def __repr__(self) -> str:
+        return self.fn.__name__
+
+    def __call__(self, solver) -> CheckResult:
+        import pytest
+
+        cls = target_class(solver)
+        key = (cls, self.quick)
+        if key not in self.subjects:  # one subject per solver: its reference runs are shared by its checks
+            self.subjects[key] = (Subject(cls, self.quick), _availability(cls))
+        result = run_check(self.fn, *self.subjects[key])
+        if result.status == "skipped":
+            pytest.skip(f"{self.fn.__name__}: {result.message}")
+        if result.failed:
+            raise AssertionError(result.line())
+        return result
+
+
+def parametrize_with_checks(solvers, quick: bool = True):
+    """A pytest parametrize mark over every (solver, check) pair, each its own test case (scikit-learn's
+    ``parametrize_with_checks``): ``-k "linkedlist-cpu and agreement"`` runs one. ``solvers``: registered names
+    or Solver subclasses (a class need not be registered)::
+
+        @parametrize_with_checks([MySolver])
+        def test_my_solver_conforms(solver, check):
+            check(solver)
+    """
+    import pytest
+
+    subjects: dict = {}
+    return pytest.mark.parametrize(
+        ("solver", "check"),
+        [
+            pytest.param(solver, Check(fn, quick, subjects), id=f"{getattr(solver, 'name', solver)}-{fn.__name__}")
+            for solver in solvers
+            for fn in CHECKS
+        ],
+    )
 
 
 def check_solver(solver, quick: bool = False, only=None) -> list[CheckResult]:

@@ -8,7 +8,7 @@ import pytest
 
 from solvers import Scene, make_solver, resolve_pair_loop
 from solvers.physics import denormals
-from solvers.physics.integrators import step_program
+from solvers.physics.integrators import evolve
 from solvers.search import compress, pairlist
 
 from .conftest import strip_for
@@ -20,13 +20,7 @@ def max_rel(a, b):
 
 def stepped(scene, pair_loop, threads=1, steps=None):
     """A linkedlist-cpu solver after ``steps`` Verlet steps (all of the scene's by default)."""
-    s = make_solver("linkedlist-cpu", threads=threads, pair_loop=pair_loop)
-    s.input(scene)
-    s.init()
-    for n in range(steps or scene.n_steps):
-        for _, op in step_program(scene.integrator, s, first=(n == 0)):
-            op()
-    return s
+    return evolve(make_solver("linkedlist-cpu", threads=threads, pair_loop=pair_loop), scene, steps or None)
 
 
 @pytest.mark.parametrize("model,threads", [("lagrangian", 1), ("lagrangian", 2), ("linear", 1)])

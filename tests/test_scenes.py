@@ -13,7 +13,7 @@ from pcabench.reports.frame import frame
 from pcabench.spec import RunSpec, identity, scene_from_row
 from solvers import DEFAULT_SCENE, Scene, SceneError, make_solver, scene_names
 from solvers.linkedlist_cpu import LinkedListCPU
-from solvers.physics.integrators import step_program
+from solvers.physics.integrators import evolve as run_primitives
 from solvers.reference.dispersion import predict, predicted_fields_2d, stable_cfl
 
 from .conftest import cli_main, in_simulator
@@ -25,13 +25,7 @@ def pulse(dx=1.0, **kw) -> Scene:
 
 def evolve(name, scene, **kw):
     """The final fields of ``scene`` run on solver ``name`` (no harness: the primitives, step by step)."""
-    solver = make_solver(name, **kw)
-    solver.input(scene)
-    solver.init()
-    for step in range(1, scene.n_steps + 1):
-        for _stage, op in step_program(scene.integrator, solver, first=(step == 1)):
-            op()
-    return solver.output()
+    return run_primitives(make_solver(name, **kw), scene).output()
 
 
 def test_the_registry_offers_the_paper_scene_first_and_the_2d_pulse():
@@ -85,12 +79,7 @@ def test_moving_particles_cross_the_x_seam_and_keep_their_neighbours():
     (which moves a crossing particle's lattice coordinate by a period) agrees with the all-pair minimum image."""
     scene = pulse(dx=0.5, model="lagrangian", mach=0.3, pulse_center=-20.0, steps=40, cfl=1.0)
     ref = evolve("allpair-cpu", scene)
-    solver = make_solver("linkedlist-cpu")
-    solver.input(scene)
-    solver.init()
-    for step in range(1, scene.n_steps + 1):
-        for _stage, op in step_program(scene.integrator, solver, first=(step == 1)):
-            op()
+    solver = run_primitives(make_solver("linkedlist-cpu"), scene)
     got = solver.output()
     assert np.abs(got.drho - ref.drho).max() < 1e-13 and np.abs(got.u - ref.u).max() < 1e-13
     lx = solver.arrays["lx"]
@@ -100,18 +89,14 @@ def test_moving_particles_cross_the_x_seam_and_keep_their_neighbours():
 SIM_SCRIPT = r"""
 import json, sys, numpy as np
 from solvers import Scene, make_solver
-from solvers.physics.integrators import step_program
+from solvers.physics.integrators import evolve
 out = {}
 for precision, model in (("float64", "lagrangian"), ("float32", "linear")):
     # 13 x 13 particles, h = 1.3 dx: the x and y seams cut every stencil (3 cells a side) at a simulator's cost
     scene = Scene(dx=1.0, name="acoustic-pulse", x_min=-6.5, x_max=6.5, y_min=-6.5, y_max=6.5, steps=4,
                   cfl=0.5, model=model, precision=precision, mach=0.2, pulse_width=1.5, h_factor=1.3)
     for name in ("linkedlist-cpu", "linkedlist-gpu"):
-        s = make_solver(name); s.input(scene); s.init()
-        for step in range(1, scene.n_steps + 1):
-            for _st, op in step_program(scene.integrator, s, first=(step == 1)):
-                op()
-        out[precision + name] = s.output().drho.tolist()
+        out[precision + name] = evolve(make_solver(name), scene).output().drho.tolist()
 print(json.dumps(out))
 """
 
@@ -167,13 +152,7 @@ def test_mass_and_momentum_are_conserved_on_the_periodic_square():
     _u, _v, drho0 = scene.kind.initial_fields(scene, x, y, np)
     assert abs(f.drho.sum() - drho0.sum()) < 1e-12 * np.abs(drho0).sum()
     moving = pulse(model="lagrangian", mach=0.2, steps=20, pulse_center=-20.0)  # the pulse across the x seam
-    solver = make_solver("linkedlist-cpu")
-    solver.input(moving)
-    solver.init()
-    for step in range(1, moving.n_steps + 1):
-        for _stage, op in step_program(moving.integrator, solver, first=(step == 1)):
-            op()
-    a = solver.arrays
+    a = run_primitives(make_solver("linkedlist-cpu"), moving).arrays
     scale = np.abs(a["mass"] * np.hypot(a["u"], a["v"])).sum()
     assert abs((a["mass"] * a["u"]).sum()) < 1e-12 * scale and abs((a["mass"] * a["v"]).sum()) < 1e-12 * scale
 

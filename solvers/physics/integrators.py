@@ -63,3 +63,23 @@ def step_program(integrator: str, solver, first: bool) -> list:
             ("su", lambda: s.kick(1.0)),
         ]
     raise ValueError(f"integrator must be one of verlet, kdk1, euler, rk2 (got {integrator!r})")
+
+
+def advance_steps(solver, integrator: str, steps: int, first: bool = True, each=None) -> None:
+    """``steps`` steps of ``integrator`` on ``solver`` (input and initialised), the primitives one after another,
+    untimed (the harness, pcabench/execute/run.py, times each); ``first``: the first of them is the run's first
+    step; ``each()`` after every step (a test's measure)."""
+    for n in range(steps):
+        for _stage, op in step_program(integrator, solver, first=first and n == 0):
+            op()
+        if each is not None:
+            each()
+
+
+def evolve(solver, scene, steps: int | None = None):
+    """``scene`` on ``solver`` from its initial fields for ``steps`` steps (the scene's own by default), untimed:
+    the solver, to read its output or arrays."""
+    solver.input(scene)
+    solver.init()
+    advance_steps(solver, scene.integrator, scene.n_steps if steps is None else steps)
+    return solver
