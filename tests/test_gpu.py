@@ -200,7 +200,7 @@ def test_simulated_gpu_integrators_match_cpu(integrator):
 @pytest.mark.parametrize("precision,tol", [("float64", 1e-12), ("float32", 1e-4)])
 def test_gpu_graph_replays_the_plain_step(requires_gpu, precision, tol):
     """The captured step (CUDA graph) advances the state as the plain launches do, from one state."""
-    from pcabench.gpu.check import graph_vs_plain
+    from pcabench.gpu.graph_timing import graph_vs_plain
 
     row = graph_vs_plain(0.25, precision, steps=10, rounds=1, scene_overrides={})
     assert row["max_rel_diff_u"] < tol, row
@@ -211,7 +211,8 @@ def test_gpu_graph_replays_the_plain_step(requires_gpu, precision, tol):
 def test_gpu_walls_match_cpu(requires_gpu, tmp_path):
     """The GPU check's walls stage on the card: plane-wall and pulse-wall (mirror particles), linear and
     lagrangian, float64 and float32, against linkedlist-cpu."""
-    from pcabench.gpu.check import FULL, agrees, walls_against_cpu
+    from pcabench.gpu.agreement import agrees, walls_against_cpu
+    from pcabench.gpu.plan import FULL
 
     rows = walls_against_cpu(FULL, tmp_path)
     assert len(rows) == len(FULL.wall_scenes) * 2 * len(FULL.wall_models) and agrees(rows), rows

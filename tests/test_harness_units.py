@@ -127,6 +127,7 @@ def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
     from pathlib import Path
 
     from pcabench.gpu import check as G
+    from pcabench.gpu import plan
 
     ran = []
 
@@ -136,9 +137,9 @@ def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
     def fine(c):
         ran.append("fine")
 
-    budget = G.Budget(100.0)
+    budget = plan.Budget(100.0)
     budget.say = lambda *a, **k: None  # quiet
-    check = G.Check(G.REHEARSAL, Path("."), budget, {"stages": []}, {"id": "m"}, None, Path("s.jsonl"), True, {})
+    check = G.Check(plan.REHEARSAL, Path("."), budget, {"stages": []}, {"id": "m"}, None, Path("s.jsonl"), True, {})
     for stage in (G.Stage("broken", 0, broken), G.Stage("greedy", 1e9, fine), G.Stage("fine", 0, fine)):
         G.run_stage(stage, check)
     status = {s["stage"]: s["status"] for s in check.state["stages"]}
@@ -151,15 +152,15 @@ def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows()
     """The walls stage (GPU against CPU on the walled scenes) fails on a row past its precision's tolerance or
     on no rows, and the check's tables list its rows; the rehearsal's walled scenes are check-solver's tiny ones."""
     from pcabench.conformance import SCENES
-    from pcabench.gpu import check as G
+    from pcabench.gpu import agreement, plan, tables
     from solvers import Scene
 
     row = {"scene": "pulse-wall", "N": 182, "precision": "float32", "model": "lagrangian", "dx": 1.0, "steps": 3}
-    assert G.agrees([{**row, "max_rel_diff_u": 5e-5, "max_rel_diff_drho": 1e-5}])
-    assert not G.agrees([{**row, "max_rel_diff_u": 5e-4, "max_rel_diff_drho": 1e-5}])
-    assert not G.agrees([{**row, "precision": "float64", "max_rel_diff_u": 5e-5, "max_rel_diff_drho": 0.0}])
-    assert not G.agrees([])
-    text = G.markdown(
+    assert agreement.agrees([{**row, "max_rel_diff_u": 5e-5, "max_rel_diff_drho": 1e-5}])
+    assert not agreement.agrees([{**row, "max_rel_diff_u": 5e-4, "max_rel_diff_drho": 1e-5}])
+    assert not agreement.agrees([{**row, "precision": "float64", "max_rel_diff_u": 5e-5, "max_rel_diff_drho": 0.0}])
+    assert not agreement.agrees([])
+    text = tables.markdown(
         {"id": "m"},
         {
             "budget_s": 1,
@@ -169,6 +170,8 @@ def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows()
         },
     )
     assert "## Rigid walls" in text and "| pulse-wall | 182 | float32 | lagrangian | 1.0 | 3 | 5.00e-05 |" in text
-    assert {Scene(**w).name for w in G.FULL.wall_scenes} == {"plane-wall", "pulse-wall"}
-    assert set(G.FULL.wall_models) == {"linear", "lagrangian"}
-    assert G.REHEARSAL.wall_scenes and all(w in SCENES.values() and Scene(**w).walls for w in G.REHEARSAL.wall_scenes)
+    assert {Scene(**w).name for w in plan.FULL.wall_scenes} == {"plane-wall", "pulse-wall"}
+    assert set(plan.FULL.wall_models) == {"linear", "lagrangian"}
+    assert plan.REHEARSAL.wall_scenes and all(
+        w in SCENES.values() and Scene(**w).walls for w in plan.REHEARSAL.wall_scenes
+    )

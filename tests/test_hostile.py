@@ -424,7 +424,7 @@ def test_gpu_check_out_link_is_refused(tmp_path, capsys):
 
 
 def test_gpu_check_writes_files_in_its_folder_without_following_links(tmp_path):
-    from pcabench.gpu.check import write_file
+    from pcabench.store.safeio import write_file  # what the GPU check writes with
 
     out, target = tmp_path / "out", tmp_path / "precious.txt"
     out.mkdir()

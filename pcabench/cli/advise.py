@@ -17,13 +17,25 @@ from __future__ import annotations
 
 import itertools
 import shlex
+from pathlib import Path
 
 import numpy as np
 
+from pcabench import jsonout, paths
+from pcabench.cli.accuracy import ROUNDED_AS_PRINTED
+from pcabench.cli.exits import EXIT_OK, EXIT_RUN_FAILED
+from pcabench.errors import NoResults
 from pcabench.predict.stability import assess, e_foldings
 from pcabench.reports.tables import comparable, default_numerics, error_column, latest, numerics_label
-from pcabench.spec import scene_from_row
-from solvers import DEFAULT_KERNEL, DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_names, scene_kind
+from pcabench.spec import OptionError, scene_from_row
+from solvers import (
+    DEFAULT_KERNEL,
+    DEFAULT_SCENE,
+    DEFAULT_SOLVER,
+    Scene,
+    kernel_names,
+    scene_kind,
+)
 from solvers.reference.dispersion import predict, stable_cfl
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid), for
@@ -345,3 +357,49 @@ def unstable_lines(rows, what: str) -> list[str]:
             f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)"
         )
     return lines
+
+
+def cmd_advise(args) -> int:
+    from pcabench.machine.profiles import machine_id
+    from pcabench.reports.frame import load as load_frame
+    from pcabench.store import runs
+
+    if not 0 < args.error <= 1:
+        raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
+    results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
+    df = load_frame(results) if results is not None and Path(results).exists() else None
+    if df is not None and not df.empty:
+        import numpy as np
+
+        mach = Scene.default("mach") if args.mach is None else args.mach
+        df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach)]
+    if df is None or df.empty:
+        study = ["pcabench", "study", "--front", *([] if args.scene == DEFAULT_SCENE else ["--scene", args.scene])]
+        raise NoResults(
+            f"no stored runs of the {args.scene} scene at --mach "
+            f"{Scene.default('mach') if args.mach is None else args.mach:g} in {results}: run "
+            f"`{shlex.join(study)}` first, or use --reference"
+        )
+    machines = df.machine.value_counts()
+    if args.machine:
+        named = runs.machines(machines.index, args.machine)  # a machine's name, or a prefix of one
+        if len(named) != 1:
+            why = f"names {', '.join(named)}" if named else f"is none of {', '.join(sorted(machines.index))}"
+            raise OptionError(f"--machine {args.machine!r} {why}: give one machine (or a prefix of one)")
+        machine = named[0]
+    else:
+        machine = machine_id() if machine_id() in machines else machines.index[0]
+    out = {
+        "machine": machine,
+        "scene": args.scene,
+        **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain, args.scene),
+    }
+    if args.json:  # the numbers the text prints, rounded as it prints them
+        shown = {key: jsonout.significant(out[key]) for key in ROUNDED_AS_PRINTED if out.get(key) is not None}
+        if out.get("cfl_fraction") is not None:
+            shown["cfl_fraction"] = round(out["cfl_fraction"], 2)  # printed as "0.66 of the predicted stable"
+        print(jsonout.dumps({**out, **shown}, sort_keys=True))
+        return EXIT_OK if out["found"] else EXIT_RUN_FAILED
+    text, found = advice_text(out, args.error, args.t_end, args.model, args.domain, args.scene)
+    print(text)
+    return EXIT_OK if found else EXIT_RUN_FAILED

@@ -10,8 +10,15 @@ import dataclasses
 import sys
 from pathlib import Path
 
+from pcabench import paths
+from pcabench.cli.exits import EXIT_OK
+from pcabench.cli.options import SCENE_OPTIONS, check_folder, check_wall_option, home_option
 from pcabench.machine import memory, profiles
-from pcabench.spec import RunSpec
+from pcabench.spec import SERIAL, OptionError, RunSpec
+from solvers import (
+    DEFAULT_SCENE,
+    DEFAULT_SOLVER,
+)
 
 
 def bounded_spec(spec: RunSpec) -> RunSpec:
@@ -89,3 +96,79 @@ def run_study(
         if report:
             print(f"\nReport with every table and figure: {report}")
     return 0
+
+
+def study_specs(args) -> tuple[str, list[RunSpec]]:
+    """The preset named by the flags, or the matrix built from the scene options."""
+    from pcabench.presets import DEFAULT_PRESET, PRESETS, flags, matrix, named_by, preset
+
+    given = [flag for flag in flags() if getattr(args, flag, None)]
+    if args.dx and given:
+        raise OptionError(f"--dx builds a matrix of runs; --{given[0]} is a preset with its own: give one or the other")
+    if args.dx:
+        lists = {key: getattr(args, opt) for opt, key in SCENE_OPTIONS.items() if getattr(args, opt)}
+        check_wall_option(lists.get("name", [DEFAULT_SCENE]), "x_max" in lists)
+        return "matrix", matrix(
+            args.solver or [DEFAULT_SOLVER],
+            args.dx,
+            threads=args.threads or [SERIAL],
+            steps=args.steps or [None],
+            t_ends=args.t_end or [None],
+            strip=args.strip,
+            pair_loops=args.pair_loop or ["auto"],
+            **lists,
+        )
+    scene = args.scene or [DEFAULT_SCENE]
+    if (
+        any(
+            getattr(args, opt)
+            for opt in (*SCENE_OPTIONS, "solver", "steps", "t_end", "threads", "pair_loop")
+            if opt != "scene"
+        )
+        or args.strip
+    ):
+        raise OptionError(
+            "--dx is needed to build a matrix from the scene options; a preset ("
+            + ", ".join(f"--{flag}" for flag in flags())
+            + ") takes none of them"
+        )
+    name = named_by(given[0], getattr(args, given[0])) if given else DEFAULT_PRESET
+    scened = [p.option for p in PRESETS.all().values() if p.scened]
+    if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not PRESETS.get(name).scened):
+        raise OptionError(
+            f"--scene with a preset: one scene, with {' or '.join(scened)} (the other presets choose their own scenes)"
+        )
+    return name, preset(name, scene[0])
+
+
+def cmd_study(args) -> int:
+    from pcabench.presets import budget
+
+    name, specs = study_specs(args)
+    if args.cluster:  # the workers check their own solvers (a GPU run needs a GPU worker, not a GPU here)
+        specs = [bounded_spec(spec) for spec in specs]
+    else:
+        specs = check_specs(specs)
+    specs = list(dict.fromkeys(specs))  # resolved, two specs may be one run (auto is list here): counted once
+    if args.list:
+        for i, spec in enumerate(specs, 1):
+            print(f"[{i}/{len(specs)}] {spec.preset}: {spec.label}")
+        return EXIT_OK
+    run_budget = args.run_budget if args.run_budget is not None else budget(name)
+    for flag, value in (("--run-budget", run_budget), ("--sweep-budget", args.sweep_budget)):
+        if not value > 0:
+            raise OptionError(f"{flag} must be > 0 seconds (got {value})")
+    if not args.cluster:
+        check_folder(paths.user_profiles(), home_option())  # where the sweep saves this machine's profile
+    if not args.no_report:
+        check_folder(args.reports, "--reports")  # before the sweep, not after it
+    return run_study(
+        name,
+        specs,
+        Path(args.results),
+        None if args.no_report else Path(args.reports),
+        run_budget,
+        args.sweep_budget,
+        cluster=args.cluster,
+        retry_failed=args.retry_failed,
+    )

@@ -1,0 +1,62 @@
+"""``pcabench run``: one scene on one solver, its stage table or its stored record as JSON."""
+
+from __future__ import annotations
+
+import sys
+
+from pcabench import jsonout
+from pcabench.cli.exits import EXIT_OK, EXIT_RUN_FAILED
+from pcabench.cli.options import check_output_path, scene_from_args
+from pcabench.execute.progress import Progress
+from pcabench.spec import SERIAL, OptionError, RunSpec
+
+
+# ---------------------------------------------------------------- commands
+def cmd_run(args) -> int:
+    from pcabench.execute.run import run, solver_output_to_stderr
+    from pcabench.machine.profiles import machine_id
+    from pcabench.store import to_row
+
+    scene = scene_from_args(args)
+    from pcabench.cli.study import check_specs
+
+    # resolved once, and checked: the solver can run here (a GPU for a GPU solver), before anything is printed
+    (spec,) = check_specs([RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto")])
+    if args.fields is not None:
+        if args.fields.strip() and not args.fields.endswith((".npz", "/")):
+            args.fields += ".npz"  # as numpy.savez names it
+        check_output_path(args.fields, "--fields")
+    if args.run_budget is not None and not args.run_budget > 0:
+        raise OptionError(f"--run-budget must be > 0 seconds (got {args.run_budget})")
+    if not args.json:
+        print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
+    if args.run_budget is not None:  # in a child, as a sweep runs it: the budget holds whatever the solver does
+        record = run_in_child(spec, args)
+    else:
+        progress = None if args.quiet else Progress(args.solver)
+        with solver_output_to_stderr(args.json):
+            record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
+    if args.json:  # the record as a store holds it: the whole scene, so the run can be made again from it
+        print(jsonout.dumps(to_row(record)))  # strict JSON: null, never NaN
+    else:
+        print(record.text(scene))
+    return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
+
+
+def run_in_child(spec: RunSpec, args):
+    """``pcabench run --run-budget S``: the run in a child process of its own group (as a sweep's,
+    :func:`pcabench.execute.sweep.run_child`), killed with all it started at S seconds, whether or not the solver
+    returns to Python (a compiled loop, a solver that ignores signals); its record."""
+    import subprocess
+
+    from pcabench.execute.sweep import failed_record, run_child
+    from pcabench.machine.profiles import machine_id
+    from pcabench.store.provenance import git_commit
+    from pcabench.store.record import RunRecord
+
+    stream = None if args.quiet else sys.stderr
+    try:
+        row = run_child(spec, args.run_budget, git_commit(), machine_id(), stream=stream, fields_to=args.fields)
+    except subprocess.TimeoutExpired:
+        return failed_record(spec, "timeout", f"past the run budget of {args.run_budget:g} s", machine_id())
+    return RunRecord.from_row(row)

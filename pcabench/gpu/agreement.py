@@ -1,0 +1,78 @@
+"""The GPU solver against the CPU one on the same scenes, every model and precision, walls included (stage 2)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from pcabench.execute.run import run
+from pcabench.gpu.plan import GPU_SOLVER, Plan
+from pcabench.spec import RunSpec
+from pcabench.store.safeio import fresh
+from solvers import DEFAULT_SOLVER, MODELS, PRECISIONS, Scene
+
+# ---------------------------------------------------------------- 2. GPU against CPU
+AGREEMENT = {"float64": 1e-12, "float32": 1e-4}  # the largest relative difference of u GPU vs CPU that passes
+
+
+def gpu_against_cpu(scene: Scene, out: Path) -> dict:
+    """``scene`` run by linkedlist-gpu and linkedlist-cpu: its row, with the max relative difference of the final
+    u and drho (each over the CPU field's max)."""
+    fields = {}
+    for solver in (DEFAULT_SOLVER, GPU_SOLVER):
+        path = fresh(out / f"compare_{solver}.npz")
+        rec = run(RunSpec(solver, scene), fields_path=path)
+        if rec.status != "ok":
+            raise RuntimeError(f"{solver} {scene.name} {scene.model} {scene.precision}: {rec.status} {rec.message}")
+        fields[solver] = dict(np.load(path))
+        path.unlink()
+    diff = {
+        name: float(
+            np.max(np.abs(fields[GPU_SOLVER][name] - fields[DEFAULT_SOLVER][name]))
+            / np.max(np.abs(fields[DEFAULT_SOLVER][name]))
+        )
+        for name in ("u", "drho")
+    }
+    print(
+        f"compare {scene.name} {scene.precision} {scene.model}: u {diff['u']:.2e}, drho {diff['drho']:.2e}",
+        file=sys.stderr,
+        flush=True,
+    )
+    return {
+        "scene": scene.name,
+        "N": scene.n_particles,
+        "precision": scene.precision,
+        "model": scene.model,
+        "dx": scene.dx,
+        "steps": scene.n_steps,
+        "max_rel_diff_u": diff["u"],
+        "max_rel_diff_drho": diff["drho"],
+    }
+
+
+def agrees(rows: list[dict]) -> bool:
+    """Whether every row's u agrees within its precision's :data:`AGREEMENT` (and there is a row)."""
+    return bool(rows) and all(r["max_rel_diff_u"] < AGREEMENT[r["precision"]] for r in rows)
+
+
+def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
+    """Max relative difference GPU vs CPU of the final u and drho, every model and precision."""
+    return [
+        gpu_against_cpu(
+            Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision, **plan.scene), out
+        )
+        for precision in PRECISIONS
+        for model in MODELS
+    ]
+
+
+def walls_against_cpu(plan: Plan, out: Path) -> list[dict]:
+    """The same on each walled scene of the plan (mirror particles), each wall model and precision."""
+    return [
+        gpu_against_cpu(Scene(**{**walled, "steps": plan.compare_steps, "model": model, "precision": precision}), out)
+        for walled in plan.wall_scenes
+        for precision in PRECISIONS
+        for model in plan.wall_models
+    ]

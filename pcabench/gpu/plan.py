@@ -1,0 +1,83 @@
+"""What the GPU check runs and within what time: the full plan (sized on the H100 run), the rehearsal's, and
+the budget each stage is given."""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+
+from pcabench.conformance import SCENES
+from solvers import Scene
+
+GPU_SOLVER = "linkedlist-gpu"  # the solver this check measures (its CUDA graph path, its kernels under ncu)
+GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
+CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
+
+RESERVE_S = 25.0  # kept back from every stage for the reports and the tarball
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What the check runs and at what size."""
+
+    gpu_dx: tuple = GPU_DX
+    models: tuple = ("lagrangian",)
+    min_steps: int = 10  # steps of the biggest runs; smaller ones take up to max_steps (see gpu_steps)
+    max_steps: int = 100
+    compare_dx: float = 0.5
+    compare_steps: int = 20
+    # the walled scenes (Scene fields, name included), run compare_steps steps; their default domains here
+    wall_scenes: tuple = ({"name": "plane-wall", "dx": 0.5}, {"name": "pulse-wall", "dx": 0.5})
+    wall_models: tuple = ("linear", "lagrangian")  # mirrors set once; mirrors following the particles
+    graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
+    graph_steps: int = 50
+    graph_rounds: int = 5
+    cpu_dx: tuple = CPU_DX
+    cpu_steps: int = 5
+    scene: dict = field(default_factory=dict)  # Scene overrides (the rehearsal's small domain)
+    asv_bench: str = "TimeGPUStep"
+    ncu_dx: float = 0.01
+
+    def gpu_steps(self, dx: float) -> int:
+        """100 steps up to 2M particles, then 2e8 particle-steps per run, but at least ``min_steps``."""
+        n = Scene(dx=dx, **self.scene).n_particles
+        return max(self.min_steps, min(self.max_steps, int(2e8 // max(n, 1))))
+
+
+FULL = Plan()
+REHEARSAL = Plan(
+    gpu_dx=(1.0, 0.5),
+    min_steps=2,
+    max_steps=2,
+    compare_dx=1.0,
+    compare_steps=3,
+    # check-solver's 182-particle duct walled at both ends (both mirror branches), its mirrors following the
+    # particles: 2 runs, not 8 (~20 s each in the simulator); check-solver runs every walled case there
+    wall_scenes=(SCENES["pulse-wall"],),
+    wall_models=("lagrangian",),
+    graph_dx=(1.0,),
+    graph_steps=2,
+    graph_rounds=1,
+    cpu_dx=(1.0,),
+    cpu_steps=2,
+    scene={"x_min": -8.0, "x_max": 8.0},
+    asv_bench="TimeGPUStep",
+    ncu_dx=1.0,
+)
+
+
+class Budget:
+    """Seconds left of the check's budget, with progress lines that say where it stands."""
+
+    def __init__(self, seconds: float):
+        self.seconds, self.t0 = seconds, time.perf_counter()
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.t0
+
+    def left(self) -> float:
+        return self.seconds - self.elapsed() - RESERVE_S
+
+    def say(self, text: str) -> None:
+        print(f"[gpu-check {self.elapsed():6.1f} s of {self.seconds:.0f}] {text}", file=sys.stderr, flush=True)
