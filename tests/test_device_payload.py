@@ -8,7 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from pcabench.gpu import payload as dp
+from pcabench.gpu import asv_stage
+from tools import device_payload as dp
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -45,9 +46,9 @@ def test_payload_with_wheels_and_history_fits(tmp_path):
 
 def test_run_asv_gpu_reports_instead_of_raising(tmp_path, monkeypatch):
     monkeypatch.setenv("HOME", str(tmp_path))  # pcabench profile --asv writes ~/.asv-machine.json
-    spent = dp.run_asv_gpu(tmp_path / "out", budget_s=0, root=ROOT)
-    assert [r["commit"] for r in spent] == list(dp.COMMITS)
+    spent = asv_stage.run_asv_gpu(tmp_path / "out", budget_s=0, root=ROOT)
+    assert [r["commit"] for r in spent] == list(asv_stage.COMMITS)
     assert all(r["message"].startswith("not run: budget spent") for r in spent)
     (tmp_path / "bare").mkdir()
-    bare = dp.run_asv_gpu(tmp_path / "out", commits=("HEAD",), budget_s=60, root=tmp_path / "bare")
+    bare = asv_stage.run_asv_gpu(tmp_path / "out", commits=("HEAD",), budget_s=60, root=tmp_path / "bare")
     assert len(bare) == 1 and bare[0]["message"].startswith("not run") and bare[0]["returncode"] is None

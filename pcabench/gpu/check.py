@@ -24,7 +24,7 @@ spent, keeping what it has:
 5. ``cpu``: linkedlist-cpu on this host (one thread and every core): Table 6's
    same-machine CPU column;
 6. ``asv``: asv's GPU benchmarks at HEAD and at the H100's commit, when asv
-   and the history were brought along (pcabench/gpu/payload.py);
+   and the history were brought along (tools/device_payload.py carries them);
 7. ``bench``: the pytest-benchmark suite's JSON; ``pytest-gpu``: the GPU tests;
 8. ``ncu``: Nsight Compute's speed-of-light section of one step's kernels;
 9. the reports, regenerated from the store.
@@ -160,7 +160,7 @@ def cpu_peers(c: Check) -> bool:
 
 
 def asv(c: Check) -> bool:
-    from pcabench.gpu.payload import run_asv_gpu
+    from pcabench.gpu.asv_stage import run_asv_gpu
 
     c.state["asv"] = run_asv_gpu(
         c.out / "asv",
