@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import shlex
 
-from pcabench.parameters import METHOD, PRECISION_MODEL, PROBLEM, number_word
+from pcabench.parameters import PARAMETERS, number_word
 from pcabench.spec import SERIAL, RunSpec
 from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, kernel_named, resolve_pair_loop
 
@@ -54,7 +54,7 @@ def words_of(solver: str, scene, threads=SERIAL, pair_loop: str = "") -> tuple[l
             unset += [k for k in DOMAIN if k != "x_max" and not _same(domain[k], defaults[k])]
     if scene.strip_height is not None:
         words += ["--strip-height", number_word(scene.strip_height)]
-    for par in (*PROBLEM[1:], *PRECISION_MODEL, *METHOD):
+    for par in (p for p in PARAMETERS if p.field != "name"):  # every parameter the table declares
         value, default = getattr(scene, par.field), scene.default_of(par.field)
         if _same(value, default):
             continue

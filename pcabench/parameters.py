@@ -17,6 +17,8 @@ from dataclasses import dataclass
 from typing import Callable
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel_names, scene_names, scenes
+from solvers.absorbers import absorber_names
+from solvers.scene import OPEN_EDGES
 
 
 @dataclass(frozen=True)
@@ -85,6 +87,31 @@ PROBLEM = (
     Parameter("pulse_center", "--pulse-center", "the pulse's centre x at t = 0, m", numeric=True),
     Parameter("x_max", "--wall-x", _wall_help, numeric=True, per_scene=True),
 )
+BOUNDARY = (
+    Parameter(
+        "open",
+        "--open",
+        "open edges: x opens both x edges by an absorbing layer of particles beyond the domain, which stays "
+        "the scored one (default: closed, as the scene is)",
+        lambda: tuple(e for e in OPEN_EDGES if e),
+        per_scene=True,
+    ),
+    Parameter(
+        "layer_width",
+        "--layer-width",
+        "the absorbing layer's width, m, in whole columns of dx (default: 2 pulse widths)",
+        numeric=True,
+        per_scene=True,
+    ),
+    Parameter("absorber", "--absorber", "what damps an open edge's layer (solvers/absorbers/)", absorber_names),
+    Parameter(
+        "absorber_strength",
+        "--absorber-strength",
+        "the absorber's strength, 1/s (default: the absorber's for the layer, 12 c0 / width for the sponge)",
+        numeric=True,
+        per_scene=True,
+    ),
+)
 PRECISION_MODEL = (
     Parameter("precision", "--precision", "floating-point precision", lambda: PRECISIONS),
     Parameter("model", "--model", "the physics model", lambda: MODELS),
@@ -96,7 +123,7 @@ METHOD = (
     Parameter("h_factor", "--h-factor", "h / dx", numeric=True),
     Parameter("cfl", "--cfl", "dt * c0 / dx", numeric=True),
 )
-PARAMETERS = PROBLEM + PRECISION_MODEL + METHOD
+PARAMETERS = PROBLEM + BOUNDARY + PRECISION_MODEL + METHOD
 
 
 def parameter(field: str) -> Parameter:

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from solvers.absorbers import absorber_named
 from solvers.kernels import constants as kernel
 from solvers.kernels import kernel_names
 from solvers.scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
@@ -146,6 +147,7 @@ class Solver(abc.ABC):
         self.dtype = np.dtype(scene.precision)
         self.k = kernel.constants(scene, self.dtype)
         self.moving = scene.model == "lagrangian"
+        self.absorber = absorber_named(scene.absorber) if scene.open else None
 
     def check_scene(self, scene: Scene) -> None:
         """Solver-specific limits; raise SceneError naming the parameter."""
@@ -226,6 +228,19 @@ class Solver(abc.ABC):
         )
         self.t += f * self.scene.dt
 
+    def absorb(self, f: float) -> None:
+        """The open edges' absorbing layers (solvers/absorbers/): u, v and drho times exp(-sigma f dt), sigma
+        from each particle's depth beyond the domain at its current position (0 inside the domain)."""
+        s, xp, a = self.scene, self.xp, self.arrays
+        if not s.open_x:
+            return
+        x = s.x_lo + (a["lx"].astype(xp.float64) + 0.5) * s.dx + a["sx"]
+        depth = xp.maximum(xp.maximum(s.x_min - x, x - s.x_max), 0.0)
+        sigma = self.absorber.sigma(depth, s.layer, s.strength, xp)
+        factor = xp.exp(-sigma * (f * s.dt)).astype(self.dtype)
+        for name in ("u", "v", "drho"):
+            a[name] *= factor
+
     def save(self) -> None:
         """Keep a copy of the state (for two-stage integrators)."""
         for name in ("sx", "sy", "u", "v", "drho"):
@@ -254,8 +269,11 @@ class Solver(abc.ABC):
         """Copy the fields back to the host in particle-id order."""
         s = self.scene
         h = {name: self.to_host(self.arrays[name]) for name in STATE}
-        ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + np.rint(h["lx"]).astype(np.int64) % s.nx
+        column = np.rint(h["lx"]).astype(np.int64) % s.nx
+        ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + column
         order = np.argsort(ids, kind="stable")
+        if s.n_layer:  # open edges: the particles of the scored domain only (their lattice column inside it)
+            order = order[(column[order] >= s.n_layer) & (column[order] < s.nx - s.n_layer)]
         x = s.x_lo + (h["lx"].astype(np.float64) + 0.5) * s.dx + h["sx"]
         y = s.y_lo + (h["ly"].astype(np.float64) + 0.5) * s.dx + h["sy"]
         return Fields(
@@ -311,7 +329,7 @@ def cell_grid(scene: Scene) -> tuple:
             return cw, scene.height / ncy, inside, ncy, 0.0, scene.width
         spare_left, spare_right = "x_min" not in scene.walls, "x_max" not in scene.walls
         return cw, scene.height / ncy, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0
-    ncx = int(math.ceil((scene.x_max - scene.x_min) / scene.cutoff)) + 2
+    ncx = int(math.ceil(scene.width / scene.cutoff)) + 2  # the lattice's width: an open edge's layer included
     return scene.cutoff, scene.height / ncy, ncx, ncy, -scene.cutoff, 0.0
 
 

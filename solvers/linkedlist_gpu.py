@@ -164,6 +164,12 @@ class LinkedListGPU(CellListSolver):
         self.t += f * self.scene.dt
         self.coefficients_fresh = True
 
+    def absorb(self, f: float) -> None:
+        """The open edges' layers damp drho too: its coefficients are recomputed at the next PI."""
+        super().absorb(f)
+        if self.scene.open:
+            self.coefficients_fresh = False
+
     def restore(self, names) -> None:
         super().restore(names)
         self.coefficients_fresh = self.coefficients_fresh and "drho" not in names

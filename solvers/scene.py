@@ -44,6 +44,7 @@ MIN_CFL = 1e-3  # the smallest cfl: 1e7 steps of it cross 1e4 cells, a step smal
 # Scene parameters that choose the numerical method rather than the physics.
 # The domain: the scene kind's default (solvers/scenes/) where not given.
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
+OPEN_EDGES = ("", "x", "y", "xy")  # Scene.open: none, the x edges, the y edges, all four
 PAPER_DOMAIN = {"x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
 
 
@@ -73,6 +74,10 @@ class Scene:
     mach: float = 0.05
     pulse_width: float = 3.0  # the 3 in exp(-((x - c0 t)/3)^2), m
     pulse_center: float = 0.0  # pulse position at t = 0, m
+    open: str = ""  # the edges that are open ("x": both x edges), by an absorbing layer beyond the domain
+    layer_width: float | None = None  # the layer's width, m (whole rows of dx); None: 2 pulse widths
+    absorber: str = "sponge"  # what damps the layer (solvers/absorbers/)
+    absorber_strength: float | None = None  # its strength, 1/s; None: the absorber's default for the scene
     h_factor: float = 2.13  # h = h_factor * dx
     cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h (a truncated kernel's, the Gaussian; else the default)
     kernel: str = DEFAULT_KERNEL  # a registered kernel's name (solvers/kernels/)
@@ -212,6 +217,7 @@ class Scene:
             )
         for problem in self.kind.check(self):  # the scene kind's own parameters first: they name its options
             need(False, problem)
+        self._validate_open(need, finite)
         least = STRIP_CUTOFFS * self.cutoff
         need(
             self.height >= least * (1 - 1e-9),
@@ -241,6 +247,75 @@ class Scene:
                 f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
                 f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m",
             )
+
+    def _validate_open(self, need, finite) -> None:
+        """The open edges: free edges of the scene, a layer of positive width no wider than the domain, a known
+        absorber of positive strength."""
+        need(
+            self.open in OPEN_EDGES,
+            f"--open must be one of {', '.join(e for e in OPEN_EDGES if e)} (got {self.open!r})",
+        )
+        if "y" in self.open:
+            need(
+                False,
+                f"--open y: the y edges of {self.name} are periodic by the scene's nature (the strip is a slice of "
+                "a plane wave, the square's seams are its images) and no solver runs a free y edge yet",
+            )
+        if "x" in self.open:
+            need(
+                not self.periodic_x,
+                f"--open x: the x edges of {self.name} are periodic by the scene's nature (its exact reference is "
+                "the periodic images')",
+            )
+            need(not self.kind.walls, f"--open x: the x edge {', '.join(self.kind.walls)} of {self.name} is a wall")
+        for name in ("layer_width", "absorber_strength"):
+            if getattr(self, name) is not None:
+                value = finite(name)
+                need(value > 0, f"--{name.replace('_', '-')} must be > 0 (got {value:g})")
+        if self.open:
+            need(
+                self.layer <= self.x_max - self.x_min,
+                f"--layer-width must be at most the domain's width {self.x_max - self.x_min:g} m (got "
+                f"{self.layer:g} m)",
+            )
+            need(self.n_layer >= 1, f"--layer-width must hold one column of dx = {self.dx:g} m (got {self.layer:g} m)")
+        try:
+            from solvers.absorbers import absorber_named
+
+            absorber_named(self.absorber)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
+
+    # ------------------------------------------------------------ open edges
+    @property
+    def open_x(self) -> bool:
+        """Whether the x edges are open: the lattice holds an absorbing layer beyond each."""
+        return "x" in self.open
+
+    @property
+    def n_layer(self) -> int:
+        """Columns of the absorbing layer beyond each open x edge (0 where closed)."""
+        if not self.open_x:
+            return 0
+        width = self.layer_width if self.layer_width is not None else 2.0 * self.pulse_width
+        return max(int(round(width / self.dx)), 0)
+
+    @property
+    def layer(self) -> float:
+        """The absorbing layer's width, m (whole columns of dx; 0 where no edge is open)."""
+        if not self.open:
+            return 0.0
+        width = self.layer_width if self.layer_width is not None else 2.0 * self.pulse_width
+        return max(int(round(width / self.dx)), 0) * self.dx
+
+    @property
+    def strength(self) -> float:
+        """The absorber's strength, 1/s: the scene's, or the absorber's default for it."""
+        from solvers.absorbers import absorber_named
+
+        if self.absorber_strength is not None:
+            return float(self.absorber_strength)
+        return absorber_named(self.absorber).default_strength(self)
 
     # ------------------------------------------------------------ geometry
     @property
@@ -280,8 +355,8 @@ class Scene:
 
     @property
     def nx(self) -> int:
-        """Lattice columns."""
-        return max(int(round((self.x_max - self.x_min) / self.dx)), 0)
+        """Lattice columns: the domain's, and an absorbing layer's each side where x is open."""
+        return max(int(round((self.x_max - self.x_min) / self.dx)), 0) + 2 * self.n_layer
 
     @property
     def ny(self) -> int:
@@ -307,7 +382,7 @@ class Scene:
         lattice flush with the wall, its last column half a spacing from it)."""
         if self.kind.walls == ("x_max",):
             return self.x_max - self.width
-        return self.x_min
+        return self.x_min - self.n_layer * self.dx
 
     @property
     def walls(self) -> dict:
@@ -320,6 +395,11 @@ class Scene:
     @property
     def n_particles(self) -> int:
         return self.nx * self.ny
+
+    @property
+    def n_scored(self) -> int:
+        """The particles of the scored domain: all of them, but an open edge's layers (the run's output)."""
+        return (self.nx - 2 * self.n_layer) * self.ny
 
     # ------------------------------------------------------------ time
     @property

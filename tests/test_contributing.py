@@ -26,7 +26,7 @@ from solvers import Scene, registry, solver_names
 from solvers.scenes import SCENES, scene_names
 
 ROOT = Path(__file__).resolve().parents[1]
-RECIPES = ("Add a solver", "Add a kernel", "Add a scene", "Add a report section", "Add a preset")
+RECIPES = ("Add a solver", "Add a kernel", "Add a scene", "Add a report section", "Add a preset", "Add an absorber")
 
 
 def recipe(title: str) -> str:
@@ -142,3 +142,12 @@ def test_the_preset_recipe_expands_to_runs_that_a_sweep_stores(run_recipe):
     rows = store.read_rows(ns["store_path"])
     assert len(rows) == 3 and {r["preset"] for r in rows} == {"tiny"} and {r["status"] for r in rows} == {"ok"}
     assert sorted(r["n_particles"] for r in rows) == sorted(s.scene.n_particles for s in specs)
+
+
+def test_the_absorber_recipe_registers_an_absorber_that_every_solver_applies(run_recipe):
+    from solvers.absorbers import absorber_names
+
+    ns = run_recipe("Add an absorber")
+    assert "ramp" not in absorber_names()  # unregistered once its block ended
+    assert 0 < ns["ramp"] < 0.05 and 0 < ns["sponge"] < 0.01
+    assert ns["ramp"] != ns["sponge"]  # the absorber named is the one that ran

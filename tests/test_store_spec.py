@@ -286,6 +286,7 @@ SCENES = {
         h_factor=1.7,
     ),
     "a Gaussian's cutoff": dict(dx=0.5, cutoff_factor=2.5, h_factor=1.3, t_end=4.0),
+    "open edges": dict(dx=0.5, steps=3, open="x", layer_width=4.5, absorber_strength=2.5),
 }
 
 

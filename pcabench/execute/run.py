@@ -26,8 +26,9 @@ FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.inte
 
 
 def fields_problem(fields, n_particles: int) -> str:
-    """Why ``fields`` (solvers.interface.Fields) are not a run's result for ``n_particles`` ('' if they are): an
-    array of another length, or values that are not finite, or a time that is not."""
+    """Why ``fields`` (solvers.interface.Fields) are not a run's result for ``n_particles`` ('' if they are; a
+    scene's ``n_scored``: an open edge's layers are not in them): an array of another length, or values that
+    are not finite, or a time that is not."""
     for name in FIELD_NAMES:
         values = np.asarray(getattr(fields, name))
         if values.shape != (n_particles,):
@@ -44,7 +45,7 @@ def score(record: RunRecord, scene, fields) -> RunRecord:
     against the scene's exact solution: MSE, ME, the scene's other measures and the isothermal MSE, and the
     status ``ok``; ``error`` naming the field if the fields are not one finite value per particle. The
     harness does this, never the solver: a run's errors are computed, not reported."""
-    why = fields_problem(fields, scene.n_particles)
+    why = fields_problem(fields, scene.n_scored)
     if why:
         record.status, record.failed_step = "error", record.steps or None
         record.message = (record.message + "\n" if record.message else "") + f"the run's result is not usable: {why}"

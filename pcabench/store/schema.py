@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from solvers.interface import STAGES
 from solvers.kernels.registry import KERNEL_NAME
 from solvers.registry import SOLVER_NAME
-from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, PRECISIONS
+from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, OPEN_EDGES, PRECISIONS
 
 STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
 STEP_STAGES = ("snp", "pi", "su")  # the stages of a time step; input, init and output happen once per run
@@ -150,6 +150,10 @@ SCENE_FIELDS: dict[str, Field] = {
     "integrator": Field(("str",), choices=INTEGRATORS),
     "precision": Field(("str",), choices=PRECISIONS),
     "name": _name(max_len=32, pattern=SOLVER_NAME),  # a named scene: the one name rule (plugins.NAME)
+    "open": Field(("str",), choices=OPEN_EDGES),
+    "layer_width": Field(("number", "null"), low=0, high=1e12, above=True),
+    "absorber": _name(max_len=32, pattern=SOLVER_NAME),
+    "absorber_strength": Field(("number", "null"), low=0, high=1e12, above=True),
 }
 
 

@@ -214,8 +214,9 @@ class Prediction:
 
 def predict(scene) -> Prediction:
     """The error of the scene's run predicted from the dispersion relation (linear part; see the module), by
-    the scene kind's own prediction (solvers/scenes/)."""
-    return scene.kind.predict(scene)
+    the scene kind's own prediction (solvers/scenes/). The prediction's lattice is unbounded, so for a scene
+    with open edges it is what a perfect absorber would give (its layer is not modelled)."""
+    return scene.kind.predict(scene.replace(open="") if scene.open else scene)
 
 
 def predict_plane(scene) -> Prediction:

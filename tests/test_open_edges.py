@@ -1,0 +1,127 @@
+"""Open edges (issue 41, first part): the plane pulse leaves through an absorbing layer of particles beyond its
+domain, every solver runs the layer alike, the scored domain is the closed scene's, and bad input is one line.
+
+The reference for an open edge is the open domain's answer: the dispersion prediction on a lattice long enough
+that nothing reaches its ends (``solvers.reference.dispersion.predicted_velocity``), which is what a perfect
+absorber leaves; the free end's reflection is the contrast.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from pcabench.execute.run import run
+from pcabench.spec import RunSpec
+from solvers import Scene, SceneError, make_solver
+from solvers.physics.integrators import evolve
+from solvers.reference.dispersion import predicted_velocity
+
+from .conftest import cli_main, in_simulator
+
+T_GONE = 64.0  # s: the pulse (from x = 0) left x = 40 m at t ~ 45 s, and what the layer's far end reflects is back
+
+
+def plane(dx=0.25, **kw) -> Scene:
+    return Scene(**{"dx": dx, "model": "linear", "strip_height": Scene.thinnest_strip(dx), **kw})
+
+
+def departure(scene: Scene, solver: str = "linkedlist-cpu") -> tuple[float, float]:
+    """(largest |u - u_open| over the amplitude, the energy of u - u_open over the pulse's) in the scored domain,
+    u_open the open domain's answer at the same time (the prediction on a lattice 100 m longer each way)."""
+    fields = evolve(make_solver(solver), scene).output()
+    far = scene.replace(open="", x_min=scene.x_min - 100.0, x_max=scene.x_max + 100.0)
+    x, u_open, _ = predicted_velocity(far)
+    x0, u0, _ = predicted_velocity(far.replace(t_end=None, steps=1))
+    row = np.isclose(fields.y, fields.y.min())  # the plane pulse is the same on every row
+    gap = fields.u[row] - np.interp(fields.x[row], x, u_open)
+    pulse = np.interp(fields.x[row], x0, u0)
+    return float(np.abs(gap).max() / (scene.mach * scene.c0)), float(np.sum(gap**2) / np.sum(pulse**2))
+
+
+def test_a_plane_pulse_leaves_through_an_open_end_within_the_issues_bounds():
+    """With the default layer (two pulse widths, the sponge at its default strength) what the pulse leaves
+    behind is below 1 % of its amplitude and 1e-4 of its energy; the free end sends back nearly all of it."""
+    amplitude, energy = departure(plane(open="x", t_end=T_GONE))
+    assert amplitude < 1e-2 and energy < 1e-4, (amplitude, energy)
+    free_amplitude, free_energy = departure(plane(t_end=T_GONE))
+    assert free_amplitude > 0.5 and free_energy > 0.5, (free_amplitude, free_energy)
+
+
+def test_a_thinner_or_weaker_layer_leaves_more_behind():
+    """The measure can fail: half a pulse width of layer, or a tenth of the strength, leaves far more."""
+    best, _ = departure(plane(open="x", t_end=T_GONE))
+    thin, _ = departure(plane(open="x", layer_width=1.5, t_end=T_GONE))
+    weak, _ = departure(plane(open="x", absorber_strength=0.2, t_end=T_GONE))
+    assert thin > 10 * best and weak > 10 * best, (best, thin, weak)
+
+
+def test_the_scored_domain_is_the_closed_scenes_and_the_layer_adds_its_columns():
+    closed, opened = plane(dx=0.5, steps=2), plane(dx=0.5, steps=2, open="x", layer_width=6.0)
+    assert opened.n_particles == closed.n_particles + 2 * 12 * closed.ny and opened.n_scored == closed.n_particles
+    a = evolve(make_solver("linkedlist-cpu"), closed).output()
+    b = evolve(make_solver("linkedlist-cpu"), opened).output()
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
+    record = run(RunSpec("linkedlist-cpu", opened))
+    assert record.status == "ok" and record.n_particles == opened.n_particles, record.message
+
+
+@pytest.mark.parametrize("model", ["linear", "lagrangian"])
+def test_every_cpu_solver_and_pair_loop_runs_the_layer_alike(model):
+    scene = plane(dx=1.0, steps=30, model=model, open="x", layer_width=6.0, mach=0.2, pulse_center=30.0)
+    ref = evolve(make_solver("allpair-cpu"), scene).output()
+    for kw in (dict(pair_loop="list"), dict(pair_loop="gather"), dict(pair_loop="list", threads=2)):
+        got = evolve(make_solver("linkedlist-cpu", **kw), scene).output()
+        assert np.abs(got.u - ref.u).max() < 1e-12 and np.abs(got.drho - ref.drho).max() < 1e-12, kw
+    closed = evolve(make_solver("allpair-cpu"), scene.replace(open="")).output()
+    assert np.abs(closed.u - ref.u).max() > 1e-3  # the layer acted: the pulse was at the right edge
+
+
+SIM_SCRIPT = r"""
+import json, numpy as np
+from solvers import Scene, make_solver
+from solvers.physics.integrators import evolve
+out = {}
+for precision in ("float64", "float32"):
+    strip = Scene.thinnest_strip(1.0, None, 1.3)
+    scene = Scene(dx=1.0, x_min=-6.0, x_max=6.0, strip_height=strip, steps=6, cfl=0.5, model="lagrangian",
+                  precision=precision, mach=0.2, pulse_width=1.5, h_factor=1.3, pulse_center=4.0, open="x",
+                  layer_width=3.0)
+    for name in ("linkedlist-cpu", "linkedlist-gpu"):
+        out[precision + name] = evolve(make_solver(name), scene).output().u.tolist()
+print(json.dumps(out))
+"""
+
+
+def test_the_gpu_solver_runs_the_layer_in_the_simulator():
+    out = in_simulator(SIM_SCRIPT)
+    for precision, tol in (("float64", 1e-12), ("float32", 1e-5)):
+        cpu, gpu = np.array(out[precision + "linkedlist-cpu"]), np.array(out[precision + "linkedlist-gpu"])
+        assert cpu.shape == gpu.shape and np.abs(cpu - gpu).max() < tol * max(np.abs(cpu).max(), 1e-30), precision
+
+
+@pytest.mark.parametrize(
+    "kw, words",
+    [
+        (dict(open="y"), "--open y: the y edges of plane-pulse are periodic"),
+        (dict(open="x", name="acoustic-pulse"), "--open x: the x edges of acoustic-pulse are periodic"),
+        (dict(open="x", name="plane-wall", strip_height=None), "--open x: the x edge x_max of plane-wall is a wall"),
+        (dict(open="x", layer_width=0.0), "--layer-width must be > 0"),
+        (dict(open="x", layer_width=60.0), "--layer-width must be at most the domain's width 50 m"),
+        (dict(open="x", absorber_strength=-1.0), "--absorber-strength must be > 0"),
+        (dict(open="x", absorber="nope"), "--absorber must be one of sponge"),
+        (dict(open="z"), "--open must be one of x, y, xy"),
+    ],
+)
+def test_bad_open_edges_are_one_line_naming_the_option(kw, words):
+    with pytest.raises(SceneError, match=words.replace("(", r"\(")):
+        Scene(**{"dx": 0.5, "steps": 2, "model": "linear", **kw})
+
+
+def test_the_command_line_runs_an_open_edge_and_refuses_a_periodic_one(capsys):
+    code, out, err = cli_main(
+        "run", "--solver", "linkedlist-cpu", "--dx", "1", "--steps", "3", "--open", "x", "--quiet", capsys=capsys
+    )
+    assert code == 0 and "status           ok" in out, err
+    code, out, err = cli_main("run", "--solver", "linkedlist-cpu", "--dx", "1", "--open", "y", capsys=capsys)
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "--open y" in err and "Traceback" not in err
