@@ -72,3 +72,29 @@ class TimeWallStep:
 
     def time_step(self, *_):
         self.p.step()
+
+
+# The paper's scene with and without open x edges (the default absorbing layer, two pulse widths each side:
+# 24 % more particles on the paper's 50 m domain): what a step pays for the layer, its particles and the
+# sponge's damping after the step (issue 41's target: at most 25 % of the closed scene's step).
+OPEN_DX = 0.1  # 100,000 particles closed, 124,000 open
+
+
+class TimeOpenEdgeStep:
+    """One step of linkedlist-cpu (float64, lagrangian, serial) on the paper's scene, closed or with open x
+    edges; commits before the open edges skip the open case."""
+
+    params = [["closed", "open x"]]
+    param_names = ["edges"]
+    timeout = 300
+    min_run_count = 3
+
+    def setup(self, edges):
+        extra = {} if edges == "closed" else {"open": "x"}
+        try:
+            self.p = Prepared("linkedlist-cpu", "float64", OPEN_DX, **extra)
+        except (TypeError, ValueError) as exc:  # a commit without open edges
+            raise NotImplementedError(f"no open edges at this commit: {exc}") from None
+
+    def time_step(self, *_):
+        self.p.step()
