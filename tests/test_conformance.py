@@ -185,7 +185,7 @@ def test_a_solver_without_walls_is_refused_a_walled_scene_in_one_line_and_confor
         assert len(message.splitlines()) == 1 and "wall-x" in message and scene in message, message
     (claims,) = check_solver(NoWalls, quick=True, only=("claims",))
     assert claims.status == "ok", claims.line()
-    assert Subject(NoWalls, quick=True).claimed_scenes() == ["plane-pulse", "acoustic-pulse"]
+    assert Subject(NoWalls, quick=True).claimed_scenes() == ["plane-pulse", "acoustic-pulse", "plane-pulse-open"]
 
 
 def test_a_broken_momentum_sweep_fails_the_agreement_check():
@@ -245,3 +245,18 @@ class WrongPastFourHundred(LinkedListCPU):
 def test_the_quick_check_fails_a_solver_wrong_only_past_the_tiny_lattices():
     (result,) = check_solver(WrongPastFourHundred, quick=True, only=("agreement",))
     assert result.failed and "plane-pulse-3200" in result.message, result.message
+
+
+class IgnoresTheLayer(LinkedListCPU):
+    """The cell list without the open edges' damping: the layer reflects like a free end."""
+
+    name = "ignores-the-layer"
+
+    def absorb(self, f):
+        pass
+
+
+def test_a_solver_that_skips_the_open_edges_layer_fails_agreement_on_the_open_scene_only():
+    (result,) = check_solver(IgnoresTheLayer, quick=True, only=("agreement",))
+    assert result.failed and "plane-pulse-open" in result.message, result.message
+    assert "plane-wall" not in result.message and "acoustic-pulse" not in result.message, result.message
