@@ -194,7 +194,7 @@ def compare(got, ref, scene: Scene, tol: float) -> list[str]:
     displacement from the lattice (x, y, across a periodic seam by the nearest image) and drho."""
     ids = np.arange(scene.n_particles)
     column = ids % scene.nx
-    scored = (column >= scene.n_layer) & (column < scene.nx - scene.n_layer)  # the output: an open edge's layer out
+    scored = scene.scored(column)  # the output's particles: an open edge's layer left out
     x0 = (scene.x_lo + (column + 0.5) * scene.dx)[scored]
     y0 = (scene.y_lo + (ids // scene.nx + 0.5) * scene.dx)[scored]
 

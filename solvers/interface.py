@@ -273,7 +273,7 @@ class Solver(abc.ABC):
         ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + column
         order = np.argsort(ids, kind="stable")
         if s.n_layer:  # open edges: the particles of the scored domain only (their lattice column inside it)
-            order = order[(column[order] >= s.n_layer) & (column[order] < s.nx - s.n_layer)]
+            order = order[s.scored(column[order])]
         x = s.x_lo + (h["lx"].astype(np.float64) + 0.5) * s.dx + h["sx"]
         y = s.y_lo + (h["ly"].astype(np.float64) + 0.5) * s.dx + h["sy"]
         return Fields(

@@ -278,7 +278,10 @@ class Scene:
                 f"--layer-width must be at most the domain's width {self.x_max - self.x_min:g} m (got "
                 f"{self.layer:g} m)",
             )
-            need(self.n_layer >= 1, f"--layer-width must hold one column of dx = {self.dx:g} m (got {self.layer:g} m)")
+            need(
+                self.n_layer >= 1,
+                f"--layer-width must hold one column of dx = {self.dx:g} m (got {self.layer_asked:g} m)",
+            )
         try:
             from solvers.absorbers import absorber_named
 
@@ -293,20 +296,24 @@ class Scene:
         return "x" in self.open
 
     @property
+    def layer_asked(self) -> float:
+        """The absorbing layer's width asked for, m: ``layer_width``, or two pulse widths."""
+        return self.layer_width if self.layer_width is not None else 2.0 * self.pulse_width
+
+    @property
     def n_layer(self) -> int:
         """Columns of the absorbing layer beyond each open x edge (0 where closed)."""
-        if not self.open_x:
-            return 0
-        width = self.layer_width if self.layer_width is not None else 2.0 * self.pulse_width
-        return max(int(round(width / self.dx)), 0)
+        return max(int(round(self.layer_asked / self.dx)), 0) if self.open_x else 0
 
     @property
     def layer(self) -> float:
-        """The absorbing layer's width, m (whole columns of dx; 0 where no edge is open)."""
-        if not self.open:
-            return 0.0
-        width = self.layer_width if self.layer_width is not None else 2.0 * self.pulse_width
-        return max(int(round(width / self.dx)), 0) * self.dx
+        """The absorbing layer's width, m: whole columns of dx (0 where no edge is open)."""
+        return self.n_layer * self.dx
+
+    def scored(self, column):
+        """Which lattice columns (home column indices, an array) are the scored domain's: all but an open
+        edge's layers (a run's output keeps these)."""
+        return (column >= self.n_layer) & (column < self.nx - self.n_layer)
 
     @property
     def strength(self) -> float:

@@ -11,6 +11,20 @@ from pcabench.reports.sections.base import Section, limit_words
 from solvers import Scene
 
 
+def point_cells(p) -> list[str]:
+    """A front point's cells: model, t (s), method, dx, domain, precision, time (s), error."""
+    return [
+        p["model"],
+        fmt(p["t_final"], "g"),
+        p["method"],
+        fmt(p["dx"], "g"),
+        p["domain"],
+        p["precision"],
+        fmt(p["seconds"], ".3g"),
+        fmt(p["error"], ".3g"),
+    ]
+
+
 def rows(ctx):
     points, front = T.speed_front(ctx.df)
     return {"points": points, "front": front, "predicted": T.predicted_by_model(ctx.df) if points else []}
@@ -45,14 +59,7 @@ def unstable_front_text(rows) -> list[str]:
             ],
             [
                 [
-                    p["model"],
-                    fmt(p["t_final"], "g"),
-                    p["method"],
-                    fmt(p["dx"], "g"),
-                    p["domain"],
-                    p["precision"],
-                    fmt(p["seconds"], ".3g"),
-                    fmt(p["error"], ".3g"),
+                    *point_cells(p),
                     limit_words(p["stable_cfl"]) + (" (long runs)" if p.get("limit_from") == "long runs" else ""),
                     str(p["steps"]),
                     fmt(p["e_foldings"], ".3g"),
@@ -155,14 +162,7 @@ def text(data, ctx) -> list[str]:
         )
     fronts = [
         [
-            p["model"],
-            fmt(p["t_final"], "g"),
-            p["method"],
-            fmt(p["dx"], "g"),
-            p["domain"],
-            p["precision"],
-            fmt(p["seconds"], ".3g"),
-            fmt(p["error"], ".3g"),
+            *point_cells(p),
             fmt(T.predicted_error(p), ".3g"),
         ]
         for p in front
