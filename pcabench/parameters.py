@@ -91,8 +91,8 @@ BOUNDARY = (
     Parameter(
         "open",
         "--open",
-        "open edges: x opens both x edges by an absorbing layer of particles beyond the domain, which stays "
-        "the scored one (default: closed, as the scene is)",
+        "open edges: x opens both x edges, y both y edges, xy all four, by an absorbing layer of particles "
+        "beyond the domain, which stays the scored one (default: closed, as the scene is)",
         lambda: tuple(e for e in OPEN_EDGES if e),
         per_scene=True,
     ),
@@ -103,11 +103,17 @@ BOUNDARY = (
         numeric=True,
         per_scene=True,
     ),
-    Parameter("absorber", "--absorber", "what damps an open edge's layer (solvers/absorbers/)", absorber_names),
+    Parameter(
+        "absorber",
+        "--absorber",
+        "what damps an open edge's layer (solvers/absorbers/; default: pml, the sponge on a plane pulse's strip)",
+        absorber_names,
+        per_scene=True,
+    ),
     Parameter(
         "absorber_strength",
         "--absorber-strength",
-        "the absorber's strength, 1/s (default: the absorber's for the layer, 12 c0 / width for the sponge)",
+        "the absorber's strength, 1/s (default: the absorber's for the layer, 12 c0 / width)",
         numeric=True,
         per_scene=True,
     ),

@@ -32,7 +32,7 @@ class AllPairCPU(Solver):
     pair_loop = "all-pairs"
     search = "all-pair"
     order = 2.0
-    boundaries = ("free-x", "periodic-x", "periodic-y", "wall-x")  # periodic axes by the minimum image
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")  # periodic axes by the minimum image
 
     def snp(self) -> None:
         """Nothing to build: the all-pair search happens inside the interaction loop."""

@@ -147,7 +147,8 @@ class Solver(abc.ABC):
         self.dtype = np.dtype(scene.precision)
         self.k = kernel.constants(scene, self.dtype)
         self.moving = scene.model == "lagrangian"
-        self.absorber = absorber_named(scene.absorber) if scene.open else None
+        self.absorber = absorber_named(scene.absorber_used) if scene.open else None
+        self.split = bool(self.absorber is not None and self.absorber.split)
 
     def check_scene(self, scene: Scene) -> None:
         """Solver-specific limits; raise SceneError naming the parameter."""
@@ -175,6 +176,10 @@ class Solver(abc.ABC):
         }
         for name in RATES + ("vol", "pr"):
             a[name] = xp.zeros(s.n_particles, dt)
+        if self.split:  # a split absorber's x parts of drho and of its rate (drho_y = drho - drho_x)
+            a["drho_x"] = (0.5 * drho).astype(dt)
+            a["ddx"] = xp.zeros(s.n_particles, dt)
+            self.no_velocity = xp.zeros(s.n_particles, dt)  # v = 0 for the x part's sweep (never permuted)
         self.arrays = a
         self.saved = {}
         self.t = 0.0
@@ -188,9 +193,12 @@ class Solver(abc.ABC):
         """Neighbour search for the current positions."""
 
     def rates(self, continuity: bool, momentum: bool) -> None:
-        """PI: fill dd (continuity) and/or ax, ay (momentum) from the current state."""
+        """PI: fill dd (continuity) and/or ax, ay (momentum) from the current state (and ddx, the x part of dd,
+        for a split absorber)."""
         self.coefficients(continuity, momentum)
         self._sweep(continuity, momentum)
+        if continuity and self.split:
+            self.continuity_x()
 
     def coefficients(self, continuity: bool, momentum: bool) -> None:
         """Per-particle coefficients of the sweeps: vol = m / rho (continuity), pr = c0^2 drho / rho^2 (momentum)."""
@@ -226,29 +234,57 @@ class Solver(abc.ABC):
             self.dtype.type(f * self.scene.dt),
             self.moving,
         )
+        self.advance_split(f)
         self.t += f * self.scene.dt
 
+    def advance_split(self, f: float) -> None:
+        """drho_x += f dt ddx: a split absorber's x part of drho, updated with drho."""
+        if self.split:
+            a = self.arrays
+            a["drho_x"] += self.dtype.type(f * self.scene.dt) * a["ddx"]
+
     def absorb(self, f: float) -> None:
-        """The open edges' absorbing layers (solvers/absorbers/): u, v and drho times exp(-sigma f dt), sigma
-        from each particle's depth beyond the domain at its current position (0 inside the domain)."""
+        """The open edges' absorbing layers (solvers/absorbers/): the damping factors exp(-sigma f dt) of each
+        axis, sigma from each particle's depth beyond the domain's edges at its current position (0 inside the
+        domain, 1 on a closed axis), applied to the state by the absorber."""
         s, xp, a = self.scene, self.xp, self.arrays
-        if not s.open_x:
+        if not s.open:
             return
-        x = s.x_lo + (a["lx"].astype(xp.float64) + 0.5) * s.dx + a["sx"]
-        depth = xp.maximum(xp.maximum(s.x_min - x, x - s.x_max), 0.0)
-        sigma = self.absorber.sigma(depth, s.layer, s.strength, xp)
-        factor = xp.exp(-sigma * (f * s.dt)).astype(self.dtype)
-        for name in ("u", "v", "drho"):
-            a[name] *= factor
+        factors = []
+        for axis, lo, near, far, lattice, shift in (
+            ("x", s.x_lo, s.x_min, s.x_max, "lx", "sx"),
+            ("y", s.y_lo, s.y_min, s.y_max, "ly", "sy"),
+        ):
+            if axis not in s.open:
+                factors.append(self.dtype.type(1.0))
+                continue
+            pos = lo + (a[lattice].astype(xp.float64) + 0.5) * s.dx + a[shift]
+            depth = xp.maximum(xp.maximum(near - pos, pos - far), 0.0)
+            sigma = self.absorber.sigma(depth, s.layer, s.strength, xp)
+            factors.append(xp.exp(-sigma * (f * s.dt)).astype(self.dtype))
+        self.absorber.damp(a, *factors)
+
+    def continuity_x(self) -> None:
+        """The x part of the continuity rate into ``ddx`` (a split absorber's: the PML): the same sweep with
+        v = 0, the rate being linear in the velocities (the coefficients are the ones just computed)."""
+        a = self.arrays
+        v, dd = a["v"], a["dd"]
+        a["v"], a["dd"] = self.no_velocity, a["ddx"]
+        try:
+            self._sweep(True, False)
+        finally:
+            a["v"], a["dd"] = v, dd
 
     def save(self) -> None:
         """Keep a copy of the state (for two-stage integrators)."""
-        for name in ("sx", "sy", "u", "v", "drho"):
+        for name in ("sx", "sy", "u", "v", "drho") + (("drho_x",) if self.split else ()):
             self.saved[name] = self.arrays[name].copy()
         self.saved_t = self.t
 
     def restore(self, names) -> None:
-        """Put back the saved copies of ``names`` (time goes back with drho)."""
+        """Put back the saved copies of ``names`` (time goes back with drho, and drho's x part with it)."""
+        if self.split and "drho" in names:
+            names = (*names, "drho_x")
         for name in names:
             self.arrays[name][...] = self.saved[name]
         if "drho" in names:
@@ -272,8 +308,8 @@ class Solver(abc.ABC):
         column = np.rint(h["lx"]).astype(np.int64) % s.nx
         ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + column
         order = np.argsort(ids, kind="stable")
-        if s.n_layer:  # open edges: the particles of the scored domain only (their lattice column inside it)
-            order = order[s.scored(column[order])]
+        if s.n_layer:  # open edges: the particles of the scored domain only (their home site inside it)
+            order = order[s.scored(column[order], ids[order] // s.nx)]
         x = s.x_lo + (h["lx"].astype(np.float64) + 0.5) * s.dx + h["sx"]
         y = s.y_lo + (h["ly"].astype(np.float64) + 0.5) * s.dx + h["sy"]
         return Fields(
@@ -310,13 +346,15 @@ class Solver(abc.ABC):
 
 
 def cell_grid(scene: Scene) -> tuple:
-    """(cw, ch, ncx, ncy, x_grid, width): cells at least one cutoff tall, filling the periodic height, and in
-    x either one cutoff wide with one spare each side for particles drifting past free edges (the grid's
-    left edge ``x_grid`` one cell left of the lattice, ``width`` 0), or at least one cutoff wide filling
-    the periodic width (``x_grid`` 0, ``width`` the period, m), or, with a rigid wall, at least one cutoff
-    wide filling the lattice's width, a wall being the grid's edge (its column holds every particle with
-    mirror neighbours, and they are in it) and a free edge opposite keeping its spare cell."""
+    """(cw, ch, ncx, ncy, x_grid, width, height): cells at least one cutoff tall filling the lattice's height
+    (``height`` the y period, m; 0 where the y edges are free, particles past them clamped into the edge
+    rows), and in x either one cutoff wide with one spare each side for particles drifting past free edges
+    (the grid's left edge ``x_grid`` one cell left of the lattice, ``width`` 0), or at least one cutoff wide
+    filling the periodic width (``x_grid`` 0, ``width`` the period, m), or, with a rigid wall, at least one
+    cutoff wide filling the lattice's width, a wall being the grid's edge (its column holds every particle
+    with mirror neighbours, and they are in it) and a free edge opposite keeping its spare cell."""
     ncy = max(int(math.floor(scene.height / scene.cutoff + 1e-9)), 1)
+    ch, height = scene.height / ncy, scene.height if scene.periodic_y else 0.0
     if scene.periodic_x or scene.walls:
         inside = int(math.floor(scene.width / scene.cutoff + 1e-9))
         if inside < 3:
@@ -326,11 +364,11 @@ def cell_grid(scene: Scene) -> tuple:
             )
         cw = scene.width / inside
         if scene.periodic_x:
-            return cw, scene.height / ncy, inside, ncy, 0.0, scene.width
+            return cw, ch, inside, ncy, 0.0, scene.width, height
         spare_left, spare_right = "x_min" not in scene.walls, "x_max" not in scene.walls
-        return cw, scene.height / ncy, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0
+        return cw, ch, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0, height
     ncx = int(math.ceil(scene.width / scene.cutoff)) + 2  # the lattice's width: an open edge's layer included
-    return scene.cutoff, scene.height / ncy, ncx, ncy, -scene.cutoff, 0.0
+    return scene.cutoff, ch, ncx, ncy, -scene.cutoff, 0.0, height
 
 
 def across_x(scene: Scene) -> bool:

@@ -57,7 +57,7 @@ class LinkedListCPU(CellListSolver):
     )
     pair_loops = ("list", "gather")
     threaded = True
-    boundaries = ("free-x", "periodic-x", "periodic-y", "wall-x")
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         super().__init__(threads=threads or 1, pair_loop=pair_loop)

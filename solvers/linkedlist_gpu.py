@@ -43,7 +43,7 @@ class LinkedListGPU(CellListSolver):
     device = "gpu"
     serial_why = "one GPU thread per particle"
     resources = {"timing": 1, "GPU": 1}
-    boundaries = ("free-x", "periodic-x", "periodic-y", "wall-x")
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")
 
     @classmethod
     def available(cls) -> None:
@@ -142,6 +142,8 @@ class LinkedListGPU(CellListSolver):
             self.coefficients(True, True)
             self.coefficients_fresh = True
         self._sweep(continuity, momentum)
+        if continuity and self.split:
+            self.continuity_x()
 
     def advance(self, f: float) -> None:
         """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""
@@ -161,6 +163,7 @@ class LinkedListGPU(CellListSolver):
             a["pr"],
             self.k,
         )
+        self.advance_split(f)
         self.t += f * self.scene.dt
         self.coefficients_fresh = True
 

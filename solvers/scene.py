@@ -76,7 +76,7 @@ class Scene:
     pulse_center: float = 0.0  # pulse position at t = 0, m
     open: str = ""  # the edges that are open ("x": both x edges), by an absorbing layer beyond the domain
     layer_width: float | None = None  # the layer's width, m (whole rows of dx); None: 2 pulse widths
-    absorber: str = "sponge"  # what damps the layer (solvers/absorbers/)
+    absorber: str = ""  # what damps the layer (solvers/absorbers/); "": the scene's (see absorber_used)
     absorber_strength: float | None = None  # its strength, 1/s; None: the absorber's default for the scene
     h_factor: float = 2.13  # h = h_factor * dx
     cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h (a truncated kernel's, the Gaussian; else the default)
@@ -220,7 +220,7 @@ class Scene:
         self._validate_open(need, finite)
         least = STRIP_CUTOFFS * self.cutoff
         need(
-            self.height >= least * (1 - 1e-9),
+            not self.periodic_y or self.height >= least * (1 - 1e-9),
             f"{'strip_height' if self.strip_height is not None else 'y_max - y_min'} must be at least "
             f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
             f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)",
@@ -255,28 +255,22 @@ class Scene:
             self.open in OPEN_EDGES,
             f"--open must be one of {', '.join(e for e in OPEN_EDGES if e)} (got {self.open!r})",
         )
-        if "y" in self.open:
-            need(
-                False,
-                f"--open y: the y edges of {self.name} are periodic by the scene's nature (the strip is a slice of "
-                "a plane wave, the square's seams are its images) and no solver runs a free y edge yet",
-            )
-        if "x" in self.open:
-            need(
-                not self.periodic_x,
-                f"--open x: the x edges of {self.name} are periodic by the scene's nature (its exact reference is "
-                "the periodic images')",
-            )
-            need(not self.kind.walls, f"--open x: the x edge {', '.join(self.kind.walls)} of {self.name} is a wall")
+        openable = self.kind.openable_edges()
+        for axis in ("x", "y"):
+            if axis in self.open and axis not in openable:
+                need(False, f"--open {axis}: {self.kind.closed_reason(axis)}")
         for name in ("layer_width", "absorber_strength"):
             if getattr(self, name) is not None:
                 value = finite(name)
                 need(value > 0, f"--{name.replace('_', '-')} must be > 0 (got {value:g})")
         if self.open:
+            span = min(
+                self.x_max - self.x_min if self.open_x else math.inf, self.height_span if self.open_y else math.inf
+            )
             need(
-                self.layer <= self.x_max - self.x_min,
-                f"--layer-width must be at most the domain's width {self.x_max - self.x_min:g} m (got "
-                f"{self.layer:g} m)",
+                self.layer <= span,
+                f"--layer-width must be at most the domain's "
+                f"{'width' if span == self.x_max - self.x_min else 'height'} {span:g} m (got {self.layer:g} m)",
             )
             need(
                 self.n_layer >= 1,
@@ -285,7 +279,7 @@ class Scene:
         try:
             from solvers.absorbers import absorber_named
 
-            absorber_named(self.absorber)
+            absorber_named(self.absorber_used)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
 
@@ -296,24 +290,43 @@ class Scene:
         return "x" in self.open
 
     @property
+    def open_y(self) -> bool:
+        """Whether the y edges are open: the lattice holds an absorbing layer beyond each."""
+        return "y" in self.open
+
+    @property
     def layer_asked(self) -> float:
         """The absorbing layer's width asked for, m: ``layer_width``, or two pulse widths."""
         return self.layer_width if self.layer_width is not None else 2.0 * self.pulse_width
 
     @property
     def n_layer(self) -> int:
-        """Columns of the absorbing layer beyond each open x edge (0 where closed)."""
-        return max(int(round(self.layer_asked / self.dx)), 0) if self.open_x else 0
+        """Columns (rows) of the absorbing layer beyond each open edge (0 where none is open)."""
+        return max(int(round(self.layer_asked / self.dx)), 0) if self.open else 0
+
+    @property
+    def layer_columns(self) -> int:
+        """Lattice columns of the layer beyond each x edge: n_layer where x is open, else 0."""
+        return self.n_layer if self.open_x else 0
+
+    @property
+    def layer_rows(self) -> int:
+        """Lattice rows of the layer beyond each y edge: n_layer where y is open, else 0."""
+        return self.n_layer if self.open_y else 0
 
     @property
     def layer(self) -> float:
         """The absorbing layer's width, m: whole columns of dx (0 where no edge is open)."""
         return self.n_layer * self.dx
 
-    def scored(self, column):
-        """Which lattice columns (home column indices, an array) are the scored domain's: all but an open
+    def scored(self, column, row=None):
+        """Which lattice sites (home column and row indices, arrays) are the scored domain's: all but an open
         edge's layers (a run's output keeps these)."""
-        return (column >= self.n_layer) & (column < self.nx - self.n_layer)
+        c, r = self.layer_columns, self.layer_rows
+        inside = (column >= c) & (column < self.nx - c)
+        if r and row is not None:
+            inside &= (row >= r) & (row < self.ny - r)
+        return inside
 
     @property
     def strength(self) -> float:
@@ -322,7 +335,16 @@ class Scene:
 
         if self.absorber_strength is not None:
             return float(self.absorber_strength)
-        return absorber_named(self.absorber).default_strength(self)
+        return absorber_named(self.absorber_used).default_strength(self)
+
+    @property
+    def absorber_used(self) -> str:
+        """The absorber that damps the layer: ``absorber``, or by default the split-field PML, except on a
+        strip (a plane wave along x), where the sponge gives the PML's answer (measured: the same to three
+        digits; there is no y part to split) without its second continuity sweep (docs/accuracy.md)."""
+        if self.absorber:
+            return self.absorber
+        return "sponge" if self.kind.strip else "pml"
 
     # ------------------------------------------------------------ geometry
     @property
@@ -332,12 +354,19 @@ class Scene:
 
     @property
     def periodic_x(self) -> bool:
-        """Whether the domain is periodic in x (else its left and right edges are free)."""
-        return "x" in self.kind.periodic
+        """Whether the lattice is periodic in x (else its left and right edges are free or walls): the scene
+        kind's periodic x, unless its x edges are open."""
+        return "x" in self.kind.periodic and not self.open_x
+
+    @property
+    def periodic_y(self) -> bool:
+        """Whether the lattice is periodic in y (else its bottom and top edges are free): the scene kind's
+        periodic y, unless its y edges are open."""
+        return "y" in self.kind.periodic and not self.open_y
 
     @property
     def boundaries(self) -> frozenset:
-        """The boundary kinds a solver needs for this scene (free-x, periodic-x, periodic-y)."""
+        """The boundary kinds a solver needs for this scene (free-x, periodic-x, wall-x, free-y, periodic-y)."""
         return self.kind.boundaries(self)
 
     @property
@@ -363,24 +392,25 @@ class Scene:
     @property
     def nx(self) -> int:
         """Lattice columns: the domain's, and an absorbing layer's each side where x is open."""
-        return max(int(round((self.x_max - self.x_min) / self.dx)), 0) + 2 * self.n_layer
+        return max(int(round((self.x_max - self.x_min) / self.dx)), 0) + 2 * self.layer_columns
 
     @property
     def ny(self) -> int:
-        """Lattice rows; the periodic height is ny * dx."""
+        """Lattice rows: the domain's, and an absorbing layer's each side where y is open; the periodic height
+        is ny * dx."""
         span = self.strip_height if self.strip_height is not None else self.y_max - self.y_min
-        return max(int(round(span / self.dx)), 0)
+        return max(int(round(span / self.dx)), 0) + 2 * self.layer_rows
 
     @property
     def height(self) -> float:
-        """Periodic height in y, m (a whole number of rows)."""
+        """Height of the lattice in y, m (a whole number of rows; the period where y is periodic)."""
         return self.ny * self.dx
 
     @property
     def y_lo(self) -> float:
-        """Bottom of the periodic box, m (the strip is centred on the domain)."""
+        """Bottom of the lattice, m (the strip is centred on the domain; an open edge's layer below y_min)."""
         if self.strip_height is None:
-            return self.y_min
+            return self.y_min - self.layer_rows * self.dx
         return 0.5 * (self.y_min + self.y_max) - 0.5 * self.height
 
     @property
@@ -389,7 +419,7 @@ class Scene:
         lattice flush with the wall, its last column half a spacing from it)."""
         if self.kind.walls == ("x_max",):
             return self.x_max - self.width
-        return self.x_min - self.n_layer * self.dx
+        return self.x_min - self.layer_columns * self.dx
 
     @property
     def walls(self) -> dict:
@@ -406,7 +436,7 @@ class Scene:
     @property
     def n_scored(self) -> int:
         """The particles of the scored domain: all of them, but an open edge's layers (the run's output)."""
-        return (self.nx - 2 * self.n_layer) * self.ny
+        return (self.nx - 2 * self.layer_columns) * (self.ny - 2 * self.layer_rows)
 
     # ------------------------------------------------------------ time
     @property

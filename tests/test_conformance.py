@@ -185,7 +185,12 @@ def test_a_solver_without_walls_is_refused_a_walled_scene_in_one_line_and_confor
         assert len(message.splitlines()) == 1 and "wall-x" in message and scene in message, message
     (claims,) = check_solver(NoWalls, quick=True, only=("claims",))
     assert claims.status == "ok", claims.line()
-    assert Subject(NoWalls, quick=True).claimed_scenes() == ["plane-pulse", "acoustic-pulse", "plane-pulse-open"]
+    assert Subject(NoWalls, quick=True).claimed_scenes() == [
+        "plane-pulse",
+        "acoustic-pulse",
+        "plane-pulse-open",
+        "acoustic-pulse-open",
+    ]
 
 
 def test_a_broken_momentum_sweep_fails_the_agreement_check():
@@ -259,4 +264,19 @@ class IgnoresTheLayer(LinkedListCPU):
 def test_a_solver_that_skips_the_open_edges_layer_fails_agreement_on_the_open_scene_only():
     (result,) = check_solver(IgnoresTheLayer, quick=True, only=("agreement",))
     assert result.failed and "plane-pulse-open" in result.message, result.message
-    assert "plane-wall" not in result.message and "acoustic-pulse" not in result.message, result.message
+    assert "plane-wall" not in result.message and "acoustic-pulse/" not in result.message, result.message
+
+
+class IgnoresTheSplit(LinkedListCPU):
+    """The cell list with the PML's x part of the continuity rate left at zero: drho_x never changes."""
+
+    name = "ignores-the-split"
+
+    def continuity_x(self):
+        pass
+
+
+def test_a_solver_that_skips_the_pmls_split_fails_agreement_on_the_open_square_only():
+    (result,) = check_solver(IgnoresTheSplit, quick=True, only=("agreement",))
+    assert result.failed and "acoustic-pulse-open" in result.message, result.message
+    assert "plane-pulse-open" not in result.message and "acoustic-pulse/" not in result.message, result.message

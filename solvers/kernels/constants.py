@@ -18,7 +18,7 @@ import numpy as np
 # Layout of the constant tuple passed to every pair loop: numba folds a module-level
 # integer index into a compile-time constant, so a named slot costs nothing.
 SPACING = 0  # dx, m
-NY = 1  # lattice rows in the periodic height
+NY = 1  # lattice rows in the periodic height, 0 where the y edges are free
 INV_H2 = 2  # 1 / h^2, 1/m^2
 GRAD0 = 3  # G(0) of the scene's kernel, 1/m^4 (the Gaussian's -2 / (pi h^4))
 RC2 = 4  # cutoff^2, m^2
@@ -39,7 +39,7 @@ def constants(scene, dtype) -> tuple:
     nonlin = 0.0 if scene.model == "linear" else 1.0
     values = {
         SPACING: scene.dx,
-        NY: float(scene.ny),
+        NY: float(scene.ny) if scene.periodic_y else 0.0,
         INV_H2: 1.0 / (h * h),
         GRAD0: scene.sph_kernel.grad0(h),
         RC2: scene.cutoff**2,

@@ -104,22 +104,28 @@ def build(cell, begin, ncx, ncy, lx, ly, sx, sy, nbr, fx, fy, start, count, scra
                 e1 = U(begin[cy * ncx + U(1)])
                 b1 = first_beyond(U(begin[cy * ncx]), e1, lxs, sxi, lx, sx, k)
                 nq = distances(U(begin[cy * ncx]), b1, lxs, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
-            # the three cells of the row above (across the periodic seam: i shifted down by ny rows)
+            # the three cells of the row above (across the periodic seam: i shifted down by ny rows; none past a
+            # free y edge)
             up = cy + U(1)
+            above = True
             if up >= ncy:
-                up -= ncy
-                lyi = lyi - k[NY]
-            e1 = U(begin[up * ncx + x1 + U(1)])
-            b0 = first_within(U(begin[up * ncx + x0]), e1, lxi, sxi, lx, sx, k)
-            b1 = first_beyond(b0, e1, lxi, sxi, lx, sx, k)
-            nq = distances(b0, b1, lxi, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
-            if periodic and (cx == U(0) or cx == ncx - U(1)):  # the cell of the row above across the x seam
-                other = ncx - U(1) if cx == U(0) else U(0)
-                lxs = lxi + k[NX] if cx == U(0) else lxi - k[NX]
-                e1 = U(begin[up * ncx + other + U(1)])
-                b0 = first_within(U(begin[up * ncx + other]), e1, lxs, sxi, lx, sx, k)
-                b1 = first_beyond(b0, e1, lxs, sxi, lx, sx, k)
-                nq = distances(b0, b1, lxs, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
+                if k[NY] == 0:
+                    above = False
+                else:
+                    up -= ncy
+                    lyi = lyi - k[NY]
+            if above:
+                e1 = U(begin[up * ncx + x1 + U(1)])
+                b0 = first_within(U(begin[up * ncx + x0]), e1, lxi, sxi, lx, sx, k)
+                b1 = first_beyond(b0, e1, lxi, sxi, lx, sx, k)
+                nq = distances(b0, b1, lxi, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
+                if periodic and (cx == U(0) or cx == ncx - U(1)):  # the cell of the row above across the x seam
+                    other = ncx - U(1) if cx == U(0) else U(0)
+                    lxs = lxi + k[NX] if cx == U(0) else lxi - k[NX]
+                    e1 = U(begin[up * ncx + other + U(1)])
+                    b0 = first_within(U(begin[up * ncx + other]), e1, lxs, sxi, lx, sx, k)
+                    b1 = first_beyond(b0, e1, lxs, sxi, lx, sx, k)
+                    nq = distances(b0, b1, lxs, lyi, sxi, syi, lx, ly, sx, sy, js, rxs, rys, r2s, nq, k)
             m = compress_within(js, rxs, rys, r2s, cj, crx, cry, cr2, nq, k[RC2])  # those within the cutoff
             start[i] = at
             count[i] = m

@@ -11,8 +11,9 @@ Positions are lattice coordinates (lx, ly: whole numbers held in the solver's
 float type) plus a displacement (sx, sy, m): r_ij = (lx_i - lx_j) dx +
 (sx_i - sx_j). The large part is exact, so float32 keeps its accuracy at
 small dx (absolute float32 coordinates lose up to 2 % of the momentum term at
-dx = 0.004 m). Periodicity in y is an exact shift by ny rows, in x (scenes
-periodic in x: ``k[NX]`` columns, 0 for free edges) by nx columns. A rigid
+dx = 0.004 m). Periodicity in y is an exact shift by ny rows (``k[NY]``, 0 for
+free y edges), in x (scenes periodic in x: ``k[NX]`` columns, 0 for free
+edges) by nx columns. A rigid
 wall at an x edge (``k[WALL_LO]``, ``k[WALL_HI]``) acts through mirror
 particles computed where they are needed, never stored: the image of
 particle j across the wall, at the mirrored position with the normal velocity
@@ -120,33 +121,37 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
 
         x_grid is the grid's left edge relative to the first lattice column's left
         edge; x is clamped to the grid (free edges, ``width`` 0) or taken modulo the
-        periodic ``width``, y modulo the periodic height.
+        periodic ``width``, y likewise: modulo the periodic ``height``, or clamped to the grid's first and last
+        rows (free y edges, ``height`` 0: cells are at least a cutoff tall, so a particle past the edge still
+        has all its neighbours in its clamped row's stencil).
         """
         x = (float(lx) + 0.5) * dx + float(sx)
         y = (float(ly) + 0.5) * dx + float(sy)
         if width > 0:
             x = x - math.floor(x / width) * width
-        y = y - math.floor(y / height) * height
+        if height > 0:
+            y = y - math.floor(y / height) * height
         cx = min(max(int(math.floor((x - x_grid) / cw)), 0), ncx - 1)
-        cy = min(max(int(y / ch), 0), ncy - 1)
+        cy = min(max(int(math.floor(y / ch)), 0), ncy - 1)
         return cy * ncx + cx
 
     @jit
     def wrap_at(i, lx, ly, sx, sy, dx, width, height):
         """Particle i's lattice coordinates moved by whole periods into the box [0, width) x [0, height)
         (measured from the first lattice site's cell corner) when it has crossed a periodic seam: the same
-        position, exactly (``width`` 0: x is not periodic)."""
+        position, exactly (``width`` 0: x is not periodic; ``height`` 0: y is not)."""
         if width > 0:
             x = (float(lx[i]) + 0.5) * dx + float(sx[i])
             if x >= width:
                 lx[i] -= math.floor(width / dx + 0.5)
             elif x < 0:
                 lx[i] += math.floor(width / dx + 0.5)
-        y = (float(ly[i]) + 0.5) * dx + float(sy[i])
-        if y >= height:
-            ly[i] -= math.floor(height / dx + 0.5)
-        elif y < 0:
-            ly[i] += math.floor(height / dx + 0.5)
+        if height > 0:
+            y = (float(ly[i]) + 0.5) * dx + float(sy[i])
+            if y >= height:
+                ly[i] -= math.floor(height / dx + 0.5)
+            elif y < 0:
+                ly[i] += math.floor(height / dx + 0.5)
 
     @jit
     def stencil_range(i, dcy, cell, begin, ncx, ncy, ly, k):
@@ -160,17 +165,21 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         one function and the across sums compiled in, the gather loop's PI on the
         paper's scene (free in x) took 3,100 ns a particle-step at 400K here instead of
         the 2,560 of f13fa50, before seams and walls; with this and ``across``, 2,560.
+        Beyond a free y edge (``k[NY]`` 0) the row is empty.
         """
         c = cell[i]
         cx = c % ncx
         cy = c // ncx + dcy
         lyi = ly[i]
-        if cy < 0:
-            cy += ncy
-            lyi += k[NY]
-        elif cy >= ncy:
-            cy -= ncy
-            lyi -= k[NY]
+        if cy < 0 or cy >= ncy:
+            if k[NY] == 0:  # past a free y edge: no particles
+                return 0, 0, lyi
+            if cy < 0:
+                cy += ncy
+                lyi += k[NY]
+            else:
+                cy -= ncy
+                lyi -= k[NY]
         row = cy * ncx
         x0 = cx - 1 if cx > 0 else 0
         x1 = cx + 1 if cx < ncx - 1 else ncx - 1
@@ -191,14 +200,14 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         c = cell[i]
         cx = c % ncx
         cy = c // ncx + dcy
-        if cy < 0:
-            cy += ncy
-        elif cy >= ncy:
-            cy -= ncy
+        lxq = lx[i]
+        if cy < 0 or cy >= ncy:
+            if k[NY] == 0:  # past a free y edge: no particles
+                return 0, 0, lxq
+            cy = cy + ncy if cy < 0 else cy - ncy
         row = cy * ncx
         q0 = begin[row]
         q1 = q0
-        lxq = lx[i]
         if k[NX] > 0:
             if cx == 0:  # the last cell of the row, across the seam on the left
                 q0, q1 = begin[row + ncx - 1], begin[row + ncx]
@@ -313,7 +322,9 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
     # ---------------------------------------------------------------- all pairs
     @jit
     def minimum_image_row(lyi, lyj, k):
-        """lyi shifted by a whole period so that |lyi - lyj| <= ny/2 (exact)."""
+        """lyi shifted by a whole period so that |lyi - lyj| <= ny/2 where y is periodic (exact)."""
+        if k[NY] == 0:
+            return lyi
         d = lyi - lyj
         if d > 0.5 * k[NY]:
             return lyi - k[NY]

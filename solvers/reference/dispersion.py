@@ -144,9 +144,34 @@ def evolve(solver: ModeSolver, integrator: str, steps: int) -> ModeSolver:
     return solver
 
 
+def unbounded(scene) -> tuple:
+    """(closed, columns, rows): for a scene with open edges, the closed scene whose periodic lattice holds its
+    domain with room on each open axis, so that no periodic image of the pulse comes within c0 t + 8 pulse
+    widths of the domain by the run's end (the open plane's answer, which a perfect absorber gives), and the
+    slices of its lattice's columns and rows that are the scene's scored domain; a closed scene, itself."""
+    if not scene.open:
+        return scene, slice(None), slice(None)
+    reach = scene.c0 * scene.t_final + 8.0 * scene.pulse_width
+    changes, cut = {"open": "", "layer_width": None, "absorber_strength": None}, [slice(None), slice(None)]
+    centre = (scene.pulse_center, 0.5 * (scene.y_min + scene.y_max))
+    for i, (axis, lo, hi) in enumerate((("x", scene.x_min, scene.x_max), ("y", scene.y_min, scene.y_max))):
+        if axis in scene.open:
+            far = max(hi - centre[i], centre[i] - lo)
+            pad = max(math.ceil((reach + far - (hi - lo)) / (2.0 * scene.dx)), 0)
+            changes.update({f"{axis}_min": lo - pad * scene.dx, f"{axis}_max": hi + pad * scene.dx})
+            n = int(round((hi - lo) / scene.dx))
+            cut[i] = slice(pad, pad + n)
+    return scene.replace(**changes), cut[0], cut[1]
+
+
 def predicted_velocity(scene) -> tuple[np.ndarray, np.ndarray, float]:
     """(x, u, t): u on one lattice row at the run's final time, predicted mode by mode from the scene kind's
-    initial row (with walls, on its mirror extension: solvers/scenes/base.py)."""
+    initial row (with walls, on its mirror extension: solvers/scenes/base.py; with open edges, on the
+    :func:`unbounded` lattice, cut to the scored domain)."""
+    if scene.open:
+        closed, columns, _ = unbounded(scene)
+        x, u, t = predicted_velocity(closed)
+        return x[columns], u[columns], t
     x = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx
     u0, v0, drho0 = scene.kind.initial_fields(scene, x, np.zeros_like(x), np)
     u0, _, drho0, keep = scene.kind.mirror_extension(scene, u0, v0, drho0)
@@ -214,9 +239,9 @@ class Prediction:
 
 def predict(scene) -> Prediction:
     """The error of the scene's run predicted from the dispersion relation (linear part; see the module), by
-    the scene kind's own prediction (solvers/scenes/). The prediction's lattice is unbounded, so for a scene
-    with open edges it is what a perfect absorber would give (its layer is not modelled)."""
-    return scene.kind.predict(scene.replace(open="") if scene.open else scene)
+    the scene kind's own prediction (solvers/scenes/). For a scene with open edges the prediction's lattice is
+    unbounded (:func:`unbounded`): it is what a perfect absorber would give (its layer is not modelled)."""
+    return scene.kind.predict(scene)
 
 
 def predict_plane(scene) -> Prediction:
@@ -261,7 +286,11 @@ def predicted_fields_2d(scene) -> tuple:
     """(x, y, drho, u, v, t) on the scene's periodic lattice (arrays (ny, nx)) at the run's final time, every
     lattice Fourier mode evolved by the integrator's own step matrix with the symbol D(k): the `linear`
     model's exact discrete solution (u's part along D(k) is the 1D problem with d = |D(k)|; the part across
-    it has no rate and stays)."""
+    it has no rate and stays). With open edges: on the :func:`unbounded` lattice, cut to the scored domain."""
+    if scene.open:
+        closed, columns, rows = unbounded(scene)
+        *fields, t = predicted_fields_2d(closed)
+        return (*(a[rows, columns] for a in fields), t)
     xs = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx
     ys = scene.y_lo + (np.arange(scene.ny) + 0.5) * scene.dx
     x, y = np.meshgrid(xs, ys)

@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from solvers.scenes.base import SceneKind
+from solvers.scenes.base import SceneKind, left_behind, scored_axes
 
 LN2 = math.log(2.0)
 
@@ -47,8 +47,7 @@ def measures(scene, x, y, drho, u, v, ref) -> dict:
     if not (np.all(np.isfinite(d)) and np.all(np.isfinite(du)) and np.all(np.isfinite(dv))):
         nan = float("nan")
         return {"mse": nan, "me": nan, "velocity_rms": nan, "velocity_max": nan, "axis_rms": nan, "diagonal_rms": nan}
-    xc, yc = centre(scene)
-    px, py = wrapped(x - xc, scene.x_max - scene.x_min), wrapped(y - yc, scene.y_max - scene.y_min)
+    px, py = offsets(scene, x, y)
     axis = (np.abs(px) < scene.dx) | (np.abs(py) < scene.dx)
     diagonal = (np.abs(px - py) < scene.dx) | (np.abs(px + py) < scene.dx)
     speed_err = np.hypot(du, dv)
@@ -73,6 +72,18 @@ def measures(scene, x, y, drho, u, v, ref) -> dict:
             scene.c0 * t,
         ),
     }
+
+
+def offsets(scene, x, y) -> tuple:
+    """(px, py): the offsets of points ``x``, ``y`` from the pulse's centre, m, by the nearest image along the
+    axes that are periodic (an open axis has no images)."""
+    xc, yc = centre(scene)
+    px, py = np.asarray(x, float) - xc, np.asarray(y, float) - yc
+    if scene.periodic_x:
+        px = wrapped(px, scene.x_max - scene.x_min)
+    if scene.periodic_y:
+        py = wrapped(py, scene.y_max - scene.y_min)
+    return px, py
 
 
 def peak_radius(r, values, beyond: float) -> float:
@@ -106,8 +117,12 @@ def wrapped(d, period: float):
 
 class AcousticPulse(SceneKind):
     name = "acoustic-pulse"
-    summary = "the CAA workshop's 2D acoustic pulse: a Gaussian pressure pulse at rest in a periodic square"
+    summary = (
+        "the CAA workshop's 2D acoustic pulse: a Gaussian pressure pulse at rest in a periodic square "
+        "(--open xy: in the open plane)"
+    )
     periodic = ("x", "y")
+    images = ("x", "y")  # the square's seams are the open pulse's images: --open x, y or xy opens them
     domain = {"x_min": -20.0, "x_max": 20.0, "y_min": -20.0, "y_max": 20.0}
     fields = ("drho", "velocity")
     primary = "drho"
@@ -128,10 +143,19 @@ class AcousticPulse(SceneKind):
         return scene.nx, ()
 
     def reference(self, scene, t: float):
-        """The exact linear solution on the reference lattice at ``t`` (solvers/reference/pulse2d.py)."""
-        from solvers.reference.pulse2d import periodic_linear
+        """The exact linear solution on the reference lattice at ``t`` (solvers/reference/pulse2d.py); with open
+        edges, the open plane's (the Bessel integral) on the scored domain's lattice, with the images of the
+        axes that stay periodic."""
+        from solvers.reference.pulse2d import OpenPulse, periodic_linear
 
         xc, yc = centre(scene)
+        if scene.open:
+            x, y = scored_axes(scene)
+            periods = (
+                scene.x_max - scene.x_min if scene.periodic_x else 0.0,
+                scene.y_max - scene.y_min if scene.periodic_y else 0.0,
+            )
+            return OpenPulse(x, y, xc, yc, periods, scene.pulse_width, scene.mach, scene.rho0, scene.c0, t)
         columns, images = self.reference_lattice(scene)
         return periodic_linear(
             columns,
@@ -162,20 +186,21 @@ class AcousticPulse(SceneKind):
             values = ref.at(fields.x, fields.y, order=3)  # Taylor about each site: 1e-7
         else:
             values = (ref.drho.ravel(), ref.u.ravel(), ref.v.ravel())
-        return measures(scene, fields.x, fields.y, fields.drho, fields.u, fields.v, values)
+        out = measures(scene, fields.x, fields.y, fields.drho, fields.u, fields.v, values)
+        if scene.open:
+            out.update(left_behind(scene, fields, values))
+        return out
 
     def isothermal_errors(self, scene, fields) -> float | None:
         from solvers.reference.isothermal_radial import isothermal_pulse_radial_cached
 
-        half_side = 0.5 * min(scene.x_max - scene.x_min, scene.y_max - scene.y_min)
-        if scene.c0 * fields.t + 3.0 * scene.pulse_width > half_side:
+        sides = [scene.x_max - scene.x_min] * scene.periodic_x + [scene.y_max - scene.y_min] * scene.periodic_y
+        if sides and scene.c0 * fields.t + 3.0 * scene.pulse_width > 0.5 * min(sides):
             return None  # the periodic images have come in: the open-domain solution is no reference
-        xc, yc = centre(scene)
-        px = wrapped(fields.x - xc, scene.x_max - scene.x_min)
-        py = wrapped(fields.y - yc, scene.y_max - scene.y_min)
+        px, py = offsets(scene, fields.x, fields.y)
         r = np.hypot(px, py)
         r_max = (
-            0.5 * math.hypot(scene.x_max - scene.x_min, scene.y_max - scene.y_min)
+            (0.5 if not scene.open else 1.0) * math.hypot(scene.x_max - scene.x_min, scene.y_max - scene.y_min)
             + scene.c0 * fields.t
             + 4 * scene.pulse_width
         )

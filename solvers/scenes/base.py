@@ -8,7 +8,9 @@ the entry-point group ``pcabench.scenes``) with a ``name``. It states
   edges, except the x edges named in ``walls`` ("x_min", "x_max"), which are
   rigid walls (mirror particles, solvers/physics/pairs.py). :meth:`boundaries` turns
   them into the boundary kinds a solver must support (``free-x``,
-  ``periodic-x``, ``periodic-y``, ``wall-x``);
+  ``periodic-x``, ``wall-x``, ``free-y``, ``periodic-y``); ``images`` names the
+  periodic axes whose seams are images of an open problem, which ``--open``
+  may open (a free edge of the lattice beyond an absorbing layer);
 * ``domain``: its default domain (x_min, x_max, y_min, y_max, m), where it
   differs from the paper's;
 * ``fields``: the fields its error measures name; ``primary`` the one the
@@ -26,7 +28,7 @@ from __future__ import annotations
 
 import math
 
-BOUNDARY_KINDS = ("free-x", "periodic-x", "periodic-y", "wall-x")
+BOUNDARY_KINDS = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")
 MACH_RANGE = (1e-6, 0.3)  # amplitudes a scene accepts: acoustic (linear) to weakly nonlinear
 PULSE_WIDTH_RANGE = (0.1, 20.0)  # m
 
@@ -51,6 +53,46 @@ def wall_measures(scene, x, diff, ref) -> dict:
     }
 
 
+def scored_axes(scene) -> tuple:
+    """(x (nx,), y (ny,)): the coordinates of the scored domain's lattice columns and rows, m (an open edge's
+    layer left out), in the order of a run's output (row by row)."""
+    import numpy as np
+
+    columns = np.arange(scene.layer_columns, scene.nx - scene.layer_columns)
+    rows = np.arange(scene.layer_rows, scene.ny - scene.layer_rows)
+    return scene.x_lo + (columns + 0.5) * scene.dx, scene.y_lo + (rows + 0.5) * scene.dx
+
+
+def left_behind(scene, fields, exact) -> dict:
+    """What a run with open edges leaves in its domain, against the open problem's exact solution ``exact``
+    ((drho, u, v) at the run's points): ``left_amplitude``, the largest error of the primary field over the
+    initial pulse's peak, and ``left_energy``, the acoustic energy of the error, sum of 0.5 rho0 |du|^2 +
+    0.5 c0^2 ddrho^2 / rho0 per scored site, over the initial pulse's. After the pulse has left, this is
+    what the edges sent back (with the method's own dispersive tail: the dispersion prediction's same
+    measures, a perfect absorber's, say how much)."""
+    import numpy as np
+
+    r_drho, r_u, r_v = (np.asarray(a, dtype=np.float64) for a in exact)
+    d = {"drho": np.asarray(fields.drho) - r_drho, "u": np.asarray(fields.u) - r_u, "v": np.asarray(fields.v) - r_v}
+    x, y = scored_axes(scene)
+    gx, gy = np.meshgrid(x, y)
+    u0, v0, drho0 = scene.kind.initial_fields(scene, gx.ravel(), gy.ravel(), np)
+    start = {"drho": np.asarray(drho0, float), "u": np.asarray(u0, float), "v": np.asarray(v0, float)}
+
+    def energy(f):  # per site: a plane scene's prediction is one row of its strip
+        return float(
+            np.mean(0.5 * scene.rho0 * (f["u"] ** 2 + f["v"] ** 2) + 0.5 * scene.c0**2 * f["drho"] ** 2 / scene.rho0)
+        )
+
+    primary = "drho" if scene.kind.primary == "drho" else "u"
+    if not all(np.all(np.isfinite(a)) for a in d.values()):
+        return {"left_amplitude": float("nan"), "left_energy": float("nan")}
+    return {
+        "left_amplitude": float(np.max(np.abs(d[primary])) / np.max(np.abs(start[primary]))),
+        "left_energy": energy(d) / energy(start),
+    }
+
+
 class SceneKind:
     """Base class of the scene kinds: a problem with an exact reference. Subclasses set ``name``."""
 
@@ -64,15 +106,41 @@ class SceneKind:
     has_isothermal: bool = False  # scored against the isothermal solution too (the lagrangian model's physics)
     strip: bool = False  # whether a y-periodic strip gives the same answer (the fields do not depend on y)
 
+    # the periodic axes whose seams are the images of an open problem (a square of images), so that an open
+    # edge there gives the open problem itself; a strip's y is a slice of a plane wave and stays periodic
+    images: tuple = ()
+
     def boundaries(self, scene=None) -> frozenset:
-        """The boundary kinds this scene needs of a solver."""
-        if "x" in self.periodic:
+        """The boundary kinds this scene needs of a solver (with ``scene``'s open edges, which are free edges
+        of the lattice beyond the layer)."""
+        open_edges = scene.open if scene is not None else ""
+        if "x" in self.periodic and "x" not in open_edges:
             x = {"periodic-x"}
         else:
             x = {"wall-x"} if self.walls else set()
             if len(self.walls) < 2:
                 x.add("free-x")
-        return frozenset(x | {"periodic-y" if "y" in self.periodic else "free-y"})
+        periodic_y = "y" in self.periodic and "y" not in open_edges
+        return frozenset(x | {"periodic-y" if periodic_y else "free-y"})
+
+    def openable_edges(self) -> tuple:
+        """The axes whose edges ``--open`` may open: free x edges without walls, and periodic axes whose seams
+        are images (``images``)."""
+        if self.walls:
+            return tuple(axis for axis in ("y",) if axis in self.images)
+        free_x = "x" not in self.periodic
+        return tuple(axis for axis in ("x", "y") if (axis == "x" and free_x) or axis in self.images)
+
+    def closed_reason(self, axis: str) -> str:
+        """Why the ``axis`` edges of this scene cannot be opened, one clause."""
+        if axis == "x" and self.walls:
+            return f"the x edge {', '.join(self.walls)} of {self.name} is a wall"
+        if axis in self.periodic:
+            what = (
+                "its exact reference is a plane wave's" if self.strip else "its exact reference is the periodic images'"
+            )
+            return f"the {axis} edges of {self.name} are periodic by the scene's nature ({what})"
+        return f"the {axis} edges of {self.name} cannot be opened"
 
     def check(self, scene) -> list[str]:
         """Problems with ``scene``'s parameters for this kind, one line each naming the option and range."""

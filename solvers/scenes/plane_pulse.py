@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from solvers.reference.analytic import errors as analytic_errors
-from solvers.scenes.base import SceneKind
+from solvers.scenes.base import SceneKind, left_behind
 
 
 class PlanePulse(SceneKind):
@@ -46,7 +46,15 @@ class PlanePulse(SceneKind):
 
     def errors(self, scene, fields) -> dict:
         err = analytic_errors(scene, fields.x, fields.u, fields.t)
-        return {"mse": err.mse, "me": err.me}
+        out = {"mse": err.mse, "me": err.me}
+        if scene.open:  # what the open ends leave behind, against the open line's pulse
+            import numpy as np
+
+            from solvers.reference.analytic import pulse_velocity
+
+            u = pulse_velocity(scene, np.asarray(fields.x, float), fields.t)
+            out.update(left_behind(scene, fields, (scene.rho0 * u / scene.c0, u, np.zeros_like(u))))
+        return out
 
     def isothermal_errors(self, scene, fields) -> float | None:
         """None once the pulse and four widths of its tail have left by the free right end: there is then no

@@ -39,6 +39,7 @@ class PulseWall(AcousticPulse):
     name = "pulse-wall"
     summary = "the 2D acoustic pulse two widths from a rigid wall at --wall-x, in a duct walled at both x ends"
     periodic = ("y",)
+    images = ()  # its reference is the walls' mirror images on a periodic lattice: no edge opens
     walls = ("x_min", "x_max")
     domain = {"x_min": -14.0, "x_max": DEFAULT_WALL, "y_min": -10.0, "y_max": 10.0}
     has_isothermal = False

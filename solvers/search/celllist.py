@@ -1,7 +1,7 @@
 """The paper's uniform cell list, shared by the CPU and GPU linked-list solvers.
 
 Cells are one cutoff wide in x and at least one cutoff tall in y (a whole
-number of rows fills the periodic height). SNP finds each particle's cell
+number of rows fills the lattice's height). SNP finds each particle's cell
 (particleIndex), orders particles by cell (cellParticleOrder), marks where
 each cell starts (cellBegin, with the end sentinel) and gathers every
 per-particle array into cell order, so the three cells of a stencil row are
@@ -27,7 +27,7 @@ class CellListSolver(Solver):
     """Cell-list neighbour search and gather sweeps; subclasses sort cells and launch kernels."""
 
     def after_init(self) -> None:
-        self.cw, self.ch, self.ncx, self.ncy, self.x_grid, self.width = cell_grid(self.scene)
+        self.cw, self.ch, self.ncx, self.ncy, self.x_grid, self.width, self.height = cell_grid(self.scene)
         self.ncells = self.ncx * self.ncy
         self.cells_valid = False
         self.allocate_cells()
@@ -63,7 +63,7 @@ class CellListSolver(Solver):
     def grid_arguments(self, lx, ly, sx, sy, cell) -> tuple:
         """The arguments of the cell-index kernels for positions ``lx, ly, sx, sy`` and output ``cell``."""
         s = self.scene
-        return (lx, ly, sx, sy, cell, s.dx, self.x_grid, self.width, s.height, self.cw, self.ch, self.ncx, self.ncy)
+        return (lx, ly, sx, sy, cell, s.dx, self.x_grid, self.width, self.height, self.cw, self.ch, self.ncx, self.ncy)
 
     def geometry(self) -> tuple:
         """The arguments every stencil kernel starts with: cells and positions."""
