@@ -372,12 +372,13 @@ def cmd_advise(args) -> int:
         import numpy as np
 
         mach = Scene.default("mach") if args.mach is None else args.mach
-        df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach)]
+        df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach) & (df.open == (args.open or ""))]
     if df is None or df.empty:
         study = ["pcabench", "study", "--front", *([] if args.scene == DEFAULT_SCENE else ["--scene", args.scene])]
         raise NoResults(
             f"no stored runs of the {args.scene} scene at --mach "
-            f"{Scene.default('mach') if args.mach is None else args.mach:g} in {results}: run "
+            f"{Scene.default('mach') if args.mach is None else args.mach:g}"
+            f"{f' with --open {args.open}' if args.open else ''} in {results}: run "
             f"`{shlex.join(study)}` first, or use --reference"
         )
     machines = df.machine.value_counts()

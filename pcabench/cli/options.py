@@ -90,11 +90,27 @@ def threads_option(text):
 
 
 def add_parameter_options(p: argparse.ArgumentParser, parameters, many: bool = False) -> None:
-    """Options for ``parameters`` (pcabench/parameters.py), each with its help and Scene's default."""
-    n = {"nargs": "+"} if many else {}
+    """Options for ``parameters`` (pcabench/parameters.py), each with its help and Scene's default. In a matrix
+    (``many``) an option that is also a preset's flag (``--open``) takes no values too: given alone, it is the
+    preset (:func:`preset_given`)."""
+    from pcabench.presets import flags
+
     for par in parameters:
         kind = {"choices": par.choices()} if par.choices else {"type": number(par.option)} if par.numeric else {}
-        p.add_argument(par.option, **kind, **n, help=par.describe())
+        text = par.describe()
+        n = {"nargs": "+"} if many else {}
+        if many and par.dest in flags():
+            (preset,) = flags()[par.dest]
+            n = {"nargs": "*"}
+            text = f"{text}; given alone, a preset: {preset.help.replace('{size}', '{size:' + preset.name + '}')}"
+        p.add_argument(par.option, **kind, **n, help=text)
+
+
+def preset_given(args, flag: str) -> bool:
+    """Whether ``--<flag>`` names a preset on this command line: a preset's switch or choice, or a matrix option
+    of the same word given alone (``--open`` with no values: ``[]``)."""
+    value = getattr(args, flag, None)
+    return value == [] if isinstance(value, list) else bool(value)
 
 
 def add_method_options(p: argparse.ArgumentParser, many: bool = False) -> None:
@@ -238,13 +254,19 @@ class PresetHelpFormatter(argparse.RawDescriptionHelpFormatter):
         return re.sub(r"\{size:([\w-]+)\}", lambda m: size_text(m.group(1)), text)
 
 
-def add_preset_options(group) -> None:
+def add_preset_options(group, matrix: bool = False) -> None:
     """One option per preset flag (pcabench/presets/: each preset names its flag, choice and help): a flag of
-    one preset is a switch, a flag several share takes their choices (the first one's when none is given)."""
+    one preset is a switch, a flag several share takes their choices (the first one's when none is given). A
+    flag that is also an option of the scene's (``matrix``: the parser has them too; ``--open``) is that option
+    given alone, which the matrix's option offers (:func:`add_parameter_options`)."""
     from pcabench.presets import flags
+
+    taken = {par.dest for par in PARAMETERS} if matrix else set()
 
     for flag, shared in flags().items():
         sized = [p.help.replace("{size}", "{size:" + p.name + "}") for p in shared]
+        if flag in taken:  # the matrix option's help says it (add_parameter_options)
+            continue
         if len(shared) == 1 and shared[0].choice is None:
             group.add_argument(f"--{flag}", action="store_true", help=sized[0])
             continue

@@ -32,6 +32,7 @@ from solvers import (
     registry,
     scene_names,
 )
+from solvers.scene import OPEN_EDGES
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -73,7 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=solver_help() + "\n" + MODEL_HELP,
         formatter_class=PresetHelpFormatter,
     )
-    add_preset_options(p.add_mutually_exclusive_group())
+    add_preset_options(p.add_mutually_exclusive_group(), matrix=True)
     p.add_argument("--list", action="store_true", help="print the runs the study would make, one a line, and exit")
     m = p.add_argument_group("matrix (instead of a preset: the product of these lists)")
     m.add_argument("--solver", nargs="+", choices=registry())
@@ -170,6 +171,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--mach",
         type=number("--mach"),
         help=f"only runs at this amplitude (default: the scene's {Scene.default('mach'):g})",
+    )
+    p.add_argument(
+        "--open",
+        choices=[e for e in OPEN_EDGES if e],
+        help="only runs with these edges open (default: closed runs only, as the scene is)",
     )
     p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
     p.add_argument("--results", help=results_help)

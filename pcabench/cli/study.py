@@ -12,7 +12,7 @@ from pathlib import Path
 
 from pcabench import paths
 from pcabench.cli.exits import EXIT_OK
-from pcabench.cli.options import SCENE_OPTIONS, check_folder, check_wall_option, home_option
+from pcabench.cli.options import SCENE_OPTIONS, check_folder, check_wall_option, home_option, preset_given
 from pcabench.machine import memory, profiles
 from pcabench.spec import SERIAL, OptionError, RunSpec
 from solvers import (
@@ -102,7 +102,7 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
     """The preset named by the flags, or the matrix built from the scene options."""
     from pcabench.presets import DEFAULT_PRESET, PRESETS, flags, matrix, named_by, preset
 
-    given = [flag for flag in flags() if getattr(args, flag, None)]
+    given = [flag for flag in flags() if preset_given(args, flag)]
     if args.dx and given:
         raise OptionError(f"--dx builds a matrix of runs; --{given[0]} is a preset with its own: give one or the other")
     if args.dx:
@@ -132,7 +132,8 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
             + ", ".join(f"--{flag}" for flag in flags())
             + ") takes none of them"
         )
-    name = named_by(given[0], getattr(args, given[0])) if given else DEFAULT_PRESET
+    value = getattr(args, given[0]) if given else None
+    name = named_by(given[0], True if value == [] else value) if given else DEFAULT_PRESET
     scened = [p.option for p in PRESETS.all().values() if p.scened]
     if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not PRESETS.get(name).scened):
         raise OptionError(

@@ -31,6 +31,7 @@ SCENE_COLUMNS = (
     "height",
     "mach",
     "pulse_width",
+    "open",
 )
 NUMERIC = ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal")
 

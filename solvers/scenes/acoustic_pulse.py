@@ -86,6 +86,20 @@ def offsets(scene, x, y) -> tuple:
     return px, py
 
 
+def left_by_direction(scene, x, y, drho, ref) -> dict:
+    """What the open edges left behind by direction of travel from the pulse's centre: the largest error of drho
+    over the initial peak within 15 degrees of the lattice's axes (``left_axis``: the sound met the edges at
+    normal incidence there) and beyond 30 degrees from them (``left_diagonal``: towards the corners, at oblique
+    incidence)."""
+    px, py = offsets(scene, x, y)
+    angle = np.degrees(np.arctan2(np.abs(py), np.abs(px)))
+    angle = np.minimum(angle, 90.0 - angle)  # 0 along an axis, 45 along a diagonal
+    d = np.abs(np.asarray(drho, float) - ref) / (scene.rho0 * scene.mach)
+    if not np.all(np.isfinite(d)):
+        return {"left_axis": float("nan"), "left_diagonal": float("nan")}
+    return {"left_axis": float(d[angle < 15.0].max()), "left_diagonal": float(d[angle > 30.0].max())}
+
+
 def peak_radius(r, values, beyond: float) -> float:
     """Radius of the largest value past ``beyond`` (m), by a parabola through it and its two neighbours."""
     order = np.argsort(r)
@@ -189,6 +203,7 @@ class AcousticPulse(SceneKind):
         out = measures(scene, fields.x, fields.y, fields.drho, fields.u, fields.v, values)
         if scene.open:
             out.update(left_behind(scene, fields, values))
+            out.update(left_by_direction(scene, fields.x, fields.y, fields.drho, values[0]))
         return out
 
     def isothermal_errors(self, scene, fields) -> float | None:
