@@ -175,3 +175,30 @@ def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows()
     assert plan.REHEARSAL.wall_scenes and all(
         w in SCENES.values() and Scene(**w).walls for w in plan.REHEARSAL.wall_scenes
     )
+
+
+def test_the_gpu_checks_open_stage_compares_open_scenes_and_tables_their_cost():
+    """The open stage runs open scenes (the rehearsal's: check-solver's open square, free y edges and the PML)
+    against the CPU, and the check's tables list them and the layer's cost on the GPU."""
+    from pcabench.conformance import SCENES
+    from pcabench.gpu import plan, tables
+    from solvers import Scene
+
+    assert plan.REHEARSAL.open_scenes == (SCENES["acoustic-pulse-open"],)
+    assert {Scene(**s).open for s in plan.FULL.open_scenes} == {"x", "xy"}
+    assert all(Scene(**s).open for s in plan.FULL.open_cost + plan.REHEARSAL.open_cost)
+    row = {"scene": "acoustic-pulse", "N": 324, "precision": "float64", "model": "lagrangian", "dx": 1.0, "steps": 3}
+    cost = {"scene": "plane-pulse", "dx": 0.025, "open": "x", "absorber": "sponge", "N": 1984000}
+    cost.update(closed_N=1600000, step_ms=3.1, closed_ms=2.5, ratio=1.24)
+    text = tables.markdown(
+        {"id": "m"},
+        {
+            "budget_s": 1,
+            "elapsed_s": 1,
+            "stages": [],
+            "open": [{**row, "max_rel_diff_u": 1e-14, "max_rel_diff_drho": 0}],
+            "open_cost": [cost],
+        },
+    )
+    assert "## Open edges" in text and "| acoustic-pulse | 324 | float64 | lagrangian | 1.0 | 3 | 1.00e-14 |" in text
+    assert "| plane-pulse | 0.025 | x | sponge | 1,600,000 | 1,984,000 | 2.5 | 3.1 | 1.240 |" in text

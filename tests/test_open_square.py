@@ -21,7 +21,7 @@ from solvers.physics.integrators import evolve
 from solvers.reference.dispersion import predict, predicted_fields_2d
 from solvers.reference.pulse2d import OpenPulse, gaussian_pulse, open_domain, periodic_linear
 
-from .conftest import cli_main, in_simulator
+from .conftest import cli_main
 
 B, MACH, RHO0, C0 = 3.0, 0.05, 1.0, 1.0
 
@@ -112,36 +112,9 @@ def test_open_x_alone_keeps_the_y_images():
     assert abs(got["axis_rms"] / mirrored.measures["axis_rms"] - 1) < 5e-2, (got, mirrored.measures)
 
 
-SIM_SCRIPT = r"""
-import json
-from solvers import Scene, make_solver
-from solvers.physics.integrators import evolve
-scenes = {  # the open square (free y edges, the PML) in both precisions; the plane pulse's open x (the sponge)
-    precision: Scene(dx=1.0, name="acoustic-pulse", x_min=-6.0, x_max=6.0, y_min=-6.0, y_max=6.0, steps=4,
-                     model="lagrangian", precision=precision, mach=0.2, pulse_width=1.5, pulse_center=3.0,
-                     open="xy", layer_width=3.0)
-    for precision in ("float64", "float32")
-}
-scenes["plane"] = Scene(dx=1.0, x_min=-6.0, x_max=6.0, strip_height=Scene.thinnest_strip(1.0, None, 1.3), steps=4,
-                        cfl=0.5, model="lagrangian", mach=0.2, pulse_width=1.5, h_factor=1.3, pulse_center=4.0,
-                        open="x", layer_width=3.0)
-out = {}
-for key, scene in scenes.items():
-    for name in ("linkedlist-cpu", "linkedlist-gpu"):
-        f = evolve(make_solver(name), scene).output()
-        out[key + name] = [f.u.tolist(), f.v.tolist(), f.drho.tolist()]
-print(json.dumps(out))
-"""
-
-
-def test_the_gpu_solver_runs_open_edges_free_y_and_both_absorbers_in_the_simulator():
-    out = in_simulator(SIM_SCRIPT)
-    for key, tol in (("float64", 1e-12), ("float32", 1e-5), ("plane", 1e-12)):
-        cpu, gpu = np.array(out[key + "linkedlist-cpu"]), np.array(out[key + "linkedlist-gpu"])
-        assert cpu.shape == gpu.shape, key
-        velocity = np.abs(cpu[:2]).max()  # u and v on the velocity's scale (the plane pulse's v is round-off)
-        assert np.abs(cpu[:2] - gpu[:2]).max() <= tol * velocity, key
-        assert np.abs(cpu[2] - gpu[2]).max() <= tol * np.abs(cpu[2]).max(), key
+# The GPU solver on open edges (free y, the PML, the sponge) in the simulator: check-solver's open scenes
+# (tests/test_conformance.py runs linkedlist-gpu through them), and gpu-check's open stage, both precisions, which
+# CI rehearses.
 
 
 def test_the_command_line_runs_the_open_square_and_stores_what_is_left(capsys):

@@ -14,7 +14,9 @@ spent, keeping what it has:
    (device copy bandwidth, FP32 and FP64 FMA rates, the SM clock);
 2. ``compare``: linkedlist-gpu against linkedlist-cpu, every model and precision;
    ``walls``: the same on the scenes with rigid walls (plane-wall, pulse-wall:
-   mirror particles), linear and lagrangian, both precisions;
+   mirror particles), linear and lagrangian, both precisions; ``open``: the same on
+   open edges (the 2D pulse's open square with the PML, the paper's pulse's open x
+   with the sponge), and the time per step closed and open, alternating;
 3. ``sweep``: linkedlist-gpu, lagrangian Verlet, both precisions, 100K to 62.5M
    particles on the paper's domain, steps sized to the budget; runs go to the
    results store (preset ``gpu``) through the ordinary sweep, in this process
@@ -54,7 +56,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from pcabench.gpu.agreement import agrees, compare_with_cpu, walls_against_cpu
+from pcabench.gpu.agreement import agrees, compare_with_cpu, open_against_cpu, open_cost, walls_against_cpu
 from pcabench.gpu.ceilings import measure_ceilings
 from pcabench.gpu.graph_timing import graph_vs_plain
 from pcabench.gpu.plan import FULL, REHEARSAL, Budget, Plan
@@ -114,6 +116,12 @@ def compare(c: Check) -> bool:
 def walls(c: Check) -> bool:
     c.state["walls"] = walls_against_cpu(c.plan, c.out)
     return agrees(c.state["walls"])
+
+
+def open_edges(c: Check) -> bool:
+    c.state["open"] = open_against_cpu(c.plan, c.out)
+    c.state["open_cost"] = open_cost(c.plan)
+    return agrees(c.state["open"])
 
 
 def stored_sweep(c: Check, specs, spare_s: float) -> list[dict]:
@@ -217,6 +225,7 @@ STAGES = (
     Stage("compare", 40, compare),
     Stage("walls", 40, walls),
     Stage("sweep", 60, gpu_sweep),
+    Stage("open", 40, open_edges),
     Stage("graph", 40, graph),
     Stage("cpu", 40, cpu_peers),
     Stage("asv", 60, asv),

@@ -30,6 +30,16 @@ class Plan:
     # the walled scenes (Scene fields, name included), run compare_steps steps; their default domains here
     wall_scenes: tuple = ({"name": "plane-wall", "dx": 0.5}, {"name": "pulse-wall", "dx": 0.5})
     wall_models: tuple = ("linear", "lagrangian")  # mirrors set once; mirrors following the particles
+    # open edges (issue 41): the 2D pulse in a 24 m open square (free y edges, the PML) and the paper's pulse with
+    # open x edges (the sponge), against the CPU solver; then the time per step closed and open, alternating
+    open_scenes: tuple = (
+        {"name": "acoustic-pulse", "dx": 0.25, "x_min": -12.0, "x_max": 12.0, "y_min": -12.0, "y_max": 12.0,
+         "open": "xy"},
+        {"dx": 0.25, "open": "x"},
+    )  # fmt: skip
+    open_cost: tuple = ({"dx": 0.025, "open": "x"}, {"name": "acoustic-pulse", "dx": 0.05, "open": "xy"})
+    open_cost_steps: int = 50
+    open_cost_rounds: int = 3
     graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
     graph_steps: int = 50
     graph_rounds: int = 5
@@ -56,6 +66,10 @@ REHEARSAL = Plan(
     # particles: 2 runs, not 8 (~20 s each in the simulator); check-solver runs every walled case there
     wall_scenes=(SCENES["pulse-wall"],),
     wall_models=("lagrangian",),
+    open_scenes=(SCENES["acoustic-pulse-open"],),  # check-solver's open square: free y edges and the PML
+    open_cost=({"dx": 1.0, "x_min": -8.0, "x_max": 8.0, "open": "x"},),
+    open_cost_steps=2,
+    open_cost_rounds=1,
     graph_dx=(1.0,),
     graph_steps=2,
     graph_rounds=1,

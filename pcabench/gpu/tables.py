@@ -71,6 +71,32 @@ def markdown(profile: dict, results: dict) -> str:
             f"{r['max_rel_diff_u']:.2e} | {r['max_rel_diff_drho']:.2e} |"
             for r in results["walls"]
         ]
+    if results.get("open"):
+        lines += [
+            "",
+            "## Open edges (an absorbing layer): GPU vs linkedlist-cpu (max relative difference after the steps shown)",
+            "",
+            "| scene | N | precision | model | dx | steps | u | drho |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {r['scene']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | "
+            f"{r['max_rel_diff_u']:.2e} | {r['max_rel_diff_drho']:.2e} |"
+            for r in results["open"]
+        ]
+    if results.get("open_cost"):
+        lines += [
+            "",
+            "## The open layer's cost on the GPU (linkedlist-gpu, float32, lagrangian; best of alternating rounds)",
+            "",
+            "| scene | dx | open | absorber | N closed | N open | ms / step closed | ms / step open | open / closed |",
+            "|---|---|---|---|---|---|---|---|---|",
+        ]
+        lines += [
+            f"| {r['scene']} | {r['dx']} | {r['open']} | {r['absorber']} | {r['closed_N']:,} | {r['N']:,} | "
+            f"{r['closed_ms']:.4g} | {r['step_ms']:.4g} | {r['ratio']:.3f} |"
+            for r in results["open_cost"]
+        ]
     if results.get("gpu_rows"):
         lines += [
             "",

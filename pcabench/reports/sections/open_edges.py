@@ -391,6 +391,7 @@ def figure(data, ctx):
             for row, key in enumerate(("amplitude", "energy")):
                 ax = axes[row * len(scenes) + col]
                 mine = [r for r in scan if r["scene"] == scene and r[key] is not None]
+                values = [r[key] for r in mine]
                 for absorber in sorted({r["absorber"] for r in mine}):
                     for i, c in enumerate(strengths):
                         pts = sorted(
@@ -411,8 +412,11 @@ def figure(data, ctx):
                 floor = amp if key == "amplitude" else energy
                 if floor:
                     ax.axhline(floor, color="black", ls="--", lw=1.0, label="perfect absorber (prediction)")
+                    values.append(floor)
                 if key == "amplitude":
                     ax.axhline(TARGET_AMPLITUDE, color="0.6", lw=1.0, label="target: 1 % of the amplitude")
+                    values.append(TARGET_AMPLITUDE)
+                F.nice_log_ticks(ax, values)
                 ax.set_xticks(sorted({r["widths"] for r in mine}))
                 ax.set_title(f"{INCIDENCE[scene]}: {key} left", fontsize=9)
                 if row == 0:
