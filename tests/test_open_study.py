@@ -84,8 +84,10 @@ def _store(path):
         for absorber in ("sponge", "pml"):
             add(
                 row(open="x", layer_width=layer, absorber_strength=12.0 / layer, absorber=absorber, **plane),
-                left_amplitude=amplitude,
-                left_energy=amplitude**2,
+                reflected_amplitude=amplitude,
+                reflected_energy=amplitude**2,
+                left_amplitude=amplitude + 6e-3,
+                left_energy=amplitude**2 + 3e-5,
             )
     square = dict(name="acoustic-pulse", dx=0.25, model="linear", t_end=28.0, preset="open")
     square.update(x_min=-12.0, x_max=12.0, y_min=-12.0, y_max=12.0)
@@ -93,11 +95,17 @@ def _store(path):
     for absorber, amplitude in (("sponge", 3.0e-2), ("pml", 7.0e-4)):
         add(
             row(open="xy", layer_width=6.0, absorber_strength=2.0, absorber=absorber, **square),
+            reflected_amplitude=amplitude,
+            reflected_energy=amplitude**2,
             left_amplitude=amplitude,
             left_energy=amplitude**2,
             left_axis=amplitude / 2,
             left_diagonal=amplitude,
         )
+    for cfl, status, step in ((3.0, "ok", None), (3.5, "unstable", 120)):  # a long run held, one blew up
+        long = dict(name="acoustic-pulse", dx=0.25, model="linear", t_end=300.0, cfl=cfl, open="xy", preset="open")
+        long.update(x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0, status=status, failed_step=step)
+        add(row(**long))
     for i, (closed_ms, open_ms) in enumerate(((1.0, 1.2), (1.1, 1.15)), 1):
         tag = f"open-cost-{i}"
         add(row(dx=0.1, steps=40, step_ms=(0.0, closed_ms, 0.0), preset=tag, stamp=i))
@@ -111,10 +119,11 @@ def test_the_section_renders_the_stores_numbers_and_its_cheapest_layer(tmp_path)
     df = frame.load(_store(tmp_path / "store" / "m.jsonl").parent)
     data = S.rows(df)
     left = {(r["scene"], r["absorber"], r["layer"]): r for r in data["left"]}
-    assert left[("plane-pulse", "pml", 6.0)]["amplitude"] == 1.8e-3 and left[("plane-pulse", "pml", 6.0)]["widths"] == 2
+    assert left[("plane-pulse", "pml", 6.0)]["reflected"] == 1.8e-3 and left[("plane-pulse", "pml", 6.0)]["widths"] == 2
+    assert left[("plane-pulse", "pml", 6.0)]["amplitude"] == pytest.approx(7.8e-3)
     assert left[("acoustic-pulse", "pml", 6.0)]["axis"] == pytest.approx(3.5e-4)
     cheapest = {r["scene"]: r for r in data["cheapest"]}
-    assert cheapest["plane-pulse"]["layer"] == 6.0  # the 3 m layers leave more than 1 %
+    assert cheapest["plane-pulse"]["layer"] == 6.0  # the 3 m layers reflect more than 1 %
     assert cheapest["acoustic-pulse"]["absorber"] == "pml"  # the sponge leaves 3 %
     amp, _, what = data["closed"]["plane-pulse"]
     assert amp == pytest.approx(0.89) and "free end" in what
@@ -125,12 +134,14 @@ def test_the_section_renders_the_stores_numbers_and_its_cheapest_layer(tmp_path)
     (closed, opened) = sorted(data["cost"], key=lambda r: r["open"])
     assert closed["ratio"] == 1.0 and opened["ratio"] == pytest.approx(1.15 / 1.0)  # each side's best round
     assert opened["particles"] == pytest.approx(1.24)
+    (stable,) = data["stability"]
+    assert stable["bounded_to"] == 3.0 and stable["blew_up_from"] == 3.5 and stable["first_step"] == 120
     text = "\n".join(S.text(data, None))
     assert text.startswith("## Open edges")
-    for heading in ("### What the open edges leave behind", "### What a layer costs"):
+    for heading in ("### What the open edges leave behind", "### What a layer costs", "### The stable CFL"):
         assert heading in text
-    assert "| normal (plane pulse) | pml | 6 (2; 24) | 12 | 1.80e-03 |" in text
-    assert "Cheapest below 1 % of the amplitude, oblique (2D pulse): the pml, 6 m of layer" in text
+    assert "| normal (plane pulse) | pml | 6 (2; 24) | 12 | 1.80e-03 | 3.24e-06 | 7.80e-03 |" in text
+    assert "Cheapest reflecting less than 1 % of the amplitude, oblique (2D pulse): the pml, 6 m of layer" in text
 
 
 def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):

@@ -330,6 +330,16 @@ def run_here(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sy
     return run_spec(spec)
 
 
+def error_words(row: dict) -> str:
+    """The run's headline error for a progress line: ``MSE x``, or, for a run with open edges, what they left
+    (``left x of the amplitude``: its MSE is against a pulse that may have left the domain)."""
+    left = (row.get("errors") or {}).get("left_amplitude")
+    if (row.get("scene") or {}).get("open") and left is not None:
+        return f"left {left:.3g} of the amplitude"
+    mse = row.get("mse")
+    return f"MSE {'-' if mse is None else f'{mse:.4g}'}"
+
+
 def eta_text(
     remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None, whose: str = "this host's"
 ) -> str:
@@ -502,10 +512,9 @@ def run_specs(
         made = [r for r in stored if r["status"] != "skipped"]
         per_run = (time.perf_counter() - t_start) / len(made) / executor.slots if made else None
         where = f" on {row.get('profile_id')}/{row.get('host')}" if executor.slots > 1 else ""
-        mse = row.get("mse")
         print(
             f"{labels[spec]}{where}: {row['status']}, step {1e3 * step_seconds(row['stages'], row['steps']):.2f} "
-            f"ms, MSE {'-' if mse is None else f'{mse:.4g}'} | sweep: {len(stored)}/{n_todo} done, "
+            f"ms, {error_words(row)} | sweep: {len(stored)}/{n_todo} done, "
             f"{running} running, {failed} not ok, {eta_text(queue, known, per_run, executor.whose)}",
             file=stream,
             flush=True,

@@ -162,7 +162,9 @@ class RunRecord:
             f"steps            {self.steps} (t = {self.t_end:.6g} s)",
             f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
             f"mean neighbours  {self.mean_neighbours:.2f}",
-            f"MSE (rel. RMS)   {self.mse:.6g}" + ("" if primary == "u" else f" of {primary}"),
+            f"MSE (rel. RMS)   {self.mse:.6g}"
+            + ("" if primary == "u" else f" of {primary}")
+            + (" (against the pulse; once it has left, read the left measures below)" if scene.open else ""),
             f"ME (max)         {self.me:.6g} {unit}",
         ]
         lines += [f"{name.replace('_', ' '):<17}{value:.6g}" for name, value in self.errors.items()]

@@ -93,6 +93,29 @@ def left_behind(scene, fields, exact) -> dict:
     }
 
 
+def reflected(scene, primary, predicted) -> dict:
+    """What the open edges sent back, apart from the method's own dispersive tail: the `linear` run's primary
+    field against the dispersion prediction on an unbounded lattice (a perfect absorber's answer, exact for
+    `linear`: solvers/reference/dispersion.unbounded) at the same sites, ``reflected_amplitude`` (the largest
+    difference over the initial pulse's peak) and ``reflected_energy`` (the sum of its squares over the initial
+    primary field's, per site). Nothing for the moving models, whose prediction is their linear part only."""
+    import numpy as np
+
+    if scene.model != "linear":
+        return {}
+    d = np.asarray(primary, float) - np.asarray(predicted, float)
+    x, y = scored_axes(scene)
+    gx, gy = np.meshgrid(x, y)
+    u0, _v0, drho0 = scene.kind.initial_fields(scene, gx.ravel(), gy.ravel(), np)
+    start = np.asarray(drho0 if scene.kind.primary == "drho" else u0, float)
+    if not np.all(np.isfinite(d)):
+        return {"reflected_amplitude": float("nan"), "reflected_energy": float("nan")}
+    return {
+        "reflected_amplitude": float(np.abs(d).max() / np.abs(start).max()),
+        "reflected_energy": float(np.mean(d**2) / np.mean(start**2)),
+    }
+
+
 class SceneKind:
     """Base class of the scene kinds: a problem with an exact reference. Subclasses set ``name``."""
 
