@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("scipy")
+pytestmark = pytest.mark.tier2  # a minute and a half of Bessel sums: .ci/run's second tier (pytest -m tier2)
 
 from solvers.reference.cylinder import CylinderPulse  # noqa: E402
 

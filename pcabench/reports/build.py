@@ -234,6 +234,17 @@ def summary(results_dir: Path, profile: str) -> str:
     )
 
 
+def open_study(df):
+    """Which rows are the open-edges study's: open edges, or the preset's own closed runs (``open``,
+    ``open-cost-<round>``: contrasts scored once the pulse has gone, and cost baselines)."""
+    from pcabench.presets.open_edges import OPEN, open_cost_round
+
+    if df.empty:
+        return df.index == df.index
+    edges = df["open"].fillna("") != "" if "open" in df else False
+    return edges | (df.preset == OPEN) | df.preset.map(lambda p: open_cost_round(p) is not None)
+
+
 def write_reports(results_dir: Path, reports_dir: Path, scene: str | None = None) -> list[Path]:
     """Every report from the stores in ``results_dir`` (only ``scene``'s runs, if given) into ``reports_dir``."""
     df_all = frame.load(results_dir)
@@ -248,6 +259,7 @@ def write_reports(results_dir: Path, reports_dir: Path, scene: str | None = None
     reports_dir = own_folder(reports_dir, "report folder")  # never a link: nothing written or deleted where it points
     shared = {}  # rows computed once for every report (Table 6)
     # a machine's name becomes a folder: checked (store.validate made it so) so that nothing lands outside
+    everything, df_all = df_all, df_all[~open_study(df_all)]  # the open-edges study's runs: its section only
     paper = df_all[df_all.scene == DEFAULT_SCENE]  # the paper's tables and figures: its scene only
     paths = [
         report_for(
@@ -258,9 +270,10 @@ def write_reports(results_dir: Path, reports_dir: Path, scene: str | None = None
                 reports_dir / store.check_name(str(name), "machine"),
                 shared,
                 df_scenes=g,
+                df_open=everything[everything.machine == name],
             )
         )
-        for name, g in df_all.groupby("machine")
+        for name, g in everything[~open_study(everything)].groupby("machine")
     ]
     table6 = shared.get("table6")
     paths += cards_page(paper, reports_dir, table6 if table6 is not None else T.table6(paper))

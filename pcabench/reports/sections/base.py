@@ -34,6 +34,9 @@ class Context:
     shared: dict = field(default_factory=dict)
     cache: dict = field(default_factory=dict)
     df_scenes: pd.DataFrame | None = None  # every scene's runs of this machine (``df`` holds the paper's scene's)
+    # the open-edges study's runs too (``pcabench study --open``: open edges, their closed contrasts and cost
+    # baselines), which only the "Open edges" section reads: the other sections' scenes are the closed ones
+    df_open: pd.DataFrame | None = None
 
     @property
     def pid(self) -> str:
