@@ -49,6 +49,7 @@ def _max_rel(a, b):
     return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
 
 
+@pytest.mark.tier2  # the simulator feature by feature; check-solver's GPU case (default tier) covers them
 @pytest.mark.parametrize(
     "precision,model,steps,tol",
     [
@@ -186,6 +187,7 @@ def test_simulated_step_launches_and_host_round_trips():
     assert out["scan"] == {"ok": True, "zeroed": True}
 
 
+@pytest.mark.tier2  # the simulator feature by feature; check-solver's GPU case (default tier) covers them
 @pytest.mark.parametrize("integrator", ["rk2", "kdk1"])
 def test_simulated_gpu_integrators_match_cpu(integrator):
     """The counting sort carries the two-stage integrator's saved copies along (rk2) and the one-sweep step."""

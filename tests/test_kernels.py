@@ -170,6 +170,7 @@ def test_linear_converges_at_second_order_for_each_kernel(name):
 
 
 # ------------------------------------------------------------ (d): the GPU kernels in the simulator
+@pytest.mark.tier2  # the simulator feature by feature; check-solver's GPU case (default tier) covers them
 def test_simulated_gpu_matches_cpu_on_a_wendland_kernel():
     """C4, the one with the most arithmetic (a simulated run is about 20 s)."""
     out = _simulate("float64", "lagrangian", 4, kernel="wendland-c4")

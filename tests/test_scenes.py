@@ -101,6 +101,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.tier2  # the simulator feature by feature; check-solver's GPU case (default tier) covers them
 def test_the_gpu_solver_runs_the_periodic_square_in_the_simulator():
     out = in_simulator(SIM_SCRIPT)
     for precision, tol in (("float64", 1e-12), ("float32", 2e-5)):

@@ -175,6 +175,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.tier2  # the simulator feature by feature; check-solver's GPU case (default tier) covers them
 def test_the_gpu_solver_runs_the_walls_in_the_simulator():
     out = in_simulator(SIM_SCRIPT)
     for name, tol in (("pulse-wall", 1e-12), ("plane-wall", 2e-5)):
