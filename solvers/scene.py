@@ -534,8 +534,13 @@ class Scene:
 
     def describe(self) -> str:
         scene = "" if self.name == DEFAULT_SCENE else f"{self.name}, "
+        edges = (
+            f"open {self.open} ({self.absorber_used}, {self.layer:g} m of layer, {self.strength:.3g} 1/s), "
+            if self.open
+            else ""
+        )
         return (
-            f"{scene}{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
+            f"{scene}{edges}{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
             f"{self.kernel} kernel, h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
             f"{self.n_steps} steps to t = {self.t_final:.4g} s, "
             f"{self.model}/{self.integrator}/{self.precision}, "

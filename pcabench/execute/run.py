@@ -21,6 +21,7 @@ from pcabench.spec import RunSpec
 from pcabench.store.record import RunRecord
 from solvers import SceneError, jitcache, make_solver
 from solvers.physics.integrators import step_program
+from solvers.scenes.base import reflected
 
 FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.interface.Fields), each one per particle
 
@@ -54,7 +55,7 @@ def score(record: RunRecord, scene, fields) -> RunRecord:
     record.status = "ok"
     measures = dict(scene.kind.errors(scene, fields))  # against the scene's exact linear solution
     record.mse, record.me = measures.pop("mse"), measures.pop("me")
-    record.errors = measures
+    record.errors = {**measures, **reflected(scene, fields)}  # open edges: what they sent back (linear runs)
     if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
         record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
     return record

@@ -182,6 +182,16 @@ def predicted_velocity(scene) -> tuple[np.ndarray, np.ndarray, float]:
     return x, np.fft.ifft(modes.u).real[keep], modes.t
 
 
+def predicted_primary(scene, fields) -> np.ndarray:
+    """The `linear` prediction of the scene's primary field at a run's lattice sites (``fields``: its output,
+    the scored domain row by row): u of a plane scene, drho of a 2D one (on the :func:`unbounded` lattice where
+    edges are open)."""
+    if scene.kind.primary == "u" and scene.kind.strip:
+        x, u, _ = predicted_velocity(scene)
+        return np.interp(np.asarray(fields.x, float), x, u)
+    return predicted_fields_2d(scene.replace(model="linear"))[2].ravel()
+
+
 def amplification_radius(integrator: str, z) -> np.ndarray:
     """Spectral radius of one step (after the first) of ``integrator`` for c0 |D| dt = z (rho0 = c0 = dt = 1)."""
     return np.abs(np.linalg.eigvals(step_matrices(integrator, z, 1.0, 1.0, 1.0))).max(axis=1)

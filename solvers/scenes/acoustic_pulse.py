@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from solvers.scenes.base import SceneKind, left_behind, reflected, scored_axes
+from solvers.scenes.base import SceneKind, left_behind, scored_axes
 
 LN2 = math.log(2.0)
 
@@ -204,10 +204,6 @@ class AcousticPulse(SceneKind):
         if scene.open:
             out.update(left_behind(scene, fields, values))
             out.update(left_by_direction(scene, fields.x, fields.y, fields.drho, values[0]))
-            if scene.model == "linear" and fields.drho.size == scene.n_scored:  # a run's fields, not a prediction's
-                from solvers.reference.dispersion import predicted_fields_2d
-
-                out.update(reflected(scene, fields.drho, predicted_fields_2d(scene)[2].ravel()))
         return out
 
     def isothermal_errors(self, scene, fields) -> float | None:

@@ -93,17 +93,21 @@ def left_behind(scene, fields, exact) -> dict:
     }
 
 
-def reflected(scene, primary, predicted) -> dict:
-    """What the open edges sent back, apart from the method's own dispersive tail: the `linear` run's primary
-    field against the dispersion prediction on an unbounded lattice (a perfect absorber's answer, exact for
-    `linear`: solvers/reference/dispersion.unbounded) at the same sites, ``reflected_amplitude`` (the largest
+def reflected(scene, fields) -> dict:
+    """What the open edges of a run sent back, apart from the method's own dispersive tail: the `linear` run's
+    primary field against the dispersion prediction on an unbounded lattice (a perfect absorber's answer, exact
+    for `linear`: solvers/reference/dispersion.unbounded) at its sites, ``reflected_amplitude`` (the largest
     difference over the initial pulse's peak) and ``reflected_energy`` (the sum of its squares over the initial
-    primary field's, per site). Nothing for the moving models, whose prediction is their linear part only."""
+    primary field's, per site). Nothing for a closed scene, or for the moving models, whose prediction is their
+    linear part only. The run's scorer adds it (pcabench/execute/run.py): a prediction is not scored by itself."""
     import numpy as np
 
-    if scene.model != "linear":
+    from solvers.reference.dispersion import predicted_primary
+
+    if scene.model != "linear" or not scene.open:
         return {}
-    d = np.asarray(primary, float) - np.asarray(predicted, float)
+    primary = fields.drho if scene.kind.primary == "drho" else fields.u
+    d = np.asarray(primary, float) - predicted_primary(scene, fields)
     x, y = scored_axes(scene)
     gx, gy = np.meshgrid(x, y)
     u0, _v0, drho0 = scene.kind.initial_fields(scene, gx.ravel(), gy.ravel(), np)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from solvers.reference.analytic import errors as analytic_errors
-from solvers.scenes.base import SceneKind, left_behind, reflected
+from solvers.scenes.base import SceneKind, left_behind
 
 
 class PlanePulse(SceneKind):
@@ -54,11 +54,6 @@ class PlanePulse(SceneKind):
 
             u = pulse_velocity(scene, np.asarray(fields.x, float), fields.t)
             out.update(left_behind(scene, fields, (scene.rho0 * u / scene.c0, u, np.zeros_like(u))))
-            if scene.model == "linear" and fields.u.size == scene.n_scored:  # a run's fields, not a prediction's
-                from solvers.reference.dispersion import predicted_velocity
-
-                x, u_open, _ = predicted_velocity(scene)
-                out.update(reflected(scene, fields.u, np.interp(np.asarray(fields.x, float), x, u_open)))
         return out
 
     def isothermal_errors(self, scene, fields) -> float | None:
