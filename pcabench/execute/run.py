@@ -21,7 +21,8 @@ from pcabench.spec import RunSpec
 from pcabench.store.record import RunRecord
 from solvers import SceneError, jitcache, make_solver
 from solvers.physics.integrators import step_program
-from solvers.scenes.base import reflected
+from solvers.reference.dispersion import predicted_primary
+from solvers.scenes.base import scored_axes
 
 FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.interface.Fields), each one per particle
 
@@ -39,6 +40,29 @@ def fields_problem(fields, n_particles: int) -> str:
     if not math.isfinite(float(fields.t)) or fields.t < 0:
         return f"its time t = {fields.t!r} is not a finite time >= 0"
     return ""
+
+
+def reflected(scene, fields) -> dict:
+    """What the open edges of a run sent back, apart from the method's own dispersive tail: the `linear` run's
+    primary field against the dispersion prediction on an unbounded lattice (a perfect absorber's answer, exact
+    for `linear`: solvers/reference/dispersion.unbounded) at its sites, ``reflected_amplitude`` (the largest
+    difference over the initial pulse's peak) and ``reflected_energy`` (the sum of its squares over the initial
+    primary field's, per site). Nothing for a closed scene, or for the moving models, whose prediction is their
+    linear part only. The run's scorer adds it (:func:`score`), so that a prediction is never scored by itself."""
+    if scene.model != "linear" or not scene.open:
+        return {}
+    primary = fields.drho if scene.kind.primary == "drho" else fields.u
+    d = np.asarray(primary, float) - predicted_primary(scene, fields)
+    x, y = scored_axes(scene)
+    gx, gy = np.meshgrid(x, y)
+    u0, _v0, drho0 = scene.kind.initial_fields(scene, gx.ravel(), gy.ravel(), np)
+    start = np.asarray(drho0 if scene.kind.primary == "drho" else u0, float)
+    if not np.all(np.isfinite(d)):
+        return {"reflected_amplitude": float("nan"), "reflected_energy": float("nan")}
+    return {
+        "reflected_amplitude": float(np.abs(d).max() / np.abs(start).max()),
+        "reflected_energy": float(np.mean(d**2) / np.mean(start**2)),
+    }
 
 
 def score(record: RunRecord, scene, fields) -> RunRecord:

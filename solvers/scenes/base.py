@@ -93,33 +93,6 @@ def left_behind(scene, fields, exact) -> dict:
     }
 
 
-def reflected(scene, fields) -> dict:
-    """What the open edges of a run sent back, apart from the method's own dispersive tail: the `linear` run's
-    primary field against the dispersion prediction on an unbounded lattice (a perfect absorber's answer, exact
-    for `linear`: solvers/reference/dispersion.unbounded) at its sites, ``reflected_amplitude`` (the largest
-    difference over the initial pulse's peak) and ``reflected_energy`` (the sum of its squares over the initial
-    primary field's, per site). Nothing for a closed scene, or for the moving models, whose prediction is their
-    linear part only. The run's scorer adds it (pcabench/execute/run.py): a prediction is not scored by itself."""
-    import numpy as np
-
-    from solvers.reference.dispersion import predicted_primary
-
-    if scene.model != "linear" or not scene.open:
-        return {}
-    primary = fields.drho if scene.kind.primary == "drho" else fields.u
-    d = np.asarray(primary, float) - predicted_primary(scene, fields)
-    x, y = scored_axes(scene)
-    gx, gy = np.meshgrid(x, y)
-    u0, _v0, drho0 = scene.kind.initial_fields(scene, gx.ravel(), gy.ravel(), np)
-    start = np.asarray(drho0 if scene.kind.primary == "drho" else u0, float)
-    if not np.all(np.isfinite(d)):
-        return {"reflected_amplitude": float("nan"), "reflected_energy": float("nan")}
-    return {
-        "reflected_amplitude": float(np.abs(d).max() / np.abs(start).max()),
-        "reflected_energy": float(np.mean(d**2) / np.mean(start**2)),
-    }
-
-
 class SceneKind:
     """Base class of the scene kinds: a problem with an exact reference. Subclasses set ``name``."""
 
