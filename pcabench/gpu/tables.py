@@ -33,6 +33,21 @@ def timing_row(row: dict) -> dict:
     }
 
 
+def scene_agreement(what: str, rows) -> list[str]:
+    """The table of a stage that runs the GPU against the CPU on named scenes (walls, open edges)."""
+    return [
+        "",
+        f"## {what}: GPU vs linkedlist-cpu (max relative difference after the steps shown)",
+        "",
+        "| scene | N | precision | model | dx | steps | u | drho |",
+        "|---|---|---|---|---|---|---|---|",
+    ] + [
+        f"| {r['scene']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | "
+        f"{r['max_rel_diff_u']:.2e} | {r['max_rel_diff_drho']:.2e} |"
+        for r in rows
+    ]
+
+
 def markdown(profile: dict, results: dict) -> str:
     """The check's tables: stages run, ceilings, agreement, sweep, graph path, CPU peers."""
     g = profile.get("gpu") or {}
@@ -58,32 +73,9 @@ def markdown(profile: dict, results: dict) -> str:
             f"{r['max_rel_diff_drho']:.2e} |"
             for r in results["compare"]
         ]
-    if results.get("walls"):
-        lines += [
-            "",
-            "## Rigid walls (mirror particles): GPU vs linkedlist-cpu (max relative difference after the steps shown)",
-            "",
-            "| scene | N | precision | model | dx | steps | u | drho |",
-            "|---|---|---|---|---|---|---|---|",
-        ]
-        lines += [
-            f"| {r['scene']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | "
-            f"{r['max_rel_diff_u']:.2e} | {r['max_rel_diff_drho']:.2e} |"
-            for r in results["walls"]
-        ]
-    if results.get("open"):
-        lines += [
-            "",
-            "## Open edges (an absorbing layer): GPU vs linkedlist-cpu (max relative difference after the steps shown)",
-            "",
-            "| scene | N | precision | model | dx | steps | u | drho |",
-            "|---|---|---|---|---|---|---|---|",
-        ]
-        lines += [
-            f"| {r['scene']} | {r['N']:,} | {r['precision']} | {r['model']} | {r['dx']} | {r['steps']} | "
-            f"{r['max_rel_diff_u']:.2e} | {r['max_rel_diff_drho']:.2e} |"
-            for r in results["open"]
-        ]
+    for key, what in (("walls", "Rigid walls (mirror particles)"), ("open", "Open edges (an absorbing layer)")):
+        if results.get(key):
+            lines += scene_agreement(what, results[key])
     if results.get("open_cost"):
         lines += [
             "",
