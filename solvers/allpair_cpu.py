@@ -12,6 +12,7 @@ from functools import lru_cache
 
 from solvers.interface import Solver, across_x, tiny_scene
 from solvers.physics.backend import COMPILED, cpu_loops, cpu_updates
+from solvers.search.allpairs import AllPairs
 
 
 @lru_cache(maxsize=None)
@@ -31,6 +32,7 @@ class AllPairCPU(Solver):
     pair_loops = ("all-pairs",)
     pair_loop = "all-pairs"
     search = "all-pair"
+    neighbour_search = AllPairs
     order = 2.0
     boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")  # periodic axes by the minimum image
 
@@ -39,18 +41,6 @@ class AllPairCPU(Solver):
 
     def launch(self, name: str, *args):
         return sweeps(self.scene.precision, self.scene.kernel, across_x(self.scene))[name](*args)
-
-    def _sweep(self, continuity: bool, momentum: bool) -> None:
-        a = self.arrays
-        pos = (a["lx"], a["ly"], a["sx"], a["sy"])
-        if continuity:
-            self.launch("continuity", *pos, a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
-        if momentum:
-            self.launch("momentum", *pos, a["mass"], a["pr"], a["ax"], a["ay"], self.k)
-
-    def mean_neighbours(self) -> float:
-        a = self.arrays
-        return self.launch("neighbours", a["lx"], a["ly"], a["sx"], a["sy"], self.k) / self.scene.n_particles
 
     def warmup(self) -> float:
         t0 = time.perf_counter()

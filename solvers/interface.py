@@ -66,7 +66,7 @@ class EveryKernel:
 
 
 class Solver(abc.ABC):
-    """Base class: state, system update, output. Subclasses: ``snp``, ``_sweep`` and ``launch``.
+    """Base class: state, system update, output. Subclasses: ``snp`` and ``launch``, and a neighbour search.
 
     The class attributes below state what a solver is and can do. The harness
     (run specs, predictions, cluster resources, the command line, the reports
@@ -85,6 +85,7 @@ class Solver(abc.ABC):
     pair_loops: tuple = ("gather",)  # how it can visit pairs (gather, list, all-pairs); the first is its default
     threaded: bool = False  # runs on more than one CPU thread (--threads N|all); else serial
     serial_why: str = "as in the paper"  # why a serial solver is serial, for the one-line refusal
+    neighbour_search: type | None = None  # the search's class (solvers/search/): built per scene as ``self.nnps``
     search: str = "linked list"  # the neighbour search in the paper's words (linked list, all-pair): the reports
     # set the paper's numbers only beside the same search
     order: float = 1.0  # step time ~ N^order (1: a cell list; 2: every pair tested): the predictor's prior
@@ -186,7 +187,10 @@ class Solver(abc.ABC):
         self.after_init()
 
     def after_init(self) -> None:
-        """Hook for device-specific setup after the arrays exist."""
+        """The neighbour search for the scene (``self.nnps``), once the arrays exist; a hook for device-specific
+        setup too."""
+        if self.neighbour_search is not None:
+            self.nnps = self.neighbour_search(self.scene, self.launch, self.xp)
 
     @abc.abstractmethod
     def snp(self) -> None:
@@ -210,9 +214,17 @@ class Solver(abc.ABC):
         """Run kernel ``name`` over every particle on this solver's device and threads: at least the
         per-particle ones of solvers/physics/pairs.py (coefficients, kick, advance)."""
 
-    @abc.abstractmethod
     def _sweep(self, continuity: bool, momentum: bool) -> None:
-        """The neighbour loops themselves."""
+        """The neighbour loops themselves, over the search's arguments (``self.nnps``)."""
+        a = self.arrays
+        if continuity:
+            self.launch("continuity", *self.geometry(), a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+        if momentum:
+            self.launch("momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
+
+    def geometry(self) -> tuple:
+        """What every pair loop takes first, from the neighbour search: cells (if any) and positions."""
+        return self.nnps.arguments(self.arrays)
 
     # ------------------------------------------------------------ system update
     def kick(self, f: float) -> None:
@@ -332,9 +344,10 @@ class Solver(abc.ABC):
             return float("nan")
         return m
 
-    @abc.abstractmethod
     def mean_neighbours(self) -> float:
-        """Mean count of neighbours within the cutoff at the current positions."""
+        """Mean count of neighbours within the cutoff at the current positions, by the neighbour search on
+        arrays of its own: no side effect (the state is not re-sorted: the count is the same in any order)."""
+        return self.nnps.count(self.arrays, self.k) / self.scene.n_particles
 
     # ------------------------------------------------------------ timing support
     def warmup(self) -> float:

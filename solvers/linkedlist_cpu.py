@@ -1,12 +1,14 @@
 """Linked-list CPU solver: the paper's uniform cell list, numba-compiled.
 
-SNP builds the paper's arrays by counting sort: the cell of each particle
-(particleIndex), the count per cell (particleCellNum), cellBegin (exclusive
-prefix sum, with the end sentinel) and the order of particles by cell
-(cellParticleOrder). Every per-particle array is then gathered into cell
-order, so the three cells of a stencil row are one contiguous range and the
-pair loops stream through memory. Cells are one cutoff wide in x and at least
-one cutoff tall in y (a whole number of rows fills the periodic height).
+SNP: the solver's search (solvers/search/celllist.CellList, held as
+``self.nnps``) builds the paper's arrays by counting sort: the cell of each
+particle (particleIndex), the count per cell (particleCellNum), cellBegin
+(exclusive prefix sum, with the end sentinel) and the order of particles by
+cell (cellParticleOrder). The solver then gathers every per-particle array
+into cell order, so the three cells of a stencil row are one contiguous range
+and the pair loops stream through memory. Cells are one cutoff wide in x and
+at least one cutoff tall in y (a whole number of rows fills the periodic
+height).
 
 ``threads=1`` runs the serial code, as the paper's CPU code did;
 ``threads=N`` runs the same source compiled with numba's parallel loops on N
@@ -31,11 +33,6 @@ from solvers.physics.backend import COMPILED, cpu_loops, cpu_sorting, cpu_update
 from solvers.scene import SceneError
 from solvers.search import pairlist
 from solvers.search.celllist import CellListSolver
-
-
-def counting_sort(cell, ncells, begin, order, sorted_cell) -> None:
-    """cellBegin and cellParticleOrder by a stable counting sort of ``cell`` (solvers/loops/sorting.py)."""
-    cpu_sorting().counting_sort(cell, ncells, begin, order, sorted_cell)
 
 
 @lru_cache(maxsize=None)
@@ -106,13 +103,6 @@ class LinkedListCPU(CellListSolver):
         return type(self)(threads=self.threads, pair_loop=self.pair_loop)
 
     def allocate_cells(self) -> None:
-        n = self.scene.n_particles
-        self.cell = np.empty(n, np.int32)
-        self.sorted_cell = np.empty(n, np.int32)
-        self.order = np.empty(n, np.int64)
-        # unsigned cell bounds: numba then skips negative-index wraparound on every
-        # neighbour load (measured 20-25 % faster sweeps)
-        self.begin = np.zeros(self.ncells + 1, np.uint32)
         self.pairs = pairlist.PairList(self.scene, self.threads) if self.pair_loop == "list" else None
         self.spare = None  # the next gather's target array
 
@@ -123,32 +113,17 @@ class LinkedListCPU(CellListSolver):
         return sweeps(s.precision, s.kernel, self.threads > 1, across_x(s))[name](*args)
 
     def sort_cells(self) -> None:
-        """SNP in four steps, each its own method: the cell of every particle (:meth:`cell_ids`), the order
-        by cell (:meth:`cell_order`), every per-particle array into that order (:meth:`permute`), then the
-        pair list if used (x-sorted within each cell first: the list scans x-sorted stencil rows)."""
-        a = self.arrays
-        self.cell_ids()
-        order, begin = self.cell_order()
-        if begin is not self.begin:
-            self.begin[:] = begin
-        if order is not self.order:  # a variant's own order: the cells in it by one gather
-            self.order = np.ascontiguousarray(order, dtype=np.int64)
-            np.take(self.cell, self.order, out=self.sorted_cell)
+        """SNP: the search bins the particles (``self.nnps.bin``: particleIndex, cellParticleOrder,
+        cellBegin), every per-particle array goes into that order (:meth:`permute`), then the pair list if
+        used (x-sorted within each cell first: the list scans x-sorted stencil rows)."""
+        a, nnps = self.arrays, self.nnps
+        order = nnps.bin(a["lx"], a["ly"], a["sx"], a["sy"])
         if self.pairs is not None:
-            cpu_sorting().sort_cells_by_x(self.order, self.begin, a["lx"], a["sx"], self.scene.dx)
-        self.permute(self.order)
-        self.cell, self.sorted_cell = self.sorted_cell, self.cell
+            cpu_sorting().sort_cells_by_x(order, nnps.begin, a["lx"], a["sx"], self.scene.dx)
+        self.permute(order)
+        nnps.settle()
         if self.pairs is not None:
             self.pairs.build(*self.geometry(), self.k)
-
-    def cell_order(self) -> tuple:
-        """(cellParticleOrder, cellBegin) for the cells in ``self.cell`` (particleIndex): the permutation
-        that puts the particles in cell order, stable (by particle within a cell), and the first position
-        of every cell with the end sentinel (``ncells + 1`` entries). Here a counting sort into the
-        solver's own arrays (which also leaves the cells in that order in ``self.sorted_cell``); a variant
-        overrides this method alone and may return arrays of its own."""
-        counting_sort(self.cell, self.ncells, self.begin, self.order, self.sorted_cell)
-        return self.order, self.begin
 
     def gathered(self, arr, order):
         """``arr`` reordered on the solver's threads, into the spare array; ``arr`` becomes the spare.
@@ -176,14 +151,3 @@ class LinkedListCPU(CellListSolver):
             self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
             if walls:
                 self.launch("wall_momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
-
-    def count_neighbours(self) -> int:
-        """On a cell list of its own, over copies of the positions in its cell order (the state untouched)."""
-        a, n = self.arrays, self.scene.n_particles
-        cell, sorted_cell, order = np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.int64)
-        begin = np.zeros(self.ncells + 1, np.uint32)
-        copies = [a[name].copy() for name in ("lx", "ly", "sx", "sy")]  # the kernel may wrap them
-        self.launch("cell_ids", *self.grid_arguments(*copies, cell))
-        counting_sort(cell, self.ncells, begin, order, sorted_cell)
-        positions = [arr[order] for arr in copies]
-        return int(self.launch("neighbours", sorted_cell, begin, self.ncx, self.ncy, *positions, self.k))

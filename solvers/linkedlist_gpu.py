@@ -7,12 +7,10 @@ every launch on the solver's own stream.
 The per-particle arrays are the rows of one 2D block (and a spare block of
 the same shape), so that SNP moves all of them in one launch. SNP, every step
 for moving particles and once otherwise, is three launches with no host round
-trip, a counting sort by cell: ``cell_count`` (particleIndex and each
-particle's rank within its cell, by atomics), ``cell_begin`` (cellBegin by a
-one-block scan of the counts), ``scatter`` (the whole block into cell order
-in the spare block, which then becomes the current one). Within a cell the
-order is that of the atomics, so sums may differ from run to run in the last
-bits. The system update writes the sweeps' coefficients as it updates drho,
+trip, a counting sort by cell: the search's two (solvers/gpu/cells.py:
+particleIndex and ranks by atomics, cellBegin by a one-block scan), then
+``scatter`` (the whole block into cell order in the spare block, which then
+becomes the current one). The system update writes the sweeps' coefficients as it updates drho,
 so a lagrangian Verlet step is 8 launches: kick, continuity, advance, the
 three of SNP, momentum, kick. Nothing is allocated inside a step, so a step
 can be captured once as a CUDA graph and replayed (solvers/gpu/graph.py).
@@ -26,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from solvers.gpu.cells import DeviceCellList
 from solvers.gpu.device import device_backend, simulated
 from solvers.scene import SceneError
 from solvers.search.celllist import CellListSolver
@@ -44,6 +43,7 @@ class LinkedListGPU(CellListSolver):
     serial_why = "one GPU thread per particle"
     resources = {"timing": 1, "GPU": 1}
     boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")
+    neighbour_search = DeviceCellList
 
     @classmethod
     def available(cls) -> None:
@@ -86,21 +86,15 @@ class LinkedListGPU(CellListSolver):
         return seconds
 
     def allocate_cells(self) -> None:
-        """Both particle blocks, the cell arrays and the launch shapes: everything a step needs."""
+        """Both particle blocks and the launch shapes (the search has its cell arrays): everything a step needs."""
         xp, n, a = self.xp, self.scene.n_particles, self.arrays
         self.names = tuple(a)
         block = xp.empty((len(self.names), n), self.dtype)
         for row, name in enumerate(self.names):
             block[row] = a[name]
-        self.blocks_of = [(block, xp.empty(n, xp.int32)), (xp.empty_like(block), xp.empty(n, xp.int32))]
-        self.views = [{name: blk[row] for row, name in enumerate(self.names)} for blk, _cell in self.blocks_of]
-        self.current = 0
-        self.arrays = self.views[0]
-        self.cell = self.blocks_of[0][1]
-        self.rank = xp.empty(n, xp.int32)
-        self.order = xp.empty(n, xp.int32)
-        self.counts = xp.zeros(self.ncells, xp.int32)  # cell_begin leaves them at zero again
-        self.begin = xp.empty(self.ncells + 1, xp.uint32)  # unsigned: no negative-index wraparound per load
+        self.blocks_of = [block, xp.empty_like(block)]
+        self.views = [{name: blk[row] for row, name in enumerate(self.names)} for blk in self.blocks_of]
+        self.set_state(0)
         self.coefficients_fresh = False
         # the simulator runs every thread of a block as a Python thread: keep blocks small there
         self.threads_per_block = 32 if self.cupy is None else THREADS_PER_BLOCK
@@ -114,18 +108,14 @@ class LinkedListGPU(CellListSolver):
         kernels(self.scene.precision, self.scene.kernel)[name][blocks, threads, self.launch_stream](*args)
 
     def sort_cells(self) -> None:
-        """Counting sort by cell in three launches; the spare block becomes the current one."""
-        from solvers.gpu.cuda_kernels import scan_block
-
-        a = self.arrays
-        lx, ly, sx, sy, cell, *grid = self.grid_arguments(a["lx"], a["ly"], a["sx"], a["sy"], self.cell)
-        self.launch("cell_count", lx, ly, sx, sy, cell, self.rank, self.counts, *grid)
-        self.launch("cell_begin", self.counts, self.begin, grid=(1, scan_block()))
-        (src, _), (dst, cell_out) = self.blocks_of[self.current], self.blocks_of[1 - self.current]
-        self.launch("scatter", self.cell, self.rank, self.begin, src, dst, cell_out, self.order)
-        self.set_state(1 - self.current)
+        """Counting sort by cell in three launches (the search's two, then the scatter); the spare block
+        becomes the current one."""
+        a, now = self.arrays, self.current
+        self.nnps.bin(a["lx"], a["ly"], a["sx"], a["sy"])
+        self.launch("scatter", *self.nnps.scatter_arguments(self.blocks_of[now], self.blocks_of[1 - now], now))
+        self.set_state(1 - now)
         for name, arr in self.saved.items():  # two-stage integrators' copies (not in a Verlet step)
-            self.saved[name] = self.gathered(arr, self.order)
+            self.saved[name] = self.gathered(arr, self.nnps.order)
 
     def state(self) -> int:
         """Which particle block is current (a step that searches flips it)."""
@@ -134,7 +124,7 @@ class LinkedListGPU(CellListSolver):
     def set_state(self, current: int) -> None:
         self.current = current
         self.arrays = self.views[current]
-        self.cell = self.blocks_of[current][1]
+        self.nnps.use(current)
 
     def rates(self, continuity: bool, momentum: bool) -> None:
         """PI; the coefficients only when drho changed since the system update last wrote them."""
@@ -176,24 +166,6 @@ class LinkedListGPU(CellListSolver):
     def restore(self, names) -> None:
         super().restore(names)
         self.coefficients_fresh = self.coefficients_fresh and "drho" not in names
-
-    def count_neighbours(self) -> int:
-        """On a cell list of its own (the same three launches as SNP), over a copy of the positions
-        scattered into its cell order: the particle blocks and the solver's cell list untouched."""
-        from solvers.gpu.cuda_kernels import scan_block
-
-        a, xp, n = self.arrays, self.xp, self.scene.n_particles
-        src = xp.stack([a["lx"], a["ly"], a["sx"], a["sy"]])  # a copy: the kernel may wrap it
-        dst = xp.empty_like(src)
-        cell, rank, cell_out, order = (xp.empty(n, xp.int32) for _ in range(4))
-        counts, begin = xp.zeros(self.ncells, xp.int32), xp.empty(self.ncells + 1, xp.uint32)
-        lx, ly, sx, sy, cell, *grid = self.grid_arguments(src[0], src[1], src[2], src[3], cell)
-        self.launch("cell_count", lx, ly, sx, sy, cell, rank, counts, *grid)
-        self.launch("cell_begin", counts, begin, grid=(1, scan_block()))
-        self.launch("scatter", cell, rank, begin, src, dst, cell_out, order)
-        found = xp.zeros(n, xp.int32)
-        self.launch("neighbours", cell_out, begin, self.ncx, self.ncy, dst[0], dst[1], dst[2], dst[3], found, self.k)
-        return int(found.astype(xp.int64).sum())
 
     def to_host(self, arr) -> np.ndarray:
         return self.cupy.asnumpy(arr) if self.cupy is not None else np.asarray(arr)

@@ -30,10 +30,10 @@ def snapshot(solver) -> dict:
     """Every per-particle array (object and values), the cell list and the clock."""
     out = {f"arrays.{k}": (id(v), np.array(solver.to_host(v), copy=True)) for k, v in solver.arrays.items()}
     for name in ("cell", "begin", "order", "sorted_cell"):
-        if getattr(solver, name, None) is not None:
-            v = getattr(solver, name)
+        if getattr(solver.nnps, name, None) is not None:
+            v = getattr(solver.nnps, name)
             out[name] = (id(v), np.array(solver.to_host(v), copy=True))
-    out["scalars"] = (0, np.array([solver.t, getattr(solver, "cells_valid", True)], dtype=float))
+    out["scalars"] = (0, np.array([solver.t, solver.nnps.valid], dtype=float))
     return out
 
 
@@ -46,7 +46,7 @@ def assert_unchanged(before: dict, after: dict) -> None:
 
 def resorted_count(solver) -> int:
     """The count as mean_neighbours made it before: re-sort the state, then count on the solver's cell list."""
-    solver.cells_valid = False
+    solver.nnps.valid = False
     solver.snp()
     return int(solver.launch("neighbours", *solver.geometry(), solver.k))
 
@@ -86,13 +86,13 @@ s = make_solver("linkedlist-gpu")
 s.input(scene); s.init()
 for _ in range(3):
     s.snp(); s.rates(True, True); s.kick(0.5); s.advance(1.0)
-keep = {"current": s.state(), "cell": s.cell.copy(), "begin": s.begin.copy(), "order": s.order.copy(),
+keep = {"current": s.state(), "cell": s.nnps.cell.copy(), "begin": s.nnps.begin.copy(), "order": s.nnps.order.copy(),
         **{k: v.copy() for k, v in s.arrays.items()}}
 mean = s.mean_neighbours()
 same = s.state() == keep["current"] and all(np.array_equal(s.arrays[k], v) for k, v in keep.items()
                                             if k in s.arrays)
-same = same and all(np.array_equal(getattr(s, k), keep[k]) for k in ("cell", "begin", "order"))
-s.cells_valid = False; s.snp()
+same = same and all(np.array_equal(getattr(s.nnps, k), keep[k]) for k in ("cell", "begin", "order"))
+s.nnps.valid = False; s.snp()
 counts = np.zeros(scene.n_particles, np.int32)
 s.launch("neighbours", *s.geometry(), counts, s.k)
 cpu = make_solver("linkedlist-cpu"); cpu.input(scene); cpu.init()

@@ -70,8 +70,8 @@ def test_cells_sorted_by_x_after_the_search():
     s = stepped(scene, "list")
     a = s.arrays
     x = (a["lx"] + 0.5) * scene.dx + a["sx"]
-    for c in range(len(s.begin) - 1):
-        seg = x[s.begin[c] : s.begin[c + 1]]
+    for c in range(len(s.nnps.begin) - 1):
+        seg = x[s.nnps.begin[c] : s.nnps.begin[c + 1]]
         assert np.all(np.diff(seg) >= 0), c
 
 

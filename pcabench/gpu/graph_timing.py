@@ -45,14 +45,14 @@ def graph_vs_plain(dx: float, precision: str, steps: int, rounds: int, scene_ove
             best[name] = min(best[name], timed(one_step))
     # the same steps from one state by each path: the state is the current block, its cells and cellBegin
     current = solver.state()
-    block, cells = (a.copy() for a in solver.blocks_of[current])
-    begin, t0 = solver.begin.copy(), solver.t
+    block, cells = solver.blocks_of[current].copy(), solver.nnps.cells[current].copy()
+    begin, t0 = solver.nnps.begin.copy(), solver.t
     u = {}
     for name, one_step in (("plain", plain), ("graph", graph.step)):
         solver.set_state(current)
-        solver.blocks_of[current][0][...] = block
-        solver.blocks_of[current][1][...] = cells
-        solver.begin[...] = begin
+        solver.blocks_of[current][...] = block
+        solver.nnps.cells[current][...] = cells
+        solver.nnps.begin[...] = begin
         solver.t = t0
         for _ in range(steps):
             one_step()

@@ -99,13 +99,13 @@ CONFIGS = {
 def candidates(solver) -> int:
     """The candidates the build scans: the rest of each particle's cell row within a cutoff to its right, and
     the row above within a cutoff either side (rows sorted by x, as the build's binary searches bound them)."""
-    a, rc, ncx = solver.arrays, solver.scene.cutoff, solver.ncx
+    a, rc, ncx = solver.arrays, solver.scene.cutoff, solver.nnps.grid.ncx
     x = (a["lx"].astype(float) + 0.5) * solver.scene.dx + a["sx"]
     total = 0
     for cy in range(solver.ncy):
-        lo, hi = int(solver.begin[cy * ncx]), int(solver.begin[(cy + 1) * ncx])
+        lo, hi = int(solver.nnps.begin[cy * ncx]), int(solver.nnps.begin[(cy + 1) * ncx])
         up = (cy + 1) % solver.ncy
-        ulo, uhi = int(solver.begin[up * ncx]), int(solver.begin[(up + 1) * ncx])
+        ulo, uhi = int(solver.nnps.begin[up * ncx]), int(solver.nnps.begin[(up + 1) * ncx])
         xr, xu = x[lo:hi], x[ulo:uhi]
         total += int((np.searchsorted(xr, xr + rc, "left") - (np.arange(hi - lo) + 1)).sum())
         total += int((np.searchsorted(xu, xr + rc, "left") - np.searchsorted(xu, xr - rc, "right")).sum())
