@@ -106,11 +106,16 @@ def test_the_stability_summary_agrees_with_the_prediction_and_the_map(tmp_path, 
         assert (p["class"] in ("unstable", "unstable by prediction")) == (p["cfl"] >= 4.97), p
     lines = stability_section.text((points, limits), None)
     text = "\n".join(lines)
+    short = next(lim for lim in limits if lim["protocol"] == "t = 10 s")
+    assert short["stable_cfl"] == 4.8 and short["limit_from"] == "long runs"  # the free ends' measured limit
+    assert short["predicted"] == pytest.approx(4.97, abs=0.005)  # the periodic lattice's
+    assert short["blew_up_at"] == [(8.0, 4)] and short["blew_up_below_limit"] == []
+    assert [c for c, _steps, _e in short["bounded_past_limit"]] == [5.0, 6.0, 7.0]  # bounded, unstable by prediction
+    assert all(1 < e < 30 for _c, _steps, e in short["bounded_past_limit"])  # too few e-foldings to show
+    assert short["accurate_at"] == [0.2, 1.0, 2.0, 3.0, 4.0] and short["inaccurate_at"] == [(4.5, 0.3)]
     summary = next(line for line in lines if line.startswith("- **verlet** (t = 10 s)"))
-    assert "stable up to CFL 4.8 as long runs on this scene measured" in summary, summary  # the free ends
-    assert "4.97 predicted for a periodic lattice" in summary and "blew up at CFL 8" in summary, summary
-    assert "CFL 5-7 ended bounded after 10 steps" in summary and "unstable by prediction" in summary, summary
-    assert "within 20 % error at CFL 0.2-4." in summary, summary  # 4.5 inaccurate, 5-7 past the limit
+    for number in ("CFL 4.8", "4.97", "CFL 8", "CFL 5-7", "CFL 0.2-4."):  # the row's values, rendered
+        assert number in summary, (number, summary)
     assert "never blew up" not in text and "bounded up to" not in text
     long = next(lim for lim in limits if lim["protocol"] == "t = 30 s")
     assert long["accurate_at"] == [4.0] and [c for c, _ in long["inaccurate_at"]] == [0.2]  # not "none"

@@ -10,8 +10,7 @@ import pytest
 
 from solvers import Scene
 from solvers.kernels import constants as kernel
-from solvers.linkedlist_cpu import counting_sort
-from solvers.physics.backend import cpu_pairs
+from solvers.physics.backend import cpu_pairs, cpu_sorting
 from solvers.physics.integrators import step_program
 
 
@@ -87,7 +86,7 @@ def test_counting_sort_is_a_stable_sort_with_cell_begin():
     begin = np.zeros(ncells + 1, np.uint32)
     order = np.empty(200, np.int64)
     sorted_cell = np.empty(200, np.int32)
-    counting_sort(cell, ncells, begin, order, sorted_cell)
+    cpu_sorting().counting_sort(cell, ncells, begin, order, sorted_cell)
     assert np.array_equal(order, np.argsort(cell, kind="stable"))
     assert np.array_equal(sorted_cell, np.sort(cell))
     assert np.array_equal(begin, np.concatenate([[0], np.cumsum(np.bincount(cell, minlength=ncells))]))

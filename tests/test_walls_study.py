@@ -141,7 +141,8 @@ def test_the_section_renders_the_stores_numbers_and_findings(tmp_path):
     df = frame.load(_store(tmp_path / "store" / "m.jsonl").parent)
     data = W.rows(df)
     acc = {(r["scene"], r["model"]): r for r in data["accuracy"]}
-    assert set(acc) == {(n, m) for n in ("plane-wall", "pulse-wall") for m in ("linear", "lagrangian")}
+    acc_scenes = ("plane-wall", "pulse-wall")
+    assert set(acc) == {(n, m) for n in acc_scenes for m in ("linear", "lagrangian")}
     lin = acc[("pulse-wall", "linear")]
     assert abs(lin["gap"]) < 1e-12 and acc[("plane-wall", "linear")]["gap"] == pytest.approx(1e-5)
     (stab,) = data["stability"]
@@ -153,10 +154,13 @@ def test_the_section_renders_the_stores_numbers_and_findings(tmp_path):
     assert text.startswith("## Sound at a rigid wall")
     for heading in ("### Accuracy at the wall", "### Stability at the wall", "### What the wall costs"):
         assert heading in text
-    assert "pulse-wall**, linear: measured and predicted differ by at most" in text and ": round-off;" in text
-    assert "the difference is the free left end's, not the wall's" in text  # plane-wall: equal near the wall
-    assert text.count(", not one the wall adds.") == 2
-    assert "blew up below the predicted" in text and "the wall: without a free end" in text
+    linear = {n: [r for r in data["accuracy"] if r["scene"] == n and r["model"] == "linear"] for n in acc_scenes}
+    assert W.gap_cause("pulse-wall", linear["pulse-wall"]) == "round-off"
+    assert W.gap_cause("plane-wall", linear["plane-wall"]) == "free end"  # equal near the wall, not away from it
+    assert [W.near_wall_cause(linear[n]) for n in acc_scenes] == ["dispersion", "dispersion"]  # no error of its own
+    assert W.blow_up_cause(stab) == "the wall alone"  # linear, no free end, no free counterpart's long runs
+    for scene, cause in (("pulse-wall", ": round-off;"), ("plane-wall", "the free left end's, not the wall's")):
+        assert f"- **{scene}**, linear: measured and predicted differ by at most" in text and cause in text
     assert "| pulse-wall / acoustic-pulse | lagrangian | full | 0.5 | 1,600 | 10 x 2 | 1 | 1.1 | 1.100 |" in text
 
 

@@ -172,24 +172,51 @@ def _close(a, b, rtol: float = 0.01) -> bool:
     return len(a) == len(b) and all(abs(x / y - 1) <= rtol for x, y in zip(a, b))
 
 
+def gap_cause(scene: str, linear) -> str:
+    """Why the linear runs of ``scene`` do (or do not) equal the prediction on the mirror extension: "round-off"
+    (they do), "free end" (they differ away from the wall only: the free left end's), "not only the free end"
+    or "mirrors" (walls at both ends, where the prediction is exact: a defect of the mirrors)."""
+    worst = max(abs(r["gap"]) for r in linear)
+    at_wall = _at_wall(linear)
+    free = "free-x" in scenes()[scene].boundaries()
+    if worst < ROUND_OFF_GAP:
+        return "round-off"
+    if free and at_wall and max(at_wall) < 0.1 * worst:
+        return "free end"
+    return "not only the free end" if free else "mirrors"
+
+
+def _at_wall(linear) -> list[float]:
+    return [abs(r["wall_rms"] / r["predicted_wall"] - 1) for r in linear if r["wall_rms"] and r["predicted_wall"]]
+
+
+def near_wall_cause(near) -> str:
+    """Whether the near-wall error of linear runs ``near`` over the bulk's is the prediction's ratio (the lattice's
+    dispersion: "dispersion") or departs from it (an error the wall or the model adds: "wall")."""
+    measured = [r["wall_rms"] / r["bulk_rms"] for r in near]
+    predicted = [r["predicted_wall"] / r["predicted_bulk"] for r in near]
+    return "dispersion" if _close(measured, predicted) else "wall"
+
+
 def _gap_note(scene: str, linear) -> str:
-    """Why the linear runs of ``scene`` do (or do not) equal the prediction on the mirror extension."""
+    """Why the linear runs of ``scene`` do (or do not) equal the prediction on the mirror extension, in words."""
     worst = max(linear, key=lambda r: abs(r["gap"]))
-    at_wall = [abs(r["wall_rms"] / r["predicted_wall"] - 1) for r in linear if r["wall_rms"] and r["predicted_wall"]]
+    at_wall = _at_wall(linear)
     head = f"measured and predicted differ by at most {_gap_words(worst['gap'])} (dx = {worst['dx']:g})"
-    if abs(worst["gap"]) < ROUND_OFF_GAP:
+    cause = gap_cause(scene, linear)
+    if cause == "round-off":
         return head + ": round-off; the mirror extension is exactly the run's problem."
-    if "free-x" in scenes()[scene].boundaries() and at_wall and max(at_wall) < 0.1 * abs(worst["gap"]):
+    if cause == "free end":
         x_min, gap = free_end_moved()
         return (
-            head + (f", near the wall by {max(at_wall):.2g}" if at_wall else "") + ": the difference is the "
+            head + f", near the wall by {max(at_wall):.2g}: the difference is the "
             "free left end's, not the wall's. The run's particles at that end miss the neighbours beyond it, "
             "while the prediction's even extension across the wall has no edge there; the pulse's tail "
             "(1.5e-5 of its peak at 10 m) is at that end from the start. With the left end moved to "
             f"x = {x_min:g} m the same runs match the prediction to {gap:.1g} (measured once, not in this "
             "store; tests/test_walls.py checks it)."
         )
-    if "free-x" in scenes()[scene].boundaries():
+    if cause == "not only the free end":
         return head + ": more than round-off, and not only away from the wall (its free left end is not all of it)."
     return (
         head + ": more than round-off where the prediction is exact (walls at both ends: the mirror "
@@ -261,7 +288,7 @@ def _accuracy_text(rows) -> list[str]:
                 "error is the lattice's dispersion of the pulse that is there at t = 10 s"
                 + (
                     ", not one the wall adds."
-                    if _close(measured, predicted)
+                    if near_wall_cause(near) == "dispersion"
                     else "; the runs' ratio departs from it: an error the wall (or the model) adds."
                 )
             )
@@ -283,6 +310,39 @@ def _free_words(r) -> str:
         f"{r['free_scene']}: bounded to {fmt(f['bounded_to'], 'g') if f['bounded_to'] is not None else 'none'}, "
         f"blew up from {fmt(f['blew_up_from'], 'g') if f['blew_up_from'] is not None else 'none'}"
     )
+
+
+def blow_up_cause(r) -> str:
+    """What set the limit of a wall scene's method that blew up below its predicted stable CFL (stability row
+    ``r``): "free ends" or "model" (its free counterpart blew up there too, without a wall: by its free ends, or
+    by the model's terms), "wall" (the counterpart stayed bounded), or, with no counterpart's long runs, "free
+    end or wall", "the wall alone" (a linear run with no free end: nothing else can) or "wall or model"."""
+    f, w = r["free"], r["blew_up_from"]
+    if f is not None and f["blew_up_from"] is not None and (f["bounded_to"] is None or w > f["bounded_to"]):
+        return "free ends" if "free-x" in scenes()[r["free_scene"]].boundaries() else "model"
+    if f is not None:
+        return "wall"
+    if "free-x" in scenes()[r["scene"]].boundaries():
+        return "free end or wall"
+    return "the wall alone" if r["model"] == "linear" else "wall or model"
+
+
+def _cause_words(why: str, r) -> str:
+    f = r["free"]
+    if why in ("free ends", "model"):
+        return f"as on {r['free_scene']}, which blew up from {f['blew_up_from']:g} without a wall: " + (
+            f"the free ends ({r['scene']} keeps one) set this limit, not the wall"
+            if why == "free ends"
+            else "the model's own terms set this limit, not the wall"
+        )
+    if why == "wall":
+        return f"{r['free_scene']} stayed bounded to {fmt(f['bounded_to'], 'g')}: the wall destabilises it"
+    return {
+        "free end or wall": "the free left end or the wall (no free long run of this method tells them apart)",
+        "the wall alone": "the wall: without a free end the linear run is the prediction's periodic problem, "
+        "so nothing else can",
+        "wall or model": "the wall or the model's nonlinear terms (no free long run of this method tells them apart)",
+    }[why]
 
 
 def _stability_text(rows) -> list[str]:
@@ -342,27 +402,10 @@ def _stability_text(rows) -> list[str]:
     for r in rows:
         if not r["below_prediction"]:
             continue
-        f, w = r["free"], r["blew_up_from"]
-        free_set_it = (
-            f is not None and f["blew_up_from"] is not None and (f["bounded_to"] is None or w > f["bounded_to"])
-        )
-        not_the_wall.append(free_set_it)
-        if free_set_it:
-            cause = f"as on {r['free_scene']}, which blew up from {f['blew_up_from']:g} without a wall: " + (
-                f"the free ends ({r['scene']} keeps one) set this limit, not the wall"
-                if "free-x" in scenes()[r["free_scene"]].boundaries()
-                else "the model's own terms set this limit, not the wall"
-            )
-        elif f is not None:
-            cause = f"{r['free_scene']} stayed bounded to {fmt(f['bounded_to'], 'g')}: the wall destabilises it"
-        elif "free-x" in scenes()[r["scene"]].boundaries():
-            cause = "the free left end or the wall (no free long run of this method tells them apart)"
-        elif r["model"] == "linear":
-            cause = (
-                "the wall: without a free end the linear run is the prediction's periodic problem, so nothing else can"
-            )
-        else:
-            cause = "the wall or the model's nonlinear terms (no free long run of this method tells them apart)"
+        w = r["blew_up_from"]
+        why = blow_up_cause(r)
+        not_the_wall.append(why in ("free ends", "model"))
+        cause = _cause_words(why, r)
         lines.append(
             f"- **{r['model']}, {r['kernel']} h = {r['h_factor']:g} dx** on {r['scene']} blew up below "
             f"the predicted {r['predicted']:.3g}, from CFL {w:g} ("
