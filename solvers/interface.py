@@ -392,6 +392,9 @@ def across_x(scene: Scene) -> bool:
 
 def tiny_scene(scene: Scene) -> Scene:
     """A few hundred particles with the same scene kind, model, integrator and precision (for JIT warm-up)."""
+    own = scene.kind.tiny(scene)
+    if own is not None:
+        return own
     return scene.replace(
         dx=1.0,
         x_min=-10.0,

@@ -46,6 +46,10 @@ MIN_CFL = 1e-3  # the smallest cfl: 1e7 steps of it cross 1e4 cells, a step smal
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
 OPEN_EDGES = ("", "x", "y", "xy")  # Scene.open: none, the x edges, the y edges, all four
 PAPER_DOMAIN = {"x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
+# Parameters whose default is the scene kind's where it states one (SceneKind.defaults), else these (the paper's;
+# a body's radius only where the kind has a body).
+PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
+PER_KIND = ("pulse_width", "pulse_center", "cylinder_radius")
 
 
 class SceneError(ValueError):
@@ -72,9 +76,12 @@ class Scene:
     rho0: float = 1.0
     c0: float = 1.0
     mach: float = 0.05
-    pulse_width: float = 3.0  # the 3 in exp(-((x - c0 t)/3)^2), m
-    pulse_center: float = 0.0  # pulse position at t = 0, m
-    open: str = ""  # the edges that are open ("x": both x edges), by an absorbing layer beyond the domain
+    pulse_width: float | None = None  # the 3 in exp(-((x - c0 t)/3)^2), m; None: the kind's (the paper's 3)
+    pulse_center: float | None = None  # pulse position at t = 0, m; None: the kind's (the paper's 0)
+    cylinder_radius: float | None = None  # a rigid cylinder's radius, m (a scene kind with a body); None: the kind's
+    boundary_method: str = ""  # how a body's curved wall is modelled (solvers/bodies/); "": the default
+    open: str = ""  # the edges that are open ("x": both x edges), by an absorbing layer beyond the domain;
+    # "": the kind's (closed, but an open problem's: the cylinder's four edges)
     layer_width: float | None = None  # the layer's width, m (whole rows of dx); None: 2 pulse widths
     absorber: str = ""  # what damps the layer (solvers/absorbers/); "": the scene's (see absorber_used)
     absorber_strength: float | None = None  # its strength, 1/s; None: the absorber's default for the scene
@@ -100,6 +107,11 @@ class Scene:
         for key in DOMAIN:
             if getattr(self, key) is None:
                 object.__setattr__(self, key, kind.domain.get(key, PAPER_DOMAIN[key]))
+        for key in PER_KIND:
+            if getattr(self, key) is None:
+                object.__setattr__(self, key, kind.defaults.get(key, PAPER_PULSE.get(key)))
+        if not self.open:
+            object.__setattr__(self, "open", kind.defaults.get("open", ""))
         self._validate()
 
     # ------------------------------------------------------------ validation
@@ -217,6 +229,7 @@ class Scene:
             )
         for problem in self.kind.check(self):  # the scene kind's own parameters first: they name its options
             need(False, problem)
+        self._validate_body(need, finite)
         self._validate_open(need, finite)
         least = STRIP_CUTOFFS * self.cutoff
         need(
@@ -247,6 +260,38 @@ class Scene:
                 f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
                 f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m",
             )
+
+    def _validate_body(self, need, finite) -> None:
+        """A body's parameters only where the kind has a body (its own checks are the kind's), and a known
+        boundary method."""
+        if not self.kind.body:
+            need(
+                self.cylinder_radius is None,
+                f"--cylinder-radius: the {self.name} scene has no body (use --scene cylinder)",
+            )
+            need(
+                not self.boundary_method,
+                f"--boundary-method: the {self.name} scene has no body (use --scene cylinder)",
+            )
+            return
+        try:
+            from solvers.bodies import boundary_method_named
+
+            boundary_method_named(self.boundary_method_used)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
+
+    @property
+    def body(self) -> tuple | None:
+        """(x0, y0, radius) of the scene's rigid body, m (a cylinder, its axis at x0, y0), or None."""
+        return self.kind.body_of(self) if self.kind.body else None
+
+    @property
+    def boundary_method_used(self) -> str:
+        """How the body's wall is modelled: ``boundary_method``, or the default (solvers/bodies/)."""
+        from solvers.bodies import DEFAULT_BOUNDARY_METHOD
+
+        return self.boundary_method or DEFAULT_BOUNDARY_METHOD
 
     def _validate_open(self, need, finite) -> None:
         """The open edges: free edges of the scene, a layer of positive width no wider than the domain, a known
@@ -491,11 +536,16 @@ class Scene:
         are the paper's here, a scene kind's own in :meth:`default_of`)."""
         if name in PAPER_DOMAIN:
             return PAPER_DOMAIN[name]
+        if name in PAPER_PULSE:
+            return PAPER_PULSE[name]
         return cls.__dataclass_fields__[name].default
 
     def default_of(self, name: str):
-        """The default of parameter ``name`` for this scene's kind (its domain may differ from the paper's)."""
-        return self.kind.domain.get(name, self.default(name))
+        """The default of parameter ``name`` for this scene's kind (its domain, pulse or edges may differ from the
+        paper's)."""
+        if name in self.kind.domain:
+            return self.kind.domain[name]
+        return self.kind.defaults.get(name, self.default(name))
 
     @classmethod
     def cutoff_ratio(cls, kernel: str | None = None, cutoff_factor: float | None = None) -> float:

@@ -12,7 +12,12 @@ the entry-point group ``pcabench.scenes``) with a ``name``. It states
   periodic axes whose seams are images of an open problem, which ``--open``
   may open (a free edge of the lattice beyond an absorbing layer);
 * ``domain``: its default domain (x_min, x_max, y_min, y_max, m), where it
-  differs from the paper's;
+  differs from the paper's; ``defaults``: its other defaults where they
+  differ (the pulse's width and centre, a body's radius; ``open``: the edges
+  an open problem always opens);
+* ``body``: whether it holds a rigid body (:meth:`body_of`: a cylinder's axis
+  and radius), whose curved wall a boundary method models (solvers/bodies/;
+  the boundary kind ``body``);
 * ``fields``: the fields its error measures name; ``primary`` the one the
   headline error (a record's ``mse`` and ``me``) measures;
 * its initial fields (:meth:`initial_fields`), its exact linear reference
@@ -28,7 +33,7 @@ from __future__ import annotations
 
 import math
 
-BOUNDARY_KINDS = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")
+BOUNDARY_KINDS = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")
 MACH_RANGE = (1e-6, 0.3)  # amplitudes a scene accepts: acoustic (linear) to weakly nonlinear
 PULSE_WIDTH_RANGE = (0.1, 20.0)  # m
 
@@ -101,6 +106,8 @@ class SceneKind:
     periodic: tuple = ("y",)
     walls: tuple = ()  # the x edges that are rigid walls: "x_min", "x_max" (the others free, or periodic)
     domain: dict = {}  # {x_min, x_max, y_min, y_max}: where the kind's default domain differs from Scene's
+    defaults: dict = {}  # the kind's other defaults where they differ from Scene's (solvers.scene.PER_KIND, open)
+    body: bool = False  # whether the scene holds a rigid body (body_of), modelled by a boundary method
     fields: tuple = ("u",)
     primary: str = "u"
     has_isothermal: bool = False  # scored against the isothermal solution too (the lagrangian model's physics)
@@ -121,7 +128,16 @@ class SceneKind:
             if len(self.walls) < 2:
                 x.add("free-x")
         periodic_y = "y" in self.periodic and "y" not in open_edges
-        return frozenset(x | {"periodic-y" if periodic_y else "free-y"})
+        return frozenset(x | {"periodic-y" if periodic_y else "free-y"} | ({"body"} if self.body else set()))
+
+    def body_of(self, scene) -> tuple:
+        """(x0, y0, radius) of the body, m (a kind with ``body``)."""
+        raise NotImplementedError
+
+    def tiny(self, scene):
+        """A few hundred particles of this kind with ``scene``'s method, for the JIT warm-up (None: the
+        interface's generic tiny scene)."""
+        return None
 
     def openable_edges(self) -> tuple:
         """The axes whose edges ``--open`` may open: free x edges without walls, and periodic axes whose seams
