@@ -18,6 +18,7 @@ from typing import Callable
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel_names, scene_names, scenes
 from solvers.absorbers import absorber_names
+from solvers.bodies import DEFAULT_BOUNDARY_METHOD, boundary_method_names
 from solvers.scene import OPEN_EDGES
 
 
@@ -76,6 +77,14 @@ def _wall_help() -> str:
     )
 
 
+def _per_scene(text: str, field: str) -> str:
+    """``text`` with its default: the paper's, and the scene kinds' that differ."""
+    paper = Scene.default(field)
+    own = [f"{name} {kind.defaults[field]:g}" for name, kind in scenes().items() if field in kind.defaults]
+    head = f"default {paper:g}" if paper is not None else "default"
+    return f"{text} ({head}" + ("; " if paper is not None and own else " ") + ", ".join(own) + ")"
+
+
 def _scene_help() -> str:
     return "the problem: " + "; ".join(f"{name}: {kind.summary}" for name, kind in scenes().items())
 
@@ -83,8 +92,27 @@ def _scene_help() -> str:
 PROBLEM = (
     Parameter("name", "--scene", _scene_help, scene_names),
     Parameter("mach", "--mach", "the pulse's amplitude as a Mach number", numeric=True),
-    Parameter("pulse_width", "--pulse-width", "the pulse's width, m", numeric=True),
-    Parameter("pulse_center", "--pulse-center", "the pulse's centre x at t = 0, m", numeric=True),
+    Parameter(
+        "pulse_width",
+        "--pulse-width",
+        lambda: _per_scene("the pulse's width, m", "pulse_width"),
+        numeric=True,
+        per_scene=True,
+    ),
+    Parameter(
+        "pulse_center",
+        "--pulse-center",
+        lambda: _per_scene("the pulse's centre x at t = 0, m", "pulse_center"),
+        numeric=True,
+        per_scene=True,
+    ),
+    Parameter(
+        "cylinder_radius",
+        "--cylinder-radius",
+        lambda: _per_scene("the rigid cylinder's radius, m, in the scenes with a body", "cylinder_radius"),
+        numeric=True,
+        per_scene=True,
+    ),
     Parameter("x_max", "--wall-x", _wall_help, numeric=True, per_scene=True),
 )
 BOUNDARY = (
@@ -118,6 +146,16 @@ BOUNDARY = (
         per_scene=True,
     ),
 )
+BODY = (
+    Parameter(
+        "boundary_method",
+        "--boundary-method",
+        "how a body's curved wall is modelled (solvers/bodies/: ghost particles on rings fitted to its surface, "
+        f"or on the lattice inside it; default {DEFAULT_BOUNDARY_METHOD})",
+        boundary_method_names,
+        per_scene=True,
+    ),
+)
 PRECISION_MODEL = (
     Parameter("precision", "--precision", "floating-point precision", lambda: PRECISIONS),
     Parameter("model", "--model", "the physics model", lambda: MODELS),
@@ -129,7 +167,7 @@ METHOD = (
     Parameter("h_factor", "--h-factor", "h / dx", numeric=True),
     Parameter("cfl", "--cfl", "dt * c0 / dx", numeric=True),
 )
-PARAMETERS = PROBLEM + BOUNDARY + PRECISION_MODEL + METHOD
+PARAMETERS = PROBLEM + BOUNDARY + BODY + PRECISION_MODEL + METHOD
 
 
 def parameter(field: str) -> Parameter:

@@ -17,6 +17,8 @@ import os
 from dataclasses import dataclass
 
 from solvers import Scene, SceneError, check_pair_loop, resolve_pair_loop, solver_class
+from solvers.scene import PAPER_PULSE, PER_KIND
+from solvers.scenes import scene_kind
 
 SERIAL = 1
 ALL_CORES = "all"
@@ -156,7 +158,15 @@ def stored_parameters(scene: dict) -> dict:
     its default: the value runs had before the parameter existed (rows without ``kernel`` are Gaussian). The
     one place old rows are brought up to the current fields (the frame, the resume key, scene_from_row)."""
     fields = Scene.__dataclass_fields__
-    return {k: fields[k].default if scene.get(k) is None else scene[k] for k in fields if fields[k].compare}
+    out = {k: fields[k].default if scene.get(k) is None else scene[k] for k in fields if fields[k].compare}
+    try:
+        kind = scene_kind(out["name"])
+    except ValueError:  # a plug-in's scene not installed here: its row keeps what it stored
+        return out
+    for k in PER_KIND:  # parameters whose default is the scene kind's: the value a Scene resolves
+        if out[k] is None:
+            out[k] = kind.defaults.get(k, PAPER_PULSE.get(k))
+    return out
 
 
 def scene_from_row(row) -> Scene:

@@ -34,7 +34,7 @@ class AllPairCPU(Solver):
     search = "all-pair"
     neighbour_search = AllPairs
     order = 2.0
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")  # periodic axes by the minimum image
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")  # periodic: the minimum image
 
     def snp(self) -> None:
         """Nothing to build: the all-pair search happens inside the interaction loop."""

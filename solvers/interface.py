@@ -177,6 +177,16 @@ class Solver(abc.ABC):
         }
         for name in RATES + ("vol", "pr"):
             a[name] = xp.zeros(s.n_particles, dt)
+        self.body = None
+        if s.body is not None:  # a rigid body: its particles' roles and places (solvers/bodies/)
+            from solvers.bodies import Body, boundary_method_named
+
+            self.body = Body(boundary_method_named(s.boundary_method_used), s)
+            role, shift_x, shift_y = (xp.asarray(v) for v in self.body.place(self.to_host(x), self.to_host(y)))
+            a["role"] = role.astype(dt)
+            a["sx"], a["sy"] = shift_x.astype(dt), shift_y.astype(dt)
+            for name in ("u", "v", "drho"):
+                a[name][role != 0] = 0
         if self.split:  # a split absorber's x parts of drho and of its rate (drho_y = drho - drho_x)
             a["drho_x"] = (0.5 * drho).astype(dt)
             a["ddx"] = xp.zeros(s.n_particles, dt)
@@ -184,6 +194,7 @@ class Solver(abc.ABC):
         self.arrays = a
         self.saved = {}
         self.t = 0.0
+        self.reordered = 0  # how many times the arrays were put in a new order (a body's indices follow it)
         self.after_init()
 
     def after_init(self) -> None:
@@ -199,10 +210,21 @@ class Solver(abc.ABC):
     def rates(self, continuity: bool, momentum: bool) -> None:
         """PI: fill dd (continuity) and/or ax, ay (momentum) from the current state (and ddx, the x part of dd,
         for a split absorber)."""
+        self.fill_body()
         self.coefficients(continuity, momentum)
         self._sweep(continuity, momentum)
         if continuity and self.split:
             self.continuity_x()
+
+    def fill_body(self) -> None:
+        """A body's ghost particles take the fluid's values mirrored across its wall (solvers/bodies/)."""
+        if self.body is not None:
+            self.body.fill(self)
+
+    def pin_body(self) -> None:
+        """A body's particles back at their places after an advance that moved particles."""
+        if self.body is not None and self.moving:
+            self.body.pin(self)
 
     def coefficients(self, continuity: bool, momentum: bool) -> None:
         """Per-particle coefficients of the sweeps: vol = m / rho (continuity), pr = c0^2 drho / rho^2 (momentum)."""
@@ -247,6 +269,7 @@ class Solver(abc.ABC):
             self.moving,
         )
         self.advance_split(f)
+        self.pin_body()
         self.t += f * self.scene.dt
 
     def advance_split(self, f: float) -> None:
@@ -304,6 +327,7 @@ class Solver(abc.ABC):
 
     def permute(self, order) -> None:
         """Reorder every per-particle array (state, rates, saved copies) by ``order``."""
+        self.reordered += 1
         for store in (self.arrays, self.saved):
             for name, arr in store.items():
                 store[name] = self.gathered(arr, order)

@@ -54,7 +54,7 @@ class LinkedListCPU(CellListSolver):
     )
     pair_loops = ("list", "gather")
     threaded = True
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         super().__init__(threads=threads or 1, pair_loop=pair_loop)

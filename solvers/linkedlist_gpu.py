@@ -42,7 +42,7 @@ class LinkedListGPU(CellListSolver):
     device = "gpu"
     serial_why = "one GPU thread per particle"
     resources = {"timing": 1, "GPU": 1}
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y")
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")
     neighbour_search = DeviceCellList
 
     @classmethod
@@ -114,6 +114,7 @@ class LinkedListGPU(CellListSolver):
         self.nnps.bin(a["lx"], a["ly"], a["sx"], a["sy"])
         self.launch("scatter", *self.nnps.scatter_arguments(self.blocks_of[now], self.blocks_of[1 - now], now))
         self.set_state(1 - now)
+        self.reordered += 1
         for name, arr in self.saved.items():  # two-stage integrators' copies (not in a Verlet step)
             self.saved[name] = self.gathered(arr, self.nnps.order)
 
@@ -127,7 +128,11 @@ class LinkedListGPU(CellListSolver):
         self.nnps.use(current)
 
     def rates(self, continuity: bool, momentum: bool) -> None:
-        """PI; the coefficients only when drho changed since the system update last wrote them."""
+        """PI; the coefficients only when drho changed since the system update last wrote them (a body's
+        ghosts take new values first: then always)."""
+        if self.body is not None:
+            self.fill_body()
+            self.coefficients_fresh = False
         if not self.coefficients_fresh:
             self.coefficients(True, True)
             self.coefficients_fresh = True
@@ -154,6 +159,7 @@ class LinkedListGPU(CellListSolver):
             self.k,
         )
         self.advance_split(f)
+        self.pin_body()
         self.t += f * self.scene.dt
         self.coefficients_fresh = True
 

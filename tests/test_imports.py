@@ -156,7 +156,14 @@ def test_no_private_imports():
 # data flow of ARCHITECTURE.md: scene -> solver -> stage clock -> run record -> store -> reports). A module's
 # layer is that of the longest prefix here that names it.
 LAYERS = (
-    ("solvers.plugins", "solvers.kernels", "solvers.absorbers", "solvers.jitcache"),  # registries, kernels, absorbers
+    (
+        "solvers.plugins",
+        "solvers.kernels",
+        "solvers.absorbers",
+        "solvers.bodies",
+        "solvers.jitcache",
+    ),  # registries, kernels,
+    # absorbers, boundary methods
     ("solvers.physics",),  # the rates per pair and the integrators, for every backend
     ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method"),  # the problem
     ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops

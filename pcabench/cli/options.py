@@ -11,7 +11,7 @@ import tempfile
 from pathlib import Path
 
 from pcabench.machine import memory
-from pcabench.parameters import BOUNDARY, METHOD, PARAMETERS, PRECISION_MODEL, PROBLEM
+from pcabench.parameters import BODY, BOUNDARY, METHOD, PARAMETERS, PRECISION_MODEL, PROBLEM
 from pcabench.spec import OptionError, parse_threads
 from solvers import (
     DEFAULT_SCENE,
@@ -121,7 +121,7 @@ def add_method_options(p: argparse.ArgumentParser, many: bool = False) -> None:
 def add_problem_options(p: argparse.ArgumentParser, many: bool = False) -> None:
     """The problem's options: the scene kind, its physical parameters and its open edges, with Scene's
     defaults."""
-    add_parameter_options(p, PROBLEM + BOUNDARY, many)
+    add_parameter_options(p, PROBLEM + BOUNDARY + BODY, many)
     if not many:
         p.add_argument(
             "--domain-size",

@@ -20,6 +20,7 @@ from pcabench.machine.memory import is_out_of_memory
 from pcabench.spec import RunSpec
 from pcabench.store.record import RunRecord
 from solvers import SceneError, jitcache, make_solver
+from solvers.bodies import BodyEntered
 from solvers.physics.integrators import step_program
 from solvers.reference.dispersion import predicted_primary
 from solvers.scenes.base import scored_axes
@@ -49,7 +50,7 @@ def reflected(scene, fields) -> dict:
     difference over the initial pulse's peak) and ``reflected_energy`` (the sum of its squares over the initial
     primary field's, per site). Nothing for a closed scene, or for the moving models, whose prediction is their
     linear part only. The run's scorer adds it (:func:`score`), so that a prediction is never scored by itself."""
-    if scene.model != "linear" or not scene.open:
+    if scene.model != "linear" or not scene.open or scene.body is not None:  # a body: no prediction
         return {}
     primary = fields.drho if scene.kind.primary == "drho" else fields.u
     d = np.asarray(primary, float) - predicted_primary(scene, fields)
@@ -163,7 +164,7 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None, score
                 record.stages = clock.totals()
             except Exception:  # noqa: BLE001
                 pass
-        if record.status == "error":
+        if record.status == "error" and not isinstance(exc, BodyEntered):  # the message says it all
             import traceback
 
             record.message += "\n" + traceback.format_exc(limit=8)

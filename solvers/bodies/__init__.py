@@ -1,0 +1,25 @@
+"""Rigid bodies' curved walls: the boundary methods, one file each (see base.py), found by registry.py."""
+
+from __future__ import annotations
+
+from solvers.bodies.base import GHOST, INERT, Body, BodyEntered, BoundaryMethod
+from solvers.bodies.registry import (
+    BOUNDARY_METHODS,
+    DEFAULT_BOUNDARY_METHOD,
+    ENTRY_POINT_GROUP,
+    boundary_method_named,
+    boundary_method_names,
+)
+
+__all__ = [
+    "GHOST",
+    "INERT",
+    "Body",
+    "BodyEntered",
+    "BoundaryMethod",
+    "BOUNDARY_METHODS",
+    "DEFAULT_BOUNDARY_METHOD",
+    "ENTRY_POINT_GROUP",
+    "boundary_method_named",
+    "boundary_method_names",
+]

@@ -1,0 +1,198 @@
+"""What a boundary method is: how a rigid body's curved wall is modelled by particles inside it, one file each.
+
+A body (``Scene.body``: a cylinder of radius a, its axis at x0, y0) holds the lattice sites inside it. A boundary
+method says which of them are the wall's particles (ghosts) and where they sit (:meth:`BoundaryMethod.place`);
+the others inside are inert (zero fields: deeper than any fluid particle's kernel reaches). Before every sweep
+the solver gives each ghost the fluid's values mirrored across the wall (:meth:`Body.fill`): drho (so the
+pressure) even, the normal velocity odd and the tangential one even, the conditions of a rigid wall for the
+linear acoustic equations (u . n = 0 and dp/dn = 0), sampled at the ghost's mirror point across the surface
+(:meth:`BoundaryMethod.sample_points`) from the fluid particles within a cutoff of it by first-order moving
+least squares (exact for linear fields; Shepard's average where too few neighbours make it singular): the
+fixed ghost particles of Marrone et al. (2011). The body's particles never move (put back after every advance:
+:meth:`Body.pin`), and a fluid particle inside the body stops the run (:class:`BodyEntered`).
+
+Every solver applies a body through the same primitives (solvers/interface.py), on any backend: the few
+particles near the body are found on the device and their values copied to the host, where the sampling
+weights are built (scipy's cKDTree), once for particles that do not move and before every sweep for those
+that do.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+FLUID, GHOST, INERT = 0.0, 1.0, 2.0  # a particle's role (the solver's ``role`` array)
+
+
+class BodyEntered(RuntimeError):
+    """A fluid particle moved inside the body: the run has failed at this step."""
+
+
+class BoundaryMethod:
+    """Where a body's ghost particles sit (:meth:`place`) and where the fluid is sampled for their values
+    (:meth:`sample_points`: by default their mirror points across the wall)."""
+
+    name: str = ""
+    summary: str = ""
+
+    def place(self, scene, x, y) -> tuple:
+        """(ghost, inert, gx, gy) for the lattice sites at ``x``, ``y`` (m, float64 arrays, site order): which
+        sites are ghosts and which inert (boolean arrays), and the ghosts' positions (m, in the order of their
+        sites)."""
+        raise NotImplementedError
+
+    def sample_points(self, scene, gx, gy) -> tuple:
+        """(sx, sy, nx, ny): where the fluid is sampled for each ghost at ``gx``, ``gy`` and the wall's outward
+        normal there: the mirror point across the cylinder's surface, r -> 2a - r."""
+        x0, y0, a = scene.body
+        px, py = gx - x0, gy - y0
+        r = np.maximum(np.hypot(px, py), 1e-12 * a)
+        nx, ny = px / r, py / r
+        mirror = 2.0 * a - r
+        return x0 + mirror * nx, y0 + mirror * ny, nx, ny
+
+    def __repr__(self) -> str:
+        return f"<boundary method {self.name}>"
+
+
+def sites_inside(scene, x, y):
+    """(r, inside): the sites' distances from the body's axis (m) and which are inside it (r < a)."""
+    x0, y0, a = scene.body
+    r = np.hypot(np.asarray(x, float) - x0, np.asarray(y, float) - y0)
+    return r, r < a
+
+
+def mls_weights(scene, points, fluid, volume: float):
+    """The sampling matrix (scipy CSR, points x fluid): row p holds the weights that give a field's value at
+    ``points[p]`` from its values at the ``fluid`` positions ((m, 2) arrays, m), by first-order moving least
+    squares with the scene's kernel W (cut at its cutoff) and each particle's ``volume`` (m^2); Shepard's
+    normalised average where the moment matrix is near singular (fewer than 6 neighbours, or all to one side
+    of a line)."""
+    from scipy.sparse import csr_matrix
+    from scipy.spatial import cKDTree
+
+    h, cutoff = scene.h, scene.cutoff
+    tree = cKDTree(fluid)
+    lists = tree.query_ball_point(points, cutoff)
+    counts = np.array([len(n) for n in lists], dtype=np.int64)
+    rows = np.repeat(np.arange(len(points)), counts)
+    cols = np.concatenate([np.asarray(n, dtype=np.int64) for n in lists]) if counts.sum() else np.zeros(0, np.int64)
+    d = (fluid[cols] - points[rows]) / h  # in units of h: a well-scaled basis
+    w = scene.sph_kernel.value(np.hypot(d[:, 0], d[:, 1]) * h, h) * volume
+    basis = np.stack([np.ones_like(w), d[:, 0], d[:, 1]], axis=1)
+    moments = np.zeros((len(points), 3, 3))
+    for i in range(3):
+        for j in range(3):
+            moments[:, i, j] = np.bincount(rows, weights=w * basis[:, i] * basis[:, j], minlength=len(points))
+    total = moments[:, 0, 0]
+    det = np.linalg.det(moments)
+    good = (counts >= 6) & (total > 0) & (np.abs(det) > 1e-6 * np.maximum(total, 1e-300) ** 3)
+    coef = np.zeros((len(points), 3))
+    if good.any():
+        coef[good] = np.linalg.solve(moments[good], np.tile([1.0, 0.0, 0.0], (int(good.sum()), 1))[..., None])[..., 0]
+    shepard = ~good & (total > 0)
+    coef[shepard, 0] = 1.0 / total[shepard]
+    psi = w * np.einsum("pk,pk->p", coef[rows], basis)
+    return csr_matrix((psi, (rows, cols)), shape=(len(points), len(fluid)))
+
+
+class Body:
+    """A scene's body in a solver: its particles' roles and places (:meth:`place`, at init), the ghosts'
+    values before every sweep (:meth:`fill`), the body's particles put back after every advance (:meth:`pin`)."""
+
+    def __init__(self, method: BoundaryMethod, scene):
+        self.method, self.scene = method, scene
+        self.x0, self.y0, self.a = scene.body
+        # the fluid a ghost's sample point can reach: a cutoff beyond the deepest mirror point
+        self.reach = self.a + 2.0 * scene.cutoff + 2.0 * scene.dx
+        self.key = None
+
+    def place(self, x, y) -> tuple:
+        """(role, sx, sy): each site's role (FLUID, GHOST, INERT) and shift to its place (m), float64 arrays in
+        site order, from the sites' positions ``x``, ``y`` (m)."""
+        s = self.scene
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        ghost, inert, gx, gy = self.method.place(s, x, y)
+        role = np.full(x.size, FLUID)
+        role[ghost], role[inert] = GHOST, INERT
+        sx, sy = np.zeros(x.size), np.zeros(x.size)
+        sx[ghost], sy[ghost] = gx - x[ghost], gy - y[ghost]
+        self.body_ids = np.flatnonzero(role != FLUID)  # site ids (id = row * nx + column), sorted
+        self.body_sx, self.body_sy = sx[self.body_ids], sy[self.body_ids]
+        self.ghost_ids = np.flatnonzero(ghost)
+        px, py, nx, ny = self.method.sample_points(s, gx, gy)
+        self.samples = np.stack([px, py], axis=1)
+        self.normals = np.stack([nx, ny], axis=1)
+        self.n_ghosts, self.n_inert = int(ghost.sum()), int(inert.sum())
+        return role, sx, sy
+
+    def _ids(self, a, idx, to_host):
+        s = self.scene
+        lx, ly = (np.rint(to_host(a[k][idx])).astype(np.int64) for k in ("lx", "ly"))
+        return (ly % s.ny) * s.nx + lx % s.nx
+
+    def locate(self, solver) -> None:
+        """The body's particles and the fluid near it in the solver's current order, and the sampling matrix;
+        BodyEntered if a fluid particle is inside the body."""
+        s, a, xp, to_host = self.scene, solver.arrays, solver.xp, solver.to_host
+        px = s.x_lo + (a["lx"].astype(xp.float64) + 0.5) * s.dx + a["sx"]
+        py = s.y_lo + (a["ly"].astype(xp.float64) + 0.5) * s.dx + a["sy"]
+        near = to_host(xp.flatnonzero((px - self.x0) ** 2 + (py - self.y0) ** 2 < self.reach**2)).astype(np.int64)
+        role = to_host(a["role"][near])
+        pos = np.stack([to_host(px[near]), to_host(py[near])], axis=1)
+        fluid = role == FLUID
+        r = np.hypot(pos[:, 0] - self.x0, pos[:, 1] - self.y0)
+        entered = fluid & (r < self.a)
+        if entered.any():
+            raise BodyEntered(
+                f"{int(entered.sum())} fluid particle(s) inside the cylinder (r < {self.a:g} m, the deepest at "
+                f"r = {r[entered].min():.4g} m): the wall let them through"
+            )
+        body = near[~fluid]
+        order = np.searchsorted(self.body_ids, self._ids(a, body, to_host))
+        self.body_idx, self.body_at = body, order  # solver indices, and each one's entry in body_ids
+        ghosts = role[~fluid] == GHOST
+        ghost_idx = body[ghosts]
+        self.ghost_idx = ghost_idx
+        self.ghost_at = np.searchsorted(self.ghost_ids, self._ids(a, ghost_idx, to_host))
+        self.inert_idx = body[~ghosts]
+        self.fluid_idx = near[fluid]
+        self.weights = mls_weights(s, self.samples[self.ghost_at], pos[fluid], s.dx * s.dx)
+        self.normal = self.normals[self.ghost_at]
+        dev = (lambda v: xp.asarray(v)) if xp is not np else (lambda v: v)
+        self.dev_ghost, self.dev_inert, self.dev_body = dev(ghost_idx), dev(self.inert_idx), dev(body)
+        self.dev_fluid = dev(self.fluid_idx)
+        self.dev_body_sx, self.dev_body_sy = (dev(v[order].astype(solver.dtype)) for v in (self.body_sx, self.body_sy))
+
+    def fill(self, solver) -> None:
+        """The ghosts' fields from the fluid's, mirrored across the wall; the inert particles' zero."""
+        key = getattr(solver, "reordered", 0)
+        if solver.moving or key != self.key:
+            self.locate(solver)
+            self.key = key
+        a, xp, to_host, dt = solver.arrays, solver.xp, solver.to_host, solver.dtype
+        fid = self.dev_fluid
+        drho, u, v = (self.weights @ to_host(a[k][fid]).astype(np.float64) for k in ("drho", "u", "v"))
+        un = u * self.normal[:, 0] + v * self.normal[:, 1]
+        u, v = u - 2.0 * un * self.normal[:, 0], v - 2.0 * un * self.normal[:, 1]
+        for name, values in (("drho", drho), ("u", u), ("v", v)):
+            a[name][self.dev_ghost] = xp.asarray(values.astype(dt))
+            a[name][self.dev_inert] = 0
+        if "drho_x" in a:  # a split absorber's x part: half (the layer is far from the body)
+            a["drho_x"][self.dev_ghost] = xp.asarray((0.5 * drho).astype(dt))
+            a["drho_x"][self.dev_inert] = 0
+
+    def pin(self, solver) -> None:
+        """The body's particles back at their places (for moving particles, after every advance)."""
+        if self.key is None:
+            return
+        a = solver.arrays
+        a["sx"][self.dev_body] = self.dev_body_sx
+        a["sy"][self.dev_body] = self.dev_body_sy
+
+
+def ring_count(radius: float, dx: float) -> int:
+    """Particles on a ring of ``radius`` m about dx apart."""
+    return max(int(round(2.0 * math.pi * radius / dx)), 1)

@@ -1,0 +1,30 @@
+"""The boundary-method registry: every way pcabench models a body's curved wall (solvers/bodies/, one file each;
+plug-ins through the entry-point group ``pcabench.boundary_methods``), by the one
+:class:`~solvers.plugins.Registry` mechanism."""
+
+from __future__ import annotations
+
+from solvers.bodies.base import BoundaryMethod
+from solvers.plugins import Registry
+
+ENTRY_POINT_GROUP = "pcabench.boundary_methods"
+DEFAULT_BOUNDARY_METHOD = "rings"
+
+BOUNDARY_METHODS = Registry(
+    "boundary method",
+    "solvers.bodies",
+    BoundaryMethod,
+    group=ENTRY_POINT_GROUP,
+    default=DEFAULT_BOUNDARY_METHOD,
+    make=lambda cls: cls(),
+    option="--boundary-method",
+)
+
+
+def boundary_method_names() -> tuple[str, ...]:
+    return BOUNDARY_METHODS.names()
+
+
+def boundary_method_named(name: str) -> BoundaryMethod:
+    """The boundary method ``name``; ValueError naming --boundary-method and the choices otherwise."""
+    return BOUNDARY_METHODS.get(name)

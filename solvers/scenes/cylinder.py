@@ -1,0 +1,179 @@
+"""The CAA workshop's pulse scattered by a rigid circular cylinder (Second CAA Workshop, category 1, problem 2).
+
+A cylinder of radius a = ``cylinder_radius`` (0.5 m) with its axis at the origin, the Gaussian pulse
+drho = rho0 Ma exp(-ln2 ((x - xp)^2 + y^2) / b^2) at rest at (xp, 0) = (``pulse_center``, 0) = (4, 0) m with
+b = ``pulse_width`` = 0.2 m, c0 = 1 m/s, in the open plane: the square [-6, 6]^2 m with its four edges open
+(an absorbing layer beyond each: the scene is an open problem, its edges are always open). The cylinder's wall
+is modelled by a boundary method (``boundary_method``, solvers/bodies/). The exact linear reference is the
+series solution (solvers/reference/cylinder.py: the free pulse plus the scattered field).
+
+The workshop observes p = c0^2 drho at A (r = 5 m, 90 deg), B (5 m, 135 deg) and C (5 m, 180 deg) over
+6 <= t <= 10 s. Error measures (the primary field is drho, over the fluid of the scored domain): the relative
+RMS and max error, and apart the RMS near the body (the fluid within 3 cutoffs of its surface, ``near_rms``)
+and away from it (``far_rms``), each over the RMS of the reference over the whole fluid (their squares,
+weighted by each band's share of the particles, add up to the whole's square).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from solvers.scenes.base import PULSE_WIDTH_RANGE, SceneKind
+
+LN2 = math.log(2.0)
+NEAR_CUTOFFS = 3.0  # the near-body band: the fluid within this many cutoffs of the surface
+CLEAR_WIDTHS = 4.5  # the pulse's edge: exp(-ln2 4.5^2) = 8e-7 of its peak; the body and the edges keep clear
+PROBES = {"A": (5.0, 90.0), "B": (5.0, 135.0), "C": (5.0, 180.0)}  # the workshop's points: r (m), angle (deg)
+
+
+def probe_points(scene) -> dict:
+    """{name: (x, y)} of the workshop's observation points about the body's axis, m."""
+    x0, y0, _a = scene.body
+    return {
+        name: (x0 + r * math.cos(math.radians(deg)), y0 + r * math.sin(math.radians(deg)))
+        for name, (r, deg) in PROBES.items()
+    }
+
+
+class Cylinder(SceneKind):
+    name = "cylinder"
+    summary = (
+        "the CAA workshop's pulse scattered by a rigid cylinder (radius 0.5 m at the origin) in the open plane; "
+        "--boundary-method models its wall"
+    )
+    periodic = ("x", "y")
+    images = ("x", "y")  # open: the square's edges are the open plane's (always open here)
+    domain = {"x_min": -6.0, "x_max": 6.0, "y_min": -6.0, "y_max": 6.0}
+    defaults = {"pulse_width": 0.2, "pulse_center": 4.0, "cylinder_radius": 0.5, "open": "xy"}
+    fields = ("drho",)
+    primary = "drho"
+    body = True
+
+    def body_of(self, scene) -> tuple:
+        return 0.0, 0.0, float(scene.cylinder_radius)
+
+    def check(self, scene) -> list[str]:
+        out = super().check(scene)
+        a, b = scene.cylinder_radius, scene.pulse_width
+        if scene.open != "xy":
+            out.append(
+                f"--open: the cylinder scene is sound in the open plane, its four edges are always open "
+                f"(--open xy; got {scene.open!r})"
+            )
+        if not (isinstance(a, (int, float)) and math.isfinite(a) and a > 0):
+            out.append(f"--cylinder-radius must be > 0 m (got {a!r})")
+            return out
+        reach = a + scene.cutoff
+        if not (scene.x_min + reach <= 0 <= scene.x_max - reach and scene.y_min + reach <= 0 <= scene.y_max - reach):
+            out.append(
+                f"--cylinder-radius: the cylinder (radius {a:g} m at the origin) must lie inside the domain "
+                f"[{scene.x_min:g}, {scene.x_max:g}] x [{scene.y_min:g}, {scene.y_max:g}] m, a cutoff "
+                f"({scene.cutoff:.3g} m) from its edges"
+            )
+        gap = abs(scene.pulse_center) - a
+        if gap < CLEAR_WIDTHS * b:
+            out.append(
+                f"--pulse-center: the pulse overlaps the cylinder: its centre must be at least "
+                f"{CLEAR_WIDTHS:g} pulse widths ({CLEAR_WIDTHS * b:.3g} m) from the surface, |x| >= "
+                f"{a + CLEAR_WIDTHS * b:.4g} m (got {scene.pulse_center:g})"
+            )
+        if not scene.x_min + CLEAR_WIDTHS * b <= scene.pulse_center <= scene.x_max - CLEAR_WIDTHS * b:
+            out.append(
+                f"--pulse-center: the pulse must be inside the domain, {CLEAR_WIDTHS:g} pulse widths from its "
+                f"edges: in [{scene.x_min + CLEAR_WIDTHS * b:.4g}, {scene.x_max - CLEAR_WIDTHS * b:.4g}] m "
+                f"(got {scene.pulse_center:g})"
+            )
+        if scene.dx > 0.25 * a:
+            out.append(
+                f"--dx must be at most a quarter of the cylinder's radius, {0.25 * a:g} m, for its wall to hold "
+                f"particles (got {scene.dx:g})"
+            )
+        return out
+
+    def initial_fields(self, scene, x, y, xp):
+        r2 = (x - scene.pulse_center) ** 2 + y**2
+        drho = scene.rho0 * scene.mach * xp.exp(-LN2 * r2 / scene.pulse_width**2)
+        zero = xp.zeros_like(drho)
+        return zero, zero.copy(), drho
+
+    def reference(self, scene, t_max: float | None = None):
+        """The exact linear solution (solvers/reference/cylinder.CylinderPulse) for this scene, up to ``t_max``."""
+        from solvers.reference.cylinder import CylinderPulse
+
+        x0, y0, a = scene.body
+        corner = max(math.hypot(x - x0, y - y0) for x in (scene.x_min, scene.x_max) for y in (scene.y_min, scene.y_max))
+        return CylinderPulse(
+            a,
+            scene.pulse_width,
+            scene.pulse_center,
+            0.0,
+            scene.rho0 * scene.mach,
+            scene.c0,
+            x0,
+            y0,
+            t_max=max(t_max if t_max is not None else scene.t_final, 1e-9),
+            r_max=corner + 2 * scene.cutoff,
+        )
+
+    def fluid(self, scene, fields):
+        """Which of a run's output points are fluid: outside the body."""
+        x0, y0, a = scene.body
+        return np.hypot(np.asarray(fields.x) - x0, np.asarray(fields.y) - y0) >= a
+
+    def errors(self, scene, fields) -> dict:
+        x0, y0, a = scene.body
+        keep = self.fluid(scene, fields)
+        x, y = np.asarray(fields.x)[keep], np.asarray(fields.y)[keep]
+        drho = np.asarray(fields.drho, float)[keep]
+        ref = self.reference(scene).field(x, y, fields.t)
+        d = drho - ref
+        nan = float("nan")
+        if not np.all(np.isfinite(d)):
+            return {"mse": nan, "me": nan, "near_rms": nan, "far_rms": nan}
+        scale = float(np.mean(ref**2))
+        near = np.hypot(x - x0, y - y0) < a + NEAR_CUTOFFS * scene.cutoff
+        n = d.size
+        return {
+            "mse": float(np.sqrt(np.mean(d**2) / scale)),
+            "me": float(np.max(np.abs(d))),
+            "near_rms": float(np.sqrt(np.sum(d[near] ** 2) / max(near.sum(), 1) / scale)),
+            "far_rms": float(np.sqrt(np.sum(d[~near] ** 2) / max(n - near.sum(), 1) / scale)),
+        }
+
+    def exact_fields(self, scene, t: float):
+        from solvers.interface import Fields
+
+        nx, ny = scene.nx - 2 * scene.layer_columns, scene.ny - 2 * scene.layer_rows
+        x = scene.x_min + (np.arange(nx) + 0.5) * scene.dx
+        y = scene.y_min + (np.arange(ny) + 0.5) * scene.dx
+        gx, gy = (g.ravel() for g in np.meshgrid(x, y))
+        drho = self.reference(scene, t).field(gx, gy, t)
+        zero = np.zeros_like(drho)
+        return Fields(x=gx, y=gy, u=zero, v=zero.copy(), drho=np.nan_to_num(drho), t=t)
+
+    def predict(self, scene):
+        raise NotImplementedError("the cylinder scene has no dispersion prediction: the body is off the lattice")
+
+    def tiny(self, scene):
+        """A small square with the body, for the warm-up: a few thousand particles."""
+        a = scene.cylinder_radius
+        width = max(PULSE_WIDTH_RANGE[0], 0.4 * a)
+        centre = a + CLEAR_WIDTHS * width + 0.2 * a
+        half = centre + CLEAR_WIDTHS * width + 0.2 * a
+        return scene.replace(
+            dx=0.25 * a,
+            x_min=-half,
+            x_max=half,
+            y_min=-half,
+            y_max=half,
+            pulse_center=centre,
+            pulse_width=width,
+            layer_width=None,
+            steps=2,
+            t_end=None,
+            mach=scene.default("mach"),
+            h_factor=scene.default("h_factor"),
+            cutoff_factor=min(scene.cutoff_factor, 3.0),
+        )
