@@ -48,6 +48,7 @@ class Fields:
     v: np.ndarray
     drho: np.ndarray
     t: float
+    probes: dict | None = None  # {"t": times (s), name: drho there (kg/m^3)} recorded at the scene's probe points
 
     def save(self, path) -> None:
         np.savez(path, x=self.x, y=self.y, u=self.u, v=self.v, drho=self.drho, t=self.t)
@@ -359,6 +360,31 @@ class Solver(abc.ABC):
 
     def to_host(self, arr) -> np.ndarray:
         return np.asarray(arr)
+
+    def sample(self, points) -> np.ndarray:
+        """drho (kg/m^3, float64) at ``points`` ((p, 2), m) from the fluid particles within a cutoff of each, by
+        first-order moving least squares (solvers/sampling.py): a probe's reading. The weights are kept while the
+        particles neither move nor change order."""
+        from solvers.sampling import mls_weights
+
+        s, a, xp = self.scene, self.arrays, self.xp
+        points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        key = (getattr(self, "reordered", 0), points.tobytes())
+        cached = getattr(self, "_probes", None)
+        if self.moving or cached is None or cached[0] != key:
+            px = s.x_lo + (a["lx"].astype(xp.float64) + 0.5) * s.dx + a["sx"]
+            py = s.y_lo + (a["ly"].astype(xp.float64) + 0.5) * s.dx + a["sy"]
+            near = xp.zeros(px.shape, dtype=bool)
+            for x, y in points:
+                near |= (px - x) ** 2 + (py - y) ** 2 < (s.cutoff * (1 + 1e-9)) ** 2
+            if "role" in a:
+                near &= a["role"] == 0
+            idx = xp.flatnonzero(near)
+            pos = np.stack([self.to_host(px[idx]), self.to_host(py[idx])], axis=1)
+            cached = (key, idx, mls_weights(s, points, pos, s.dx * s.dx))
+            self._probes = cached
+        _key, idx, weights = cached
+        return weights @ self.to_host(a["drho"][idx]).astype(np.float64)
 
     def amplitude(self) -> float:
         """max |u|, |v| over particles (NaN or inf if the state is not finite), m/s."""

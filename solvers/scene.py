@@ -80,6 +80,7 @@ class Scene:
     pulse_center: float | None = None  # pulse position at t = 0, m; None: the kind's (the paper's 0)
     cylinder_radius: float | None = None  # a rigid cylinder's radius, m (a scene kind with a body); None: the kind's
     boundary_method: str = ""  # how a body's curved wall is modelled (solvers/bodies/); "": the default
+    probes: tuple = ()  # points ((x, y), ...) m where a run records drho every few steps, beside the kind's own
     open: str = ""  # the edges that are open ("x": both x edges), by an absorbing layer beyond the domain;
     # "": the kind's (closed, but an open problem's: the cylinder's four edges)
     layer_width: float | None = None  # the layer's width, m (whole rows of dx); None: 2 pulse widths
@@ -112,6 +113,11 @@ class Scene:
                 object.__setattr__(self, key, kind.defaults.get(key, PAPER_PULSE.get(key)))
         if not self.open:
             object.__setattr__(self, "open", kind.defaults.get("open", ""))
+        try:
+            points = tuple((float(p[0]), float(p[1])) for p in self.probes or ())
+        except (TypeError, ValueError, IndexError):
+            raise SceneError(f"--probe takes points x,y in m (got {self.probes!r})") from None
+        object.__setattr__(self, "probes", points)
         self._validate()
 
     # ------------------------------------------------------------ validation
@@ -230,6 +236,7 @@ class Scene:
         for problem in self.kind.check(self):  # the scene kind's own parameters first: they name its options
             need(False, problem)
         self._validate_body(need, finite)
+        self._validate_probes(need)
         self._validate_open(need, finite)
         least = STRIP_CUTOFFS * self.cutoff
         need(
@@ -260,6 +267,30 @@ class Scene:
                 f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
                 f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m",
             )
+
+    def probe_points(self) -> dict:
+        """{name: (x, y)}: where a run records drho (the scene kind's points, then ``probes`` as P1, P2, ...), m."""
+        points = dict(self.kind.probe_points(self))
+        points.update({f"P{i + 1}": p for i, p in enumerate(self.probes)})
+        return points
+
+    def _validate_probes(self, need) -> None:
+        for x, y in self.probes:
+            need(
+                math.isfinite(x)
+                and math.isfinite(y)
+                and self.x_min <= x <= self.x_max
+                and self.y_min <= y <= self.y_max,
+                f"--probe {x:g},{y:g} is outside the domain [{self.x_min:g}, {self.x_max:g}] x "
+                f"[{self.y_min:g}, {self.y_max:g}] m",
+            )
+            if self.body is not None:
+                x0, y0, a = self.body
+                need(
+                    math.hypot(x - x0, y - y0) >= a + self.cutoff,
+                    f"--probe {x:g},{y:g} is inside the body or within a cutoff of its wall (r < "
+                    f"{a + self.cutoff:.4g} m from its axis)",
+                )
 
     def _validate_body(self, need, finite) -> None:
         """A body's parameters only where the kind has a body (its own checks are the kind's), and a known

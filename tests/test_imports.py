@@ -161,9 +161,9 @@ LAYERS = (
         "solvers.kernels",
         "solvers.absorbers",
         "solvers.bodies",
+        "solvers.sampling",
         "solvers.jitcache",
-    ),  # registries, kernels,
-    # absorbers, boundary methods
+    ),  # registries, kernels, absorbers, boundary methods, sampling between particles
     ("solvers.physics",),  # the rates per pair and the integrators, for every backend
     ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method"),  # the problem
     ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops

@@ -26,6 +26,7 @@ from solvers.reference.dispersion import predicted_primary
 from solvers.scenes.base import scored_axes
 
 FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.interface.Fields), each one per particle
+PROBE_SAMPLES = 1000  # the most readings a run records at each probe point (every few steps, evenly)
 
 
 def fields_problem(fields, n_particles: int) -> str:
@@ -81,6 +82,9 @@ def score(record: RunRecord, scene, fields) -> RunRecord:
     measures = dict(scene.kind.errors(scene, fields))  # against the scene's exact linear solution
     record.mse, record.me = measures.pop("mse"), measures.pop("me")
     record.errors = {**measures, **reflected(scene, fields)}  # open edges: what they sent back (linear runs)
+    if fields.probes:  # p(t) at the probe points: scored, and kept (rounded) for the figures
+        record.errors.update(scene.kind.probe_errors(scene, fields.probes))
+        record.probes = {k: [float(f"{v:.6g}") for v in np.asarray(vals, float)] for k, vals in fields.probes.items()}
     if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
         record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
     return record
@@ -93,7 +97,8 @@ def save_fields(fields, path) -> None:
     from pcabench.store.safeio import write_file
 
     buffer = io.BytesIO()
-    np.savez(buffer, **{name: getattr(fields, name) for name in FIELD_NAMES}, t=fields.t)
+    probes = {f"probe.{k}": np.asarray(v, dtype=np.float64) for k, v in (fields.probes or {}).items()}
+    np.savez(buffer, **{name: getattr(fields, name) for name in FIELD_NAMES}, t=fields.t, **probes)
     write_file(path, buffer.getvalue())
 
 
@@ -103,7 +108,27 @@ def load_fields(path):
     from solvers.interface import Fields
 
     with np.load(path, allow_pickle=False) as data:
-        return Fields(**{name: data[name] for name in FIELD_NAMES}, t=float(data["t"]))
+        probes = {k[len("probe.") :]: data[k] for k in data.files if k.startswith("probe.")}
+        return Fields(**{name: data[name] for name in FIELD_NAMES}, t=float(data["t"]), probes=probes or None)
+
+
+class Probes:
+    """drho at a scene's probe points, read every few steps (at most PROBE_SAMPLES readings, evenly in steps)."""
+
+    def __init__(self, solver, points: dict, n_steps: int):
+        self.solver, self.names = solver, list(points)
+        self.points = np.array([points[k] for k in self.names], dtype=np.float64)
+        self.stride = max(1, math.ceil(n_steps / PROBE_SAMPLES))
+        self.t, self.values = [], []
+
+    def read(self, step: int) -> None:
+        if step % self.stride == 0:
+            self.t.append(self.solver.t)
+            self.values.append(self.solver.sample(self.points))
+
+    def series(self) -> dict:
+        values = np.array(self.values).reshape(len(self.t), len(self.names))
+        return {"t": np.array(self.t), **{k: values[:, i] for i, k in enumerate(self.names)}}
 
 
 def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None, scored: bool = True) -> RunRecord:
@@ -130,9 +155,13 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None, score
         clock.time("input", solver.input, scene)
         clock.time("init", solver.init)
         bound = scene.blowup_factor * scene.mach * scene.c0
+        points = scene.probe_points()
+        probes = Probes(solver, points, scene.n_steps) if points else None
         for step in range(1, scene.n_steps + 1):
             for stage, op in step_program(scene.integrator, solver, first=(step == 1)):
                 clock.time(stage, op)
+            if probes is not None:
+                probes.read(step)  # outside the timed stages, like the amplitude check
             amp = solver.amplitude()
             if not math.isfinite(amp) or amp > bound:
                 record.status, record.failed_step = "unstable", step
@@ -144,6 +173,8 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None, score
                 progress(step, scene.n_steps)
         record.steps = step
         fields = clock.time("output", solver.output)
+        if probes is not None:
+            fields.probes = probes.series()
         record.stages = clock.totals()
         record.t_end = float(fields.t)
         if fields_path is not None:

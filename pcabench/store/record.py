@@ -41,6 +41,7 @@ class RunRecord:
     mse_isothermal: float | None = None  # relative RMS error of the primary field against the isothermal solution
     # (every model since the scene registry; lagrangian only before)
     errors: dict = field(default_factory=dict)  # the scene's other error measures (solvers/scenes/), by name
+    probes: dict = field(default_factory=dict)  # {"t": [s], name: [drho, kg/m^3]} at the scene's probe points
     scene: dict = field(default_factory=dict)
     message: str = ""
     profile_id: str = ""
@@ -126,6 +127,11 @@ class RunRecord:
             values[f.name] = value  # a contract field stored as null (an error never measured) stays None
         values["stages"] = {s: float(row["stages"][s]) for s in STAGES}
         values["errors"] = {k: v for k, v in (row.get("errors") or {}).items() if isinstance(v, (int, float))}
+        values["probes"] = {  # a reading that is not a list of numbers is dropped, not trusted
+            k: [float(x) for x in v]
+            for k, v in (row.get("probes") or {}).items()
+            if isinstance(v, list) and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
+        }
         values["scene"] = dict(row["scene"])
         values["versions"] = dict(row.get("versions") or {})
         return cls(**values)

@@ -103,6 +103,7 @@ FIELDS: dict[str, Field] = {
     "steps_requested": Field(("int",), low=0, high=MAX_STEPS),
     "mse_isothermal": _ERROR,
     "errors": Field(("dict",)),  # the scene's other error measures, by name: numbers or null
+    "probes": Field(("dict",)),  # readings at the scene's probe points, by name: lists of numbers
     "scene": Field(("dict",), True),
     "message": Field(("str",), max_len=MAX_MESSAGE),
     "profile_id": _name(required=True, empty=False, path=True),
@@ -156,6 +157,7 @@ SCENE_FIELDS: dict[str, Field] = {
     "absorber_strength": Field(("number", "null"), low=0, high=1e12, above=True),
     "cylinder_radius": Field(("number", "null"), low=0, high=1e12, above=True),
     "boundary_method": _name(max_len=32, pattern=SOLVER_NAME),
+    "probes": Field(("list",)),
 }
 
 

@@ -130,6 +130,15 @@ class SceneKind:
         periodic_y = "y" in self.periodic and "y" not in open_edges
         return frozenset(x | {"periodic-y" if periodic_y else "free-y"} | ({"body"} if self.body else set()))
 
+    def probe_points(self, scene) -> dict:
+        """{name: (x, y)} (m) where every run of this kind records drho: none by default (``--probe`` adds)."""
+        return {}
+
+    def probe_errors(self, scene, probes) -> dict:
+        """Error measures of the probes' readings ``probes`` ({"t": times, name: drho, ...}) against the exact
+        solution: none by default."""
+        return {}
+
     def body_of(self, scene) -> tuple:
         """(x0, y0, radius) of the body, m (a kind with ``body``)."""
         raise NotImplementedError

@@ -26,6 +26,7 @@ LN2 = math.log(2.0)
 NEAR_CUTOFFS = 3.0  # the near-body band: the fluid within this many cutoffs of the surface
 CLEAR_WIDTHS = 4.5  # the pulse's edge: exp(-ln2 4.5^2) = 8e-7 of its peak; the body and the edges keep clear
 PROBES = {"A": (5.0, 90.0), "B": (5.0, 135.0), "C": (5.0, 180.0)}  # the workshop's points: r (m), angle (deg)
+WINDOW = (6.0, 10.0)  # the workshop's window of p(t) at the probes, s
 
 
 def probe_points(scene) -> dict:
@@ -53,6 +54,31 @@ class Cylinder(SceneKind):
 
     def body_of(self, scene) -> tuple:
         return 0.0, 0.0, float(scene.cylinder_radius)
+
+    def probe_points(self, scene) -> dict:
+        return probe_points(scene)
+
+    def probe_errors(self, scene, probes) -> dict:
+        """The relative RMS of p = c0^2 drho at each probe over the workshop's window 6 <= t <= 10 s (to the run's
+        end; NaN before the window), ``probe_<name>``, and over all probes together, ``probe_rms``."""
+        t = np.asarray(probes["t"], dtype=np.float64)
+        inside = (t >= WINDOW[0] - 1e-9) & (t <= WINDOW[1] + 1e-9)
+        names = [k for k in probes if k != "t"]
+        nan = float("nan")
+        if inside.sum() < 2 or not names:
+            return {"probe_rms": nan, **{f"probe_{k}": nan for k in names}}
+        ref = self.reference(scene, float(t[inside].max()))
+        out, num, den = {}, 0.0, 0.0
+        points = scene.probe_points()
+        for name in names:
+            x, y = points[name]
+            exact = ref.drho(np.array([x]), np.array([y]), t[inside])[:, 0]
+            d = np.asarray(probes[name], dtype=np.float64)[inside] - exact
+            quiet = np.sqrt(np.mean(exact**2)) < 1e-6 * scene.rho0 * scene.mach  # no sound there yet
+            out[f"probe_{name}"] = nan if quiet else float(np.sqrt(np.sum(d**2) / np.sum(exact**2)))
+            num, den = num + float(np.sum(d**2)), den + float(np.sum(exact**2))
+        out["probe_rms"] = float(np.sqrt(num / den)) if np.isfinite(num) else nan
+        return out
 
     def check(self, scene) -> list[str]:
         out = super().check(scene)
