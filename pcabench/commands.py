@@ -54,6 +54,8 @@ def words_of(solver: str, scene, threads=SERIAL, pair_loop: str = "") -> tuple[l
             unset += [k for k in DOMAIN if k != "x_max" and not _same(domain[k], defaults[k])]
     if scene.strip_height is not None:
         words += ["--strip-height", number_word(scene.strip_height)]
+    for x, y in scene.probes:
+        words += ["--probe", f"{number_word(x)},{number_word(y)}"]
     for par in (p for p in PARAMETERS if p.field != "name"):  # every parameter the table declares
         value, default = getattr(scene, par.field), scene.default_of(par.field)
         if _same(value, default):

@@ -74,6 +74,11 @@ SCENES = {  # the scene kinds at their smallest: free-x, x-periodic, walled at o
         open="xy",
         layer_width=3.0,
     ),
+    # a rigid cylinder with its ghost particles (solvers/bodies/: the default boundary method), the pulse's flank
+    # at its wall from the first step (a solver that skips the ghosts' values, Solver.fill_body, fails agreement)
+    "cylinder": dict(
+        dx=0.125, name="cylinder", x_min=-3.3, x_max=3.3, y_min=-3.3, y_max=3.3, pulse_width=0.3, pulse_center=1.85
+    ),
 }
 # the paper's scene at 3,200 particles, checked once with the defaults: a solver wrong only past the tiny lattices'
 # few hundred particles (its cells, blocks or threads laid out otherwise) fails here

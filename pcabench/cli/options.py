@@ -73,6 +73,19 @@ def number(name, low: float | None = None):
     return parse
 
 
+def point(name):
+    def parse(text):
+        parts = text.split(",")
+        if len(parts) != 2 or not all(DECIMAL.fullmatch(x.strip()) for x in parts):
+            raise argparse.ArgumentTypeError(f"{name} takes a point x,y in m, such as 1.5,-2 (got {text!r})")
+        x, y = (float(v) for v in parts)
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
+        return x, y
+
+    return parse
+
+
 def folder(name):
     def parse(text):
         if not text.strip():
@@ -123,6 +136,14 @@ def add_problem_options(p: argparse.ArgumentParser, many: bool = False) -> None:
     defaults."""
     add_parameter_options(p, PROBLEM + BOUNDARY + BODY, many)
     if not many:
+        p.add_argument(
+            "--probe",
+            action="append",
+            type=point("--probe"),
+            metavar="X,Y",
+            help="a point (m) where the run records drho every few steps, beside the scene's own (the cylinder's "
+            "A, B, C); repeat for more",
+        )
         p.add_argument(
             "--domain-size",
             type=number("--domain-size"),
@@ -199,6 +220,7 @@ def scene_from_args(args) -> Scene:
         steps=args.steps,
         t_end=args.t_end,
         strip_height=args.strip_height,
+        probes=tuple(getattr(args, "probe", None) or ()),
         memory_limit_bytes=memory.available_memory_bytes(),
         **given,
         **domain_of(args),

@@ -24,7 +24,8 @@ from solvers.scenes.base import PULSE_WIDTH_RANGE, SceneKind
 
 LN2 = math.log(2.0)
 NEAR_CUTOFFS = 3.0  # the near-body band: the fluid within this many cutoffs of the surface
-CLEAR_WIDTHS = 4.5  # the pulse's edge: exp(-ln2 4.5^2) = 8e-7 of its peak; the body and the edges keep clear
+CLEAR_WIDTHS = 4.5  # the pulse's edge: exp(-ln2 4.5^2) = 8e-7 of its peak; the body keeps clear of it
+EDGE_WIDTHS = 3.0  # the domain's edges keep 3 widths from the pulse's centre (2e-3 of its peak; the layer beyond)
 PROBES = {"A": (5.0, 90.0), "B": (5.0, 135.0), "C": (5.0, 180.0)}  # the workshop's points: r (m), angle (deg)
 WINDOW = (6.0, 10.0)  # the workshop's window of p(t) at the probes, s
 
@@ -105,10 +106,10 @@ class Cylinder(SceneKind):
                 f"{CLEAR_WIDTHS:g} pulse widths ({CLEAR_WIDTHS * b:.3g} m) from the surface, |x| >= "
                 f"{a + CLEAR_WIDTHS * b:.4g} m (got {scene.pulse_center:g})"
             )
-        if not scene.x_min + CLEAR_WIDTHS * b <= scene.pulse_center <= scene.x_max - CLEAR_WIDTHS * b:
+        if not scene.x_min + EDGE_WIDTHS * b <= scene.pulse_center <= scene.x_max - EDGE_WIDTHS * b:
             out.append(
-                f"--pulse-center: the pulse must be inside the domain, {CLEAR_WIDTHS:g} pulse widths from its "
-                f"edges: in [{scene.x_min + CLEAR_WIDTHS * b:.4g}, {scene.x_max - CLEAR_WIDTHS * b:.4g}] m "
+                f"--pulse-center: the pulse must be inside the domain, {EDGE_WIDTHS:g} pulse widths from its "
+                f"edges: in [{scene.x_min + EDGE_WIDTHS * b:.4g}, {scene.x_max - EDGE_WIDTHS * b:.4g}] m "
                 f"(got {scene.pulse_center:g})"
             )
         if scene.dx > 0.25 * a:

@@ -1,0 +1,198 @@
+"""The cylinder scene (issue 42): bad input before any work, the boundary methods' ghosts (the wall's conditions,
+their places, the scattered wave they make), probes read by MLS, a particle inside the body failing its run."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pcabench.execute.run import run
+from pcabench.spec import RunSpec
+from solvers import Scene, SceneError, make_solver
+from solvers.bodies import GHOST, INERT, BodyEntered, boundary_method_names
+from solvers.physics.integrators import step_program
+from solvers.scenes.cylinder import probe_points
+
+# a coarse copy of the workshop's problem: a wider pulse, so that dx = 0.05 resolves it (the scattered wave's
+# reflection off the cylinder's front reaches (1.5, 0) at t = 3.5 s)
+WIDE = dict(name="cylinder", dx=0.05, x_min=-5.0, x_max=5.0, y_min=-5.0, y_max=5.0, pulse_width=0.5, pulse_center=3.0)
+
+
+@pytest.mark.parametrize(
+    "changes, words",
+    [
+        (dict(cylinder_radius=0.0), "--cylinder-radius must be > 0"),
+        (dict(cylinder_radius=-1.0), "--cylinder-radius must be > 0"),
+        (dict(pulse_center=1.0), "--pulse-center: the pulse overlaps the cylinder"),
+        (dict(pulse_center=5.7), "--pulse-center: the pulse must be inside the domain"),
+        (dict(cylinder_radius=5.9), "--cylinder-radius: the cylinder (radius 5.9 m at the origin) must lie inside"),
+        (dict(dx=0.2), "--dx must be at most a quarter of the cylinder's radius"),
+        (dict(open="x"), "--open: the cylinder scene is sound in the open plane"),
+        (dict(probes=((0.6, 0.0),)), "--probe 0.6,0 is inside the body"),
+        (dict(probes=((7.0, 0.0),)), "--probe 7,0 is outside the domain"),
+        (dict(boundary_method="nope"), "--boundary-method"),
+    ],
+)
+def test_bad_cylinder_input_is_one_line_naming_the_option(changes, words):
+    with pytest.raises(SceneError) as err:
+        Scene(**{"name": "cylinder", "dx": 0.05, "steps": 2, **changes})
+    message = str(err.value)
+    assert words in message and "\n" not in message, message
+
+
+def test_a_body_parameter_on_a_scene_without_one_is_refused():
+    for changes in (dict(cylinder_radius=0.5), dict(boundary_method="rings")):
+        with pytest.raises(SceneError, match="has no body"):
+            Scene(dx=0.5, steps=2, **changes)
+
+
+def test_the_workshops_defaults_and_points():
+    s = Scene(name="cylinder", dx=0.02, steps=1)
+    assert (s.pulse_width, s.pulse_center, s.cylinder_radius, s.open) == (0.2, 4.0, 0.5, "xy")
+    assert s.body == (0.0, 0.0, 0.5) and "body" in s.boundaries
+    a, b, c = (probe_points(s)[k] for k in "ABC")
+    assert a == pytest.approx((0.0, 5.0), abs=1e-12) and c == pytest.approx((-5.0, 0.0), abs=1e-12)
+    assert b == pytest.approx((-5 / math.sqrt(2), 5 / math.sqrt(2)))
+    assert Scene(dx=0.5).pulse_width == 3.0 and Scene(dx=0.5).cylinder_radius is None  # the paper's scene as was
+
+
+def advanced(solver_name, scene, steps=None, **kw):
+    solver = make_solver(solver_name, **kw)
+    solver.input(scene)
+    solver.init()
+    for n in range(steps or scene.n_steps):
+        for _stage, op in step_program(scene.integrator, solver, first=n == 0):
+            op()
+    return solver
+
+
+def positions(solver):
+    s, a = solver.scene, solver.arrays
+    x = s.x_lo + (np.asarray(a["lx"], float) + 0.5) * s.dx + np.asarray(a["sx"], float)
+    y = s.y_lo + (np.asarray(a["ly"], float) + 0.5) * s.dx + np.asarray(a["sy"], float)
+    return x, y
+
+
+@pytest.mark.parametrize("method", ["rings", "lattice"])
+def test_the_ghosts_hold_the_walls_conditions_and_stay_put(method):
+    """After lagrangian steps: every ghost holds the fluid's drho at its mirror point and the normal velocity
+    reversed (u . n of the ghost = - that of the fluid at the mirror point); the body's particles have not moved;
+    the ghosts cover a cutoff's depth of the wall (rings: on their rings)."""
+    scene = Scene(**{**WIDE, "boundary_method": method, "model": "lagrangian", "mach": 0.2, "t_end": 2.5, "cfl": 1.0})
+    solver = advanced("linkedlist-cpu", scene)
+    a = solver.arrays
+    x0, y0, r0 = scene.body
+    x, y = positions(solver)
+    role = np.asarray(a["role"])
+    r = np.hypot(x - x0, y - y0)
+    assert r[role == 0].min() >= r0  # no fluid inside
+    ghosts, inert = role == GHOST, role == INERT
+    assert ghosts.sum() > 0 and r[ghosts].max() < r0 and r[ghosts].min() < r0 - scene.cutoff + scene.dx
+    if method == "rings":  # fitted: each ghost on a ring a - (i + 1/2) dx
+        depth = (r0 - r[ghosts]) / scene.dx - 0.5
+        assert np.allclose(depth, np.round(depth), atol=1e-9)
+    assert not (ghosts & inert).any() and r[inert].max(initial=0.0) < r0
+    body = solver.body
+    solver.fill_body()  # the ghosts' values as the next sweep sees them
+    n = body.normal
+    sampled = {k: body.weights @ np.asarray(a[k])[body.fluid_idx] for k in ("drho", "u", "v")}
+    assert np.abs(sampled["drho"]).max() > 1e-4 * scene.rho0 * scene.mach  # the pulse is at the wall by now
+    assert np.allclose(np.asarray(a["drho"])[body.ghost_idx], sampled["drho"], rtol=0, atol=1e-15)
+    un_fluid = sampled["u"] * n[:, 0] + sampled["v"] * n[:, 1]
+    un_ghost = np.asarray(a["u"])[body.ghost_idx] * n[:, 0] + np.asarray(a["v"])[body.ghost_idx] * n[:, 1]
+    ut_fluid = -sampled["u"] * n[:, 1] + sampled["v"] * n[:, 0]
+    ut_ghost = -np.asarray(a["u"])[body.ghost_idx] * n[:, 1] + np.asarray(a["v"])[body.ghost_idx] * n[:, 0]
+    np.testing.assert_allclose(un_ghost, -un_fluid, atol=1e-15)
+    np.testing.assert_allclose(ut_ghost, ut_fluid, atol=1e-15)
+    # the body's particles are where they were placed (by site id: the arrays are in cell order now)
+    fresh = make_solver("linkedlist-cpu")
+    fresh.input(scene)
+    fresh.init()
+    before, after = placed(fresh), placed(solver)
+    assert before.keys() == after.keys()
+    assert max(math.dist(before[k], after[k]) for k in before) < 1e-12
+
+
+def placed(solver) -> dict:
+    """{site id: (x, y)} of the body's particles."""
+    a = solver.arrays
+    ids = np.rint(np.asarray(a["ly"])).astype(int) * solver.scene.nx + np.rint(np.asarray(a["lx"])).astype(int)
+    x, y = positions(solver)
+    body = np.asarray(a["role"]) > 0
+    return {int(i): (float(px), float(py)) for i, px, py in zip(ids[body], x[body], y[body])}
+
+
+@pytest.mark.parametrize("method", ["rings", "lattice"])
+def test_the_cylinder_sends_back_the_scattered_wave(method):
+    """At (1.5, 0), between the pulse and the cylinder, the wave the cylinder's front sends back arrives at
+    t = 3.5 s: the run follows the exact solution with the cylinder, not the free pulse (whose wave has passed)."""
+    scene = Scene(**{**WIDE, "boundary_method": method, "model": "linear", "cfl": 1.0, "t_end": 4.5, "h_factor": 1.0})
+    scene = scene.replace(probes=((1.5, 0.0),))  # h = dx: the pulse's own dispersion well below the reflection
+    record = run(RunSpec("linkedlist-cpu", scene))
+    assert record.status == "ok", record.message
+    t, p = np.array(record.probes["t"]), np.array(record.probes["P1"])
+    window = (t >= 3.0) & (t <= 4.5)
+    ref = scene.kind.reference(scene, 4.5)
+    exact = ref.drho(np.array([1.5]), np.array([0.0]), t[window])[:, 0]
+    free = ref.free(np.array([1.5]), np.array([0.0]), t[window])[:, 0]
+    scattered = np.sqrt(np.mean((exact - free) ** 2))
+    assert scattered > 0.05 * np.abs(free).max()  # there is a reflection to see here
+    err = np.sqrt(np.mean((p[window] - exact) ** 2))
+    err_free = np.sqrt(np.mean((p[window] - free) ** 2))
+    assert err < 0.2 * err_free, (err, err_free)  # the run has the reflection
+    assert err < 0.2 * scattered, (err, scattered)  # and its size (measured: 11-15 % of it)
+
+
+def test_every_solver_agrees_on_the_cylinder():
+    from pcabench.conformance import SCENES
+
+    scene = Scene(**SCENES["cylinder"], steps=8, model="lagrangian")
+    ref = advanced("allpair-cpu", scene).output()
+    for name, kw in (("linkedlist-cpu", {"pair_loop": "list"}), ("linkedlist-cpu", {"pair_loop": "gather"})):
+        out = advanced(name, scene, **kw).output()
+        np.testing.assert_allclose(out.drho, ref.drho, rtol=0, atol=1e-13 * np.abs(ref.drho).max())
+    assert set(boundary_method_names()) >= {"rings", "lattice"}
+
+
+def test_a_probe_reads_a_linear_field_exactly():
+    scene = Scene(**{**WIDE, "model": "linear", "steps": 1})
+    solver = make_solver("linkedlist-cpu")
+    solver.input(scene)
+    solver.init()
+    x, y = positions(solver)
+    solver.arrays["drho"][:] = 0.3 + 0.02 * x - 0.05 * y  # MLS of first order: exact for a linear field
+    points = np.array([[2.0, 1.0], [-1.3, 2.7], [0.9, -0.1]])
+    np.testing.assert_allclose(solver.sample(points), 0.3 + 0.02 * points[:, 0] - 0.05 * points[:, 1], atol=1e-12)
+
+
+def test_a_particle_inside_the_body_fails_the_run_at_its_step(monkeypatch):
+    from solvers.bodies import base
+
+    real = base.Body.locate
+    calls = {"n": 0}
+
+    def locate(self, solver):
+        calls["n"] += 1
+        if solver.t > 2.5 * solver.scene.dt:  # in the third step
+            raise BodyEntered("1 fluid particle(s) inside the cylinder (test)")
+        return real(self, solver)
+
+    monkeypatch.setattr(base.Body, "locate", locate)
+    scene = Scene(name="cylinder", dx=0.1, steps=6, model="lagrangian", cfl=0.5)
+    record = run(RunSpec("linkedlist-cpu", scene))
+    assert record.status == "error" and record.failed_step == 3
+    assert record.message.startswith("BodyEntered: 1 fluid particle(s) inside the cylinder")
+    assert "\n" not in record.message  # the message says it all: no traceback
+
+
+def test_the_reference_field_equals_its_series():
+    from solvers.reference.cylinder import CylinderPulse
+
+    c = CylinderPulse(0.5, 0.2, 4.0, 0.0, 0.05, t_max=8.0, r_max=8.6)
+    rng = np.random.default_rng(3)
+    x, y = rng.uniform(-6, 6, 40), rng.uniform(-6, 6, 40)
+    keep = np.hypot(x, y) > 0.5
+    x, y = x[keep], y[keep]
+    np.testing.assert_allclose(c.field(x, y, 7.0), c.drho(x, y, [7.0])[0], atol=1e-8 * 0.05)
