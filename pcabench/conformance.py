@@ -280,9 +280,20 @@ def changed(before: dict, after: dict) -> list[str]:
 def lattice_neighbours(scene: Scene) -> float:
     """The mean count of other lattice particles within the cutoff (periodic axes by the nearest image), and
     of mirror particles across each rigid wall (the wall half a spacing past the edge column: column c's
-    image is column -1 - c across the left wall, 2 nx - 1 - c across the right one), by brute force in NumPy."""
+    image is column -1 - c across the left wall, 2 nx - 1 - c across the right one), by brute force in NumPy.
+    A body's ghost particles count where its boundary method places them (rings: off the lattice)."""
     ids = np.arange(scene.n_particles)
     column, y = ids % scene.nx, (ids // scene.nx) * scene.dx
+    if scene.body is not None:
+        from solvers.bodies import Body, boundary_method_named
+
+        x = scene.x_lo + (column + 0.5) * scene.dx
+        _role, sx, sy = Body(boundary_method_named(scene.boundary_method_used), scene).place(
+            x, scene.y_lo + y + 0.5 * scene.dx
+        )
+        px, py = x + sx, y + sy
+        d2 = (px[:, None] - px[None, :]) ** 2 + (py[:, None] - py[None, :]) ** 2
+        return float(((d2 < scene.cutoff**2).sum() - scene.n_particles) / scene.n_particles)
     images = {"x_min": -1 - column, "x_max": 2 * scene.nx - 1 - column}
     dy = y[:, None] - y[None, :]
     if scene.periodic_y:

@@ -196,3 +196,20 @@ def test_the_reference_field_equals_its_series():
     keep = np.hypot(x, y) > 0.5
     x, y = x[keep], y[keep]
     np.testing.assert_allclose(c.field(x, y, 7.0), c.drho(x, y, [7.0])[0], atol=1e-8 * 0.05)
+
+
+def test_a_solver_that_skips_the_ghosts_fails_check_solver_on_the_cylinder():
+    from pcabench.conformance import check_solver
+    from solvers.linkedlist_cpu import LinkedListCPU
+
+    class SkipsGhosts(LinkedListCPU):
+        """Broken on purpose: it claims a body, yet never gives the ghosts the fluid's values."""
+
+        name = "skips-ghosts"
+
+        def fill_body(self):
+            pass
+
+    (result,) = check_solver(SkipsGhosts, quick=True, only=("agreement",))
+    assert result.failed and "cylinder" in result.message and "differs" in result.message, result.line()
+    assert "plane-pulse" not in result.message.replace("plane-pulse-3200", "")  # the other scenes agree
