@@ -79,10 +79,11 @@ class TrackSceneError:
     """Each scene's primary error at t = 10 s, linear model, Verlet, the paper's method, on its default domain:
     the plane pulse on a strip at dx 0.4 (u), the 2D acoustic pulse on its 40 m periodic square at dx 0.5
     (drho); with a rigid wall (mirror particles), the plane pulse reflected at 6 m on a strip at dx 0.4 (u)
-    and the 2D pulse in its 20 m walled duct at dx 0.5 (drho). A change that breaks one scene's accuracy shows
-    across commits; commits before the scene registry, or before a scene, skip it."""
+    and the 2D pulse in its 20 m walled duct at dx 0.5 (drho); the workshop's pulse scattered by the cylinder
+    (its default boundary method) in its open square at dx 0.05, CFL 1 (drho). A change that breaks one scene's
+    accuracy shows across commits; commits before the scene registry, or before a scene, skip it."""
 
-    params = [["plane-pulse", "acoustic-pulse", "plane-wall", "pulse-wall"]]
+    params = [["plane-pulse", "acoustic-pulse", "plane-wall", "pulse-wall", "cylinder"]]
     param_names = ["scene"]
     unit = "relative RMS"
     timeout = 300
@@ -94,6 +95,8 @@ class TrackSceneError:
                 if scene == "plane-pulse"
                 else Scene(dx=0.4, t_end=10.0, model="linear", name=scene, strip_height=thinnest_strip(0.4))
                 if scene == "plane-wall"
+                else Scene(dx=0.05, t_end=10.0, model="linear", name=scene, cfl=1.0)
+                if scene == "cylinder"
                 else Scene(dx=0.5, t_end=10.0, model="linear", name=scene)
             )
         except (TypeError, ValueError):  # a commit before the scene registry (TypeError), or without the scene

@@ -26,7 +26,15 @@ from solvers import Scene, registry, solver_names
 from solvers.scenes import SCENES, scene_names
 
 ROOT = Path(__file__).resolve().parents[1]
-RECIPES = ("Add a solver", "Add a kernel", "Add a scene", "Add a report section", "Add a preset", "Add an absorber")
+RECIPES = (
+    "Add a solver",
+    "Add a kernel",
+    "Add a scene",
+    "Add a report section",
+    "Add a preset",
+    "Add an absorber",
+    "Add a boundary method",
+)
 
 
 def recipe(title: str) -> str:
@@ -142,6 +150,14 @@ def test_the_preset_recipe_expands_to_runs_that_a_sweep_stores(run_recipe):
     rows = store.read_rows(ns["store_path"])
     assert len(rows) == 3 and {r["preset"] for r in rows} == {"tiny"} and {r["status"] for r in rows} == {"ok"}
     assert sorted(r["n_particles"] for r in rows) == sorted(s.scene.n_particles for s in specs)
+
+
+def test_the_boundary_method_recipe_registers_a_method_the_cylinder_runs(run_recipe):
+    from solvers.bodies import boundary_method_names
+
+    ns = run_recipe("Add a boundary method")
+    assert "about-itself" not in boundary_method_names()  # unregistered once its block ended
+    assert 0 < ns["lattice"] < 0.2 and 0 < ns["mine"] and ns["mine"] != ns["lattice"]  # the method named ran
 
 
 def test_the_absorber_recipe_registers_an_absorber_that_every_solver_applies(run_recipe):
