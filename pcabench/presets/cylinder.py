@@ -1,0 +1,64 @@
+"""Sound around an object (``--cylinder``): the workshop's pulse scattered by a rigid cylinder, each boundary
+method's error at the probes and near the body against dx and the kernel, linear against lagrangian, and the
+stable CFL with the body."""
+
+from __future__ import annotations
+
+from pcabench.presets.base import Preset, spec_of
+
+CYLINDER = "cylinder"
+CYLINDER_T_END = 10.0  # the end of the workshop's window 6 <= t <= 10 s
+CYLINDER_CFL = 1.0  # the time step's error is far below the space's at these dx (CFL 1: 5 times fewer steps)
+CYLINDER_METHODS = ("lattice", "rings")
+# 1. The error against dx (5 and 10 particles a pulse width) for each boundary method and kernel: the paper's
+# Gaussian at h = 2.13 dx, the Gaussian at h = dx, Wendland C4 at h = 1.6 dx (the free pulse's best two here).
+CYLINDER_DX = (0.04, 0.02)
+CYLINDER_KERNELS = (("gaussian", 2.13), ("gaussian", 1.0), ("wendland-c4", 1.6))
+# 2. The order: dx 0.01 (20 particles a pulse width, 1.6 million particles) for the Gaussian at h = dx.
+CYLINDER_FINE_DX = 0.01
+CYLINDER_FINE_KERNEL = ("gaussian", 1.0)
+# 3. The lagrangian model at dx 0.02 beside the linear one (its ghosts' weights rebuilt before every sweep).
+CYLINDER_MOVING_DX = 0.02
+# 4. The stable CFL with the body and its open edges: the linear model at dx 0.04 from CFL 2 to 4.
+CYLINDER_CFLS = (2.0, 3.0, 3.5, 4.0)
+
+
+def _run(dx, method, kernel, h, **more):
+    return spec_of(
+        name=CYLINDER,
+        dx=dx,
+        boundary_method=method,
+        kernel=kernel,
+        h_factor=h,
+        t_end=CYLINDER_T_END,
+        **{"model": "linear", "cfl": CYLINDER_CFL, **more},
+    )
+
+
+def cylinder() -> list:
+    """The cylinder study (CYLINDER_*), smallest runs first within each part."""
+    runs = [
+        _run(dx, method, kernel, h)
+        for dx in CYLINDER_DX
+        for kernel, h in CYLINDER_KERNELS
+        for method in CYLINDER_METHODS
+    ]
+    kernel, h = CYLINDER_FINE_KERNEL
+    runs += [
+        _run(dx, method, kernel, h, model="lagrangian") for dx in (CYLINDER_MOVING_DX,) for method in CYLINDER_METHODS
+    ]
+    runs += [_run(CYLINDER_DX[0], "lattice", kernel, h, cfl=cfl) for cfl in CYLINDER_CFLS]
+    runs += [_run(CYLINDER_FINE_DX, method, kernel, h) for method in CYLINDER_METHODS]
+    return runs
+
+
+CYLINDER_PRESET = Preset(
+    CYLINDER,
+    cylinder,
+    1800.0,
+    flag="cylinder",
+    help="sound around an object: the workshop's pulse scattered by a rigid cylinder, each boundary method's "
+    "error at the probes A, B, C and near the body against dx and the kernel, lagrangian beside linear, the "
+    "stable CFL with the body ({size})",
+    order=57,
+)
