@@ -213,3 +213,53 @@ def test_a_solver_that_skips_the_ghosts_fails_check_solver_on_the_cylinder():
     (result,) = check_solver(SkipsGhosts, quick=True, only=("agreement",))
     assert result.failed and "cylinder" in result.message and "differs" in result.message, result.line()
     assert "plane-pulse" not in result.message.replace("plane-pulse-3200", "")  # the other scenes agree
+
+
+def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_path):
+    """Two dx per boundary method (stored rows with chosen errors): the orders are log(e1 / e2) / log 2, the
+    target line names the best run at dx >= 0.02 and that it is not reached; both figures are drawn."""
+    from types import SimpleNamespace
+
+    from pcabench import store
+    from pcabench.reports import frame
+    from pcabench.reports.sections import cylinder as S
+
+    from .test_study import row
+
+    path = tmp_path / "store" / "m.jsonl"
+    t = [6.0 + 0.1 * i for i in range(41)]
+    errors = {
+        ("lattice", 0.04): (0.8, 0.02),
+        ("lattice", 0.02): (0.2, 0.005),
+        ("rings", 0.04): (0.8, 0.1),
+        ("rings", 0.02): (0.4, 0.08),
+    }
+    for (method, dx), (probes, near) in errors.items():
+        r = row(
+            name="cylinder",
+            dx=dx,
+            t_end=10.0,
+            model="linear",
+            cfl=1.0,
+            h_factor=1.0,
+            boundary_method=method,
+            steps=int(round(10 / dx)),
+        )
+        r.errors = {
+            "probe_rms": probes,
+            "probe_A": probes,
+            "probe_B": probes,
+            "probe_C": probes,
+            "near_rms": near,
+            "far_rms": 2 * probes,
+        }
+        r.probes = {"t": t, **{k: [1e-3 * math.sin(x) for x in t] for k in "ABC"}}
+        store.append(r, path)
+    data = S.rows(frame.load(path.parent))
+    orders = {o["key"][3]: o for o in data["orders"]}
+    assert orders["lattice"]["probes"] == pytest.approx(2.0) and orders["lattice"]["near"] == pytest.approx(2.0)
+    assert orders["rings"]["probes"] == pytest.approx(1.0) and orders["rings"]["near"] == pytest.approx(math.log2(1.25))
+    text = "\n".join(S.text(data, None))
+    assert "has 0.2 (gaussian, h = 1 dx, lattice, dx = 0.02 m): not reached" in text
+    ctx = SimpleNamespace(out=tmp_path, name="m")
+    assert S.probes_figure(data, ctx).exists() and S.error_figure(data, ctx).exists()

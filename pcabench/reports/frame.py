@@ -42,7 +42,8 @@ def load(paths) -> pd.DataFrame:
 
 
 def _flat(row: dict) -> dict:
-    r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions", "errors")}
+    r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions", "errors", "probes")}
+    r["probes"] = json.dumps(row.get("probes") or {})  # readings at the probe points: one hashable cell
     for name, value in (row.get("errors") or {}).items():  # the scene's other error measures
         r[f"err_{name}"] = value
     for stage, seconds in (row.get("stages") or {}).items():

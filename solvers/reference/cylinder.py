@@ -72,11 +72,11 @@ def _spectrum(a: float, d: float, b: float, orders: int, k_nodes: int, r_nodes: 
     kr = k[:, None] * r[None, :]
     coef_j = np.empty((orders, k_nodes))
     coef_y = np.empty((orders, k_nodes))
-    for n in range(orders):
+    for n, (jn, yn) in enumerate(bessel_orders(orders, kr)):
         f = gauss * sp.ive(n, beta) * wr  # f_n(r) r dr
         with np.errstate(over="ignore", invalid="ignore"):
-            g = sp.jn(n, kr) @ f  # G_n(k)
-            h = sp.yn(n, kr) @ f  # H_n(k): -inf where Y_n(k r) overflows (k r << n), see below
+            g = jn @ f  # G_n(k)
+            h = yn @ f  # H_n(k): -inf where Y_n(k r) overflows (k r << n), see below
             jp, yp = sp.jvp(n, k * a), sp.yvp(n, k * a)
             # s_n = -int jp [G (J jp + Y yp) + H (J yp - Y jp)] / (jp^2 + yp^2) cos(c k t) k dk, in the ratio of the
             # smaller derivative to the larger one so that nothing overflows: q = jp / yp (or p = yp / jp)

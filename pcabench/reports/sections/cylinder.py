@@ -1,0 +1,302 @@
+"""The report's "Sound around an object" section (``pcabench study --cylinder``): the CAA workshop's pulse scattered
+by a rigid cylinder, each boundary method's error at the workshop's points A, B, C over 6 <= t <= 10 s and near
+the body against dx and the kernel, the order it converges at, lagrangian beside linear, the stable CFL with the
+body, and p(t) at A, B, C beside the exact solution, the way the workshop drew them.
+
+The measures are the scene's (solvers/scenes/cylinder.py): ``probe_rms`` (A, B, C together) and ``probe_A`` ...,
+the relative RMS of p = c0^2 drho over the window; ``near_rms`` and ``far_rms``, the field's error at the run's
+end within 3 cutoffs of the surface and away from it, each over the RMS of the reference over the whole fluid.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from pcabench.presets.cylinder import CYLINDER, CYLINDER_T_END
+from pcabench.reports import figures as F
+from pcabench.reports.md import fmt, md_table
+from pcabench.reports.sections.base import Section
+from pcabench.reports.tables import latest
+from pcabench.spec import scene_from_row
+
+TARGET = 0.02  # the issue's: 2 % relative RMS at the probes
+TARGET_DX = 0.02  # at no more than 10 particles a pulse width
+
+
+def _err(r, name: str) -> float | None:
+    v = r.get(f"err_{name}")
+    return None if v is None or not np.isfinite(v) else float(v)
+
+
+def rows(df) -> dict | None:
+    """The cylinder runs of ``df`` (newest of each), one row each, with the orders between successive dx; None
+    where there are none."""
+    if df is None or df.empty or not (df.scene == CYLINDER).any():
+        return None
+    runs = []
+    for _, r in latest(df[df.scene == CYLINDER]).iterrows():
+        scene = scene_from_row(r)
+        runs.append(
+            {
+                "dx": float(scene.dx),
+                "per_width": scene.pulse_width / scene.dx,
+                "method": scene.boundary_method_used,
+                "kernel": scene.kernel,
+                "h": float(scene.h_factor),
+                "model": scene.model,
+                "cfl": float(scene.cfl),
+                "t_end": float(scene.t_final),
+                "status": r.status,
+                "failed_step": r.failed_step,
+                "probes": _err(r, "probe_rms"),
+                **{k: _err(r, f"probe_{k}") for k in "ABC"},
+                "near": _err(r, "near_rms"),
+                "far": _err(r, "far_rms"),
+                "N": int(r.n_particles),
+                "step_ms": 1e3 * float(r.t_step) if r.status == "ok" else None,
+                "wall_s": float(r.t_solution) if r.status == "ok" else None,
+                "series": json.loads(r.probes) if isinstance(r.get("probes"), str) else {},
+                "scene_value": scene,
+            }
+        )
+    runs.sort(key=lambda r: (r["model"], r["kernel"], r["h"], r["method"], r["cfl"], -r["dx"]))
+    return {"runs": runs, "orders": orders(runs)}
+
+
+def _key(r) -> tuple:
+    return (r["model"], r["kernel"], r["h"], r["method"], r["cfl"])
+
+
+def orders(runs) -> list[dict]:
+    """Per method (model, kernel, h, boundary method, CFL) with two or more dx: the order of the probes' error
+    and of the near-body error between each pair of successive dx, log(e1 / e2) / log(dx1 / dx2)."""
+    out = []
+    for key in sorted({_key(r) for r in runs}):
+        mine = sorted((r for r in runs if _key(r) == key and r["status"] == "ok"), key=lambda r: -r["dx"])
+        for a, b in zip(mine, mine[1:]):
+            step = math.log(a["dx"] / b["dx"])
+            o = {"key": key, "dx": (a["dx"], b["dx"])}
+            for what in ("probes", "near"):
+                ea, eb = a[what], b[what]
+                o[what] = math.log(ea / eb) / step if ea and eb else None
+            out.append(o)
+    return out
+
+
+def _method(r) -> str:
+    return f"{r['kernel']}, h = {r['h']:g} dx"
+
+
+def text(data, ctx) -> list[str]:
+    if not data:
+        return []
+    runs = [r for r in data["runs"] if np.isclose(r["t_end"], CYLINDER_T_END)]
+    table = [
+        [
+            f"{r['dx']:g}",
+            f"{r['per_width']:g}",
+            _method(r),
+            r["method"],
+            r["model"],
+            f"{r['cfl']:g}",
+            f"{r['N']:,}",
+            fmt(r["probes"], ".3g") if r["status"] == "ok" else f"{r['status']} (step {r['failed_step']})",
+            " / ".join(fmt(r[k], ".3g") for k in "ABC") if r["status"] == "ok" else "-",
+            fmt(r["near"], ".3g"),
+            fmt(r["far"], ".3g"),
+            fmt(r["step_ms"], ".1f"),
+        ]
+        for r in runs
+    ]
+    lines = [
+        "## Sound around an object",
+        "",
+        "The Second CAA Workshop's category 1 problem 2 (`--scene cylinder`): the pulse b = 0.2 m at (4, 0) "
+        "scattered by a rigid cylinder of radius 0.5 m at the origin, in the open square [-6, 6]^2 m, scored "
+        "against the series solution. The wall is a boundary method: ghost particles inside the body with the "
+        "fluid's values at their mirror points (`lattice`: the lattice's own sites, a staircase; `rings`: rings "
+        "fitted to the surface). Probes: the relative RMS of p at the workshop's points A (r = 5 m, 90 deg), B "
+        "(135 deg), C (180 deg) over 6 <= t <= 10 s, together and each; near the body (within 3 cutoffs of its "
+        "surface) and away from it: the field's error at t = 10 s. `pcabench study --cylinder`, linked list, "
+        "serial.",
+        "",
+        md_table(
+            [
+                "dx (m)",
+                "particles per b",
+                "kernel",
+                "boundary method",
+                "model",
+                "CFL",
+                "N",
+                "probes",
+                "A / B / C",
+                "near the body",
+                "away from it",
+                "step (ms)",
+            ],
+            table,
+        ),
+        "",
+    ]
+    ok = [r for r in runs if r["status"] == "ok" and r["probes"] is not None]
+    if ok:
+        coarse = [r for r in ok if r["dx"] >= TARGET_DX - 1e-12]
+        best = min(coarse or ok, key=lambda r: r["probes"])
+        reached = [r for r in ok if r["probes"] <= TARGET]
+        lines.append(
+            f"- **The issue's target** (2 % at the probes with at most 10 particles a pulse width): the best run at "
+            f"dx >= {TARGET_DX:g} m has {best['probes']:.3g} ({_method(best)}, {best['method']}, dx = "
+            f"{best['dx']:g} m): "
+            + (
+                "reached."
+                if best["probes"] <= TARGET
+                else "not reached by any method here"
+                + (
+                    f" (the finest run that does: dx = {min(r['dx'] for r in reached):g} m)."
+                    if reached
+                    else "; the error is the bulk's dispersion over 5 to 9 m of travel (the free pulse at this "
+                    "width shows the same, docs/accuracy.md), not the wall's."
+                )
+            )
+        )
+        for o in data["orders"]:
+            model, kernel, h, method, cfl = o["key"]
+            lines.append(
+                f"- **{kernel}, h = {h:g} dx, {method}, {model}**: converges from dx {o['dx'][0]:g} to {o['dx'][1]:g} "
+                f"at order {fmt(o['probes'], '.2g')} at the probes and {fmt(o['near'], '.2g')} near the body."
+            )
+    blown = [r for r in runs if r["status"] != "ok"]
+    for r in blown:
+        lines.append(
+            f"- **{_method(r)}, {r['method']}, {r['model']}, CFL {r['cfl']:g}, dx {r['dx']:g}**: {r['status']} at "
+            f"step {r['failed_step']}."
+        )
+    return lines + [""]
+
+
+def _exact(scene, series) -> tuple:
+    """(t, {name: exact p}) at the stored probe times."""
+    t = np.asarray(series["t"], dtype=np.float64)
+    ref = scene.kind.reference(scene, float(t.max()))
+    points = scene.probe_points()
+    return t, {k: ref.drho(np.array([points[k][0]]), np.array([points[k][1]]), t)[:, 0] for k in "ABC"}
+
+
+def probes_figure(data, ctx):
+    """p(t) at A, B and C over the workshop's window: the exact solution (black) beside each boundary method's
+    run at the finest dx of the most accurate kernel (linear)."""
+    if not data:
+        return None
+    ok = [r for r in data["runs"] if r["status"] == "ok" and r["probes"] is not None and r["series"].get("t")]
+    ok = [r for r in ok if r["model"] == "linear" and np.isclose(r["t_end"], CYLINDER_T_END)]
+    if not ok:
+        return None
+    best = min(ok, key=lambda r: (-1 if r["dx"] == min(x["dx"] for x in ok) else 0, r["probes"]))
+    shown = [r for r in ok if r["dx"] == best["dx"] and r["kernel"] == best["kernel"] and r["h"] == best["h"]]
+    path = ctx.out / "cylinder_probes.png"
+    t, exact = _exact(best["scene_value"], best["series"])
+    window = (t >= 6.0 - 1e-9) & (t <= 10.0 + 1e-9)
+    c2 = best["scene_value"].c0 ** 2
+    with F.figure(
+        path,
+        f"The pulse scattered by a cylinder: p(t) at the workshop's points, {_method(best)}, dx = {best['dx']:g} m "
+        f"({best['per_width']:g} particles a pulse width), linear ({ctx.name}); black: the exact solution",
+        "t (s)",
+        "p (Pa, c0^2 drho)",
+        ncols=3,
+        size=(15.5, 4.4),
+    ) as axes:
+        colours = {"lattice": "tab:blue", "rings": "tab:orange"}
+        for ax, name in zip(axes, "ABC"):
+            ax.plot(t[window], c2 * exact[name][window], color="black", lw=2.0, label="exact")
+            for r in shown:
+                tr = np.asarray(r["series"]["t"])
+                w = (tr >= 6.0 - 1e-9) & (tr <= 10.0 + 1e-9)
+                ax.plot(
+                    tr[w],
+                    c2 * np.asarray(r["series"][name])[w],
+                    color=colours.get(r["method"], "tab:green"),
+                    lw=1.2,
+                    ls="--" if r["method"] == "rings" else "-",
+                    label=f"{r['method']} (probes {r['probes']:.2g})",
+                )
+            ax.set_title(f"{name} ({ {'A': '90', 'B': '135', 'C': '180'}[name] } deg, r = 5 m)", fontsize=9)
+    return path
+
+
+def error_figure(data, ctx):
+    """The probes' error and the near-body error against dx, per kernel and boundary method (linear)."""
+    if not data:
+        return None
+    ok = [r for r in data["runs"] if r["status"] == "ok" and r["model"] == "linear" and r["probes"] is not None]
+    ok = [r for r in ok if np.isclose(r["cfl"], min(x["cfl"] for x in ok))]
+    if len({r["dx"] for r in ok}) < 2:
+        return None
+    path = ctx.out / "cylinder_error.png"
+    kernels = sorted({(r["kernel"], r["h"]) for r in ok})
+    colours = F.palette(len(kernels))
+    with F.figure(
+        path,
+        f"Sound around a cylinder: error against dx, linear ({ctx.name}); colour: kernel, solid: lattice ghosts, "
+        "dashed: rings; grey: the 2 % target",
+        "dx (m)",
+        "relative RMS",
+        ncols=2,
+        logx=True,
+        logy=True,
+        size=(13.0, 4.6),
+    ) as axes:
+        values = {0: [TARGET], 1: []}
+        for i, (what, title) in enumerate(
+            (
+                ("probes", "at the probes A, B, C, 6 <= t <= 10 s"),
+                ("near", "near the body (within 3 cutoffs), t = 10 s"),
+            )
+        ):
+            ax = axes[i]
+            for (kernel, h), colour in zip(kernels, colours):
+                for method in ("lattice", "rings"):
+                    pts = sorted(
+                        (r["dx"], r[what])
+                        for r in ok
+                        if (r["kernel"], r["h"], r["method"]) == (kernel, h, method) and r[what]
+                    )
+                    if pts:
+                        values[i] += [v for _, v in pts]
+                        ax.plot(
+                            *zip(*pts),
+                            color=colour,
+                            ls="-" if method == "lattice" else "--",
+                            marker="o",
+                            ms=4,
+                            label=f"{kernel}, h = {h:g} dx, {method}",
+                        )
+            if i == 0:
+                ax.axhline(TARGET, color="0.6", lw=1.0, label="target: 2 %")
+            F.nice_log_ticks(ax, values[i])
+            ax.set_xticks(sorted({r["dx"] for r in ok}))
+            ax.set_xticklabels([f"{d:g}" for d in sorted({r["dx"] for r in ok})])
+            ax.minorticks_off()
+            ax.set_title(title, fontsize=9)
+    return path
+
+
+def _runs(ctx):
+    for df in (ctx.df_open, ctx.df_scenes, ctx.df):
+        if df is not None:
+            return df
+    return None
+
+
+SECTION = Section(
+    "cylinder",
+    lambda ctx: rows(_runs(ctx)),
+    text,
+    (probes_figure, error_figure),
+    all_scenes=True,
+    order=157,
+)
