@@ -184,6 +184,8 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
     on ``scene`` (cost ~ particles x steps x neighbours: on the thinnest strip where a strip serves the scene,
     else on its own domain, with SEARCH_DX_2D and SEARCH_CFL_SHARE_2D), and the paper configuration's dx."""
     kind = scene_kind(scene)
+    if kind.body:  # no dispersion prediction off the lattice: nothing to suggest from
+        return {}
     dxs, shares = (SEARCH_DX, SEARCH_CFL_SHARE) if kind.strip else (SEARCH_DX_2D, SEARCH_CFL_SHARE_2D)
     best, paper = None, None
     for kern, h in itertools.product(kernel_names(), SEARCH_H):
@@ -283,6 +285,12 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
                 f"no {model} run of {scene} can be scored (no isothermal solution is known there); the "
                 "prediction below is of the linear part, the method to try with --model linear"
             )
+        if not s:  # a scene with a body: no dispersion prediction to search with
+            lines.append(
+                f"no prediction can suggest one on {scene} (the body is off the lattice): run finer, or other "
+                "kernels (`pcabench study --cylinder`), and ask again"
+            )
+            return "\n".join(lines), False
         if "study" not in s:
             lines.append("no method of the searched grid is predicted to reach it")
         else:
@@ -372,7 +380,8 @@ def cmd_advise(args) -> int:
         import numpy as np
 
         mach = Scene.default("mach") if args.mach is None else args.mach
-        df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach) & (df.open == (args.open or ""))]
+        edges = args.open or scene_kind(args.scene).defaults.get("open", "")  # an open problem's edges by default
+        df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach) & (df.open == edges)]
     if df is None or df.empty:
         study = ["pcabench", "study", "--front", *([] if args.scene == DEFAULT_SCENE else ["--scene", args.scene])]
         raise NoResults(

@@ -82,8 +82,7 @@ def score(record: RunRecord, scene, fields) -> RunRecord:
     measures = dict(scene.kind.errors(scene, fields))  # against the scene's exact linear solution
     record.mse, record.me = measures.pop("mse"), measures.pop("me")
     record.errors = {**measures, **reflected(scene, fields)}  # open edges: what they sent back (linear runs)
-    if fields.probes:  # p(t) at the probe points: scored, and kept (rounded) for the figures
-        record.errors.update(scene.kind.probe_errors(scene, fields.probes))
+    if fields.probes:  # p(t) at the probe points (scored by the scene's errors), kept rounded for the figures
         record.probes = {k: [float(f"{v:.6g}") for v in np.asarray(vals, float)] for k, vals in fields.probes.items()}
     if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
         record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)

@@ -67,9 +67,9 @@ class Cylinder(SceneKind):
         names = [k for k in probes if k != "t"]
         nan = float("nan")
         if inside.sum() < 2 or not names:
-            return {"probe_rms": nan, **{f"probe_{k}": nan for k in names}}
+            return {"probe_rms": nan, "probe_max": nan, **{f"probe_{k}": nan for k in names}}
         ref = self.reference(scene, float(t[inside].max()))
-        out, num, den = {}, 0.0, 0.0
+        out, num, den, worst = {}, 0.0, 0.0, 0.0
         points = scene.probe_points()
         for name in names:
             x, y = points[name]
@@ -78,7 +78,9 @@ class Cylinder(SceneKind):
             quiet = np.sqrt(np.mean(exact**2)) < 1e-6 * scene.rho0 * scene.mach  # no sound there yet
             out[f"probe_{name}"] = nan if quiet else float(np.sqrt(np.sum(d**2) / np.sum(exact**2)))
             num, den = num + float(np.sum(d**2)), den + float(np.sum(exact**2))
+            worst = max(worst, float(np.max(np.abs(d))))
         out["probe_rms"] = float(np.sqrt(num / den)) if np.isfinite(num) else nan
+        out["probe_max"] = worst if np.isfinite(num) else nan
         return out
 
     def check(self, scene) -> list[str]:
@@ -150,6 +152,10 @@ class Cylinder(SceneKind):
         return np.hypot(np.asarray(fields.x) - x0, np.asarray(fields.y) - y0) >= a
 
     def errors(self, scene, fields) -> dict:
+        """The workshop's measure as the headline (``mse``, ``me``): p at the probes over the window against the
+        exact solution (``probe_rms``; ``me`` the largest error of drho there), where the run recorded readings in
+        it; else (a run that ends before t = 6 s) the field's at its end. The field's relative RMS at the end
+        (``field_rms``), near the body and away from it, apart, always."""
         x0, y0, a = scene.body
         keep = self.fluid(scene, fields)
         x, y = np.asarray(fields.x)[keep], np.asarray(fields.y)[keep]
@@ -158,16 +164,23 @@ class Cylinder(SceneKind):
         d = drho - ref
         nan = float("nan")
         if not np.all(np.isfinite(d)):
-            return {"mse": nan, "me": nan, "near_rms": nan, "far_rms": nan}
+            return {"mse": nan, "me": nan, "field_rms": nan, "near_rms": nan, "far_rms": nan}
         scale = float(np.mean(ref**2))
         near = np.hypot(x - x0, y - y0) < a + NEAR_CUTOFFS * scene.cutoff
         n = d.size
-        return {
-            "mse": float(np.sqrt(np.mean(d**2) / scale)),
-            "me": float(np.max(np.abs(d))),
+        out = {
+            "field_rms": float(np.sqrt(np.mean(d**2) / scale)),
             "near_rms": float(np.sqrt(np.sum(d[near] ** 2) / max(near.sum(), 1) / scale)),
             "far_rms": float(np.sqrt(np.sum(d[~near] ** 2) / max(n - near.sum(), 1) / scale)),
         }
+        probes = self.probe_errors(scene, fields.probes) if fields.probes else {}
+        worst = probes.pop("probe_max", nan)
+        out.update(probes)
+        if np.isfinite(probes.get("probe_rms", nan)):  # the workshop's measure: the headline
+            out["mse"], out["me"] = probes["probe_rms"], worst
+        else:
+            out["mse"], out["me"] = out["field_rms"], float(np.max(np.abs(d)))
+        return out
 
     def exact_fields(self, scene, t: float):
         from solvers.interface import Fields
