@@ -96,9 +96,11 @@ class Body:
         self.n_ghosts, self.n_inert = int(ghost.sum()), int(inert.sum())
         return role, sx, sy
 
-    def _ids(self, a, idx, to_host):
+    def _ids(self, a, idx, to_host, xp=np):
+        """The site ids of the particles at solver indices ``idx`` (host int array)."""
         s = self.scene
-        lx, ly = (np.rint(to_host(a[k][idx])).astype(np.int64) for k in ("lx", "ly"))
+        where = idx if xp is np else xp.asarray(idx)  # a device array is indexed on the device
+        lx, ly = (np.rint(to_host(a[k][where])).astype(np.int64) for k in ("lx", "ly"))
         return (ly % s.ny) * s.nx + lx % s.nx
 
     def locate(self, solver) -> None:
@@ -107,9 +109,10 @@ class Body:
         s, a, xp, to_host = self.scene, solver.arrays, solver.xp, solver.to_host
         px = s.x_lo + (a["lx"].astype(xp.float64) + 0.5) * s.dx + a["sx"]
         py = s.y_lo + (a["ly"].astype(xp.float64) + 0.5) * s.dx + a["sy"]
-        near = to_host(xp.flatnonzero((px - self.x0) ** 2 + (py - self.y0) ** 2 < self.reach**2)).astype(np.int64)
-        role = to_host(a["role"][near])
-        pos = np.stack([to_host(px[near]), to_host(py[near])], axis=1)
+        near_dev = xp.flatnonzero((px - self.x0) ** 2 + (py - self.y0) ** 2 < self.reach**2)  # on the device
+        near = to_host(near_dev).astype(np.int64)
+        role = to_host(a["role"][near_dev])
+        pos = np.stack([to_host(px[near_dev]), to_host(py[near_dev])], axis=1)
         fluid = role == FLUID
         r = np.hypot(pos[:, 0] - self.x0, pos[:, 1] - self.y0)
         entered = fluid & (r < self.a)
@@ -119,12 +122,12 @@ class Body:
                 f"r = {r[entered].min():.4g} m): the wall let them through"
             )
         body = near[~fluid]
-        order = np.searchsorted(self.body_ids, self._ids(a, body, to_host))
+        order = np.searchsorted(self.body_ids, self._ids(a, body, to_host, xp))
         self.body_idx, self.body_at = body, order  # solver indices, and each one's entry in body_ids
         ghosts = role[~fluid] == GHOST
         ghost_idx = body[ghosts]
         self.ghost_idx = ghost_idx
-        self.ghost_at = np.searchsorted(self.ghost_ids, self._ids(a, ghost_idx, to_host))
+        self.ghost_at = np.searchsorted(self.ghost_ids, self._ids(a, ghost_idx, to_host, xp))
         self.inert_idx = body[~ghosts]
         self.fluid_idx = near[fluid]
         self.weights = mls_weights(s, self.samples[self.ghost_at], pos[fluid], s.dx * s.dx)
