@@ -98,3 +98,34 @@ class TimeOpenEdgeStep:
 
     def time_step(self, *_):
         self.p.step()
+
+
+# The cylinder (the workshop's pulse scattered by a rigid body, its ghosts filled before every sweep) beside the
+# 2D pulse's open square of the same size and dx: what a step pays for the body, linear (its ghosts' sampling
+# weights built once) and lagrangian (rebuilt before every sweep, on the host).
+CYLINDER_DX = 0.05  # 65,536 particles with the open square's layers
+
+
+class TimeCylinderStep:
+    """One step of linkedlist-cpu (float64, serial) on the cylinder and on the 2D pulse's open square of the same
+    box and dx, linear and lagrangian; commits before the cylinder skip it."""
+
+    params = [["acoustic-pulse open", "cylinder"], ["linear", "lagrangian"]]
+    param_names = ["scene", "model"]
+    timeout = 300
+    min_run_count = 3
+
+    def setup(self, scene, model):
+        box = dict(x_min=-6.0, x_max=6.0, y_min=-6.0, y_max=6.0, pulse_width=0.2)  # the layer: 2 pulse widths
+        extra = (
+            {"name": "cylinder", "pulse_center": 4.0}
+            if scene == "cylinder"
+            else {"name": "acoustic-pulse", "open": "xy", "pulse_center": 4.0}
+        )
+        try:
+            self.p = Prepared("linkedlist-cpu", "float64", CYLINDER_DX, model=model, **box, **extra)
+        except (TypeError, ValueError) as exc:  # a commit without the scene
+            raise NotImplementedError(f"no {scene} at this commit: {exc}") from None
+
+    def time_step(self, *_):
+        self.p.step()
