@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pcabench import jsonout
 from pcabench.cli.options import ACCURACY_OPTIONS, check_wall_option, domain_of
+from pcabench.spec import OptionError
 from pcabench.machine import memory
 from solvers import (
     DEFAULT_SCENE,
@@ -24,6 +25,11 @@ def cmd_accuracy(args) -> int:
         **given,
         **domain_of(args),
     )
+    if scene.body is not None:
+        raise OptionError(
+            f"--scene {scene.name}: no dispersion prediction exists with a body off the lattice; its runs are "
+            "scored against the exact solution (`pcabench run --scene cylinder`, `pcabench study --cylinder`)"
+        )
     p = predict(scene)
     past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/predict/stability.py)
     if args.json:

@@ -100,6 +100,13 @@ def front(size: str = "quick", scene: str = DEFAULT_SCENE, fast: bool = True) ->
     other: its own product (FRONT_2D) on its own domain and the paper's method beside it. Then, on a scene with
     an isothermal reference, which model it needs at several amplitudes."""
     kind = scene_kind(scene)
+    if kind.body:  # its dx must resolve the body, and no prediction names its fastest methods
+        from solvers import SceneError
+
+        raise SceneError(
+            f"--front: the {scene} scene's front is `pcabench study --cylinder` (kernels and boundary methods "
+            "against dx at the workshop's probes); advise reads it"
+        )
     axes = front_axes(size, scene)
     names = [k for k in axes if k != "dx"]
     runs = [
