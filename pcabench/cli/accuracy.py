@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pcabench import jsonout
 from pcabench.cli.options import ACCURACY_OPTIONS, check_wall_option, domain_of
-from pcabench.spec import OptionError
 from pcabench.machine import memory
+from pcabench.spec import OptionError
 from solvers import (
     DEFAULT_SCENE,
     Scene,
