@@ -263,3 +263,25 @@ def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_pa
     assert "has 0.2 (gaussian, h = 1 dx, lattice, dx = 0.02 m): not reached" in text
     ctx = SimpleNamespace(out=tmp_path, name="m")
     assert S.probes_figure(data, ctx).exists() and S.error_figure(data, ctx).exists()
+
+
+@pytest.mark.parametrize(
+    "words, says",
+    [
+        (["accuracy", "--scene", "cylinder", "--dx", "0.05"], "no dispersion prediction exists with a body"),
+        (["study", "--front", "--scene", "cylinder"], "front is `pcabench study --cylinder`"),
+        (
+            ["run", "--solver", "linkedlist-cpu", "--scene", "cylinder", "--dx", "0.05", "--probe", "0.6,0"],
+            "--probe 0.6,0 is inside the body",
+        ),
+    ],
+)
+def test_what_the_cylinder_cannot_do_is_one_line(words, says, tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PCABENCH_HOME": str(tmp_path)}
+    proc = subprocess.run([sys.executable, "-m", "pcabench.cli", *words], capture_output=True, text=True, env=env)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode != 0 and len(lines) == 1 and says in lines[0], proc.stderr
