@@ -26,6 +26,9 @@ import numpy as np
 from solvers.sampling import mls_weights
 
 FLUID, GHOST, INERT = 0.0, 1.0, 2.0  # a particle's role (the solver's ``role`` array)
+# A fluid particle has entered the body once it is this many spacings below the surface: where the ghosts' outer
+# ring sits (a lattice site can start on the surface itself and move in by round-off, which is no entry).
+ENTRY_DEPTH = 0.5
 
 
 class BodyEntered(RuntimeError):
@@ -115,11 +118,12 @@ class Body:
         pos = np.stack([to_host(px[near_dev]), to_host(py[near_dev])], axis=1)
         fluid = role == FLUID
         r = np.hypot(pos[:, 0] - self.x0, pos[:, 1] - self.y0)
-        entered = fluid & (r < self.a)
+        entered = fluid & (r < self.a - ENTRY_DEPTH * s.dx)
         if entered.any():
             raise BodyEntered(
-                f"{int(entered.sum())} fluid particle(s) inside the cylinder (r < {self.a:g} m, the deepest at "
-                f"r = {r[entered].min():.4g} m): the wall let them through"
+                f"{int(entered.sum())} fluid particle(s) inside the cylinder, past half a spacing below its "
+                f"surface (r < {self.a - ENTRY_DEPTH * s.dx:.4g} m, the deepest at r = {r[entered].min():.4g} m): "
+                "the wall let them through"
             )
         body = near[~fluid]
         order = np.searchsorted(self.body_ids, self._ids(a, body, to_host, xp))
