@@ -86,6 +86,11 @@ def orders(runs) -> list[dict]:
     return out
 
 
+def _step(r) -> str:
+    v = r["failed_step"]
+    return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else f"{int(v)}"
+
+
 def _method(r) -> str:
     return f"{r['kernel']}, h = {r['h']:g} dx"
 
@@ -103,7 +108,7 @@ def text(data, ctx) -> list[str]:
             r["model"],
             f"{r['cfl']:g}",
             f"{r['N']:,}",
-            fmt(r["probes"], ".3g") if r["status"] == "ok" else f"{r['status']} (step {r['failed_step']})",
+            fmt(r["probes"], ".3g") if r["status"] == "ok" else f"{r['status']} (step {_step(r)})",
             " / ".join(fmt(r[k], ".3g") for k in "ABC") if r["status"] == "ok" else "-",
             fmt(r["near"], ".3g"),
             fmt(r["far"], ".3g"),
@@ -142,14 +147,14 @@ def text(data, ctx) -> list[str]:
         ),
         "",
     ]
-    ok = [r for r in runs if r["status"] == "ok" and r["probes"] is not None]
+    ok = [r for r in runs if r["status"] == "ok" and r["probes"] is not None and r["model"] == "linear"]
     if ok:
         coarse = [r for r in ok if r["dx"] >= TARGET_DX - 1e-12]
         best = min(coarse or ok, key=lambda r: r["probes"])
         reached = [r for r in ok if r["probes"] <= TARGET]
         lines.append(
-            f"- **The issue's target** (2 % at the probes with at most 10 particles a pulse width): the best run at "
-            f"dx >= {TARGET_DX:g} m has {best['probes']:.3g} ({_method(best)}, {best['method']}, dx = "
+            f"- **The issue's target** (2 % at the probes with at most 10 particles a pulse width): the best linear "
+            f"run at dx >= {TARGET_DX:g} m has {best['probes']:.3g} ({_method(best)}, {best['method']}, dx = "
             f"{best['dx']:g} m): "
             + (
                 "reached."
@@ -169,11 +174,23 @@ def text(data, ctx) -> list[str]:
                 f"- **{kernel}, h = {h:g} dx, {method}, {model}**: converges from dx {o['dx'][0]:g} to {o['dx'][1]:g} "
                 f"at order {fmt(o['probes'], '.2g')} at the probes and {fmt(o['near'], '.2g')} near the body."
             )
-    blown = [r for r in runs if r["status"] != "ok"]
-    for r in blown:
+    moving = [r for r in runs if r["model"] != "linear" and r["status"] == "ok"]
+    if moving:
         lines.append(
-            f"- **{_method(r)}, {r['method']}, {r['model']}, CFL {r['cfl']:g}, dx {r['dx']:g}**: {r['status']} at "
-            f"step {r['failed_step']}."
+            "- **The lagrangian runs** are scored against the exact *linear* solution (no isothermal one is known "
+            "with a body): at Mach 0.05 the pulse of width 0.2 m steepens over a few metres, so their error holds "
+            "the model's nonlinear terms, not only the method's; they are not beside the linear runs like for like."
+        )
+    blown = [r for r in runs if r["status"] != "ok"]
+    for key in sorted({(_method(r), r["method"], r["model"], r["dx"]) for r in blown}):
+        mine = sorted(
+            (r for r in blown if (_method(r), r["method"], r["model"], r["dx"]) == key), key=lambda r: r["cfl"]
+        )
+        held = [r["cfl"] for r in runs if r["status"] == "ok" and (_method(r), r["method"], r["model"], r["dx"]) == key]
+        lines.append(
+            f"- **{key[0]}, {key[1]}, {key[2]}, dx {key[3]:g}**: "
+            + ", ".join(f"CFL {r['cfl']:g} {r['status']} at step {_step(r)}" for r in mine)
+            + (f"; bounded up to CFL {max(held):g}." if held else ".")
         )
     return lines + [""]
 
