@@ -102,9 +102,9 @@ def candidates(solver) -> int:
     a, rc, ncx = solver.arrays, solver.scene.cutoff, solver.nnps.grid.ncx
     x = (a["lx"].astype(float) + 0.5) * solver.scene.dx + a["sx"]
     total = 0
-    for cy in range(solver.ncy):
+    for cy in range(solver.nnps.grid.ncy):
         lo, hi = int(solver.nnps.begin[cy * ncx]), int(solver.nnps.begin[(cy + 1) * ncx])
-        up = (cy + 1) % solver.ncy
+        up = (cy + 1) % solver.nnps.grid.ncy
         ulo, uhi = int(solver.nnps.begin[up * ncx]), int(solver.nnps.begin[(up + 1) * ncx])
         xr, xu = x[lo:hi], x[ulo:uhi]
         total += int((np.searchsorted(xr, xr + rc, "left") - (np.arange(hi - lo) + 1)).sum())
