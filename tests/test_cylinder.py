@@ -75,6 +75,7 @@ def positions(solver):
     return x, y
 
 
+@pytest.mark.tier2  # runs of seconds each: the second tier (README's command stays within 8 minutes)
 @pytest.mark.parametrize("method", ["rings", "lattice"])
 def test_the_ghosts_hold_the_walls_conditions_and_stay_put(method):
     """After lagrangian steps: every ghost holds the fluid's drho at its mirror point and the normal velocity
@@ -124,6 +125,7 @@ def placed(solver) -> dict:
     return {int(i): (float(px), float(py)) for i, px, py in zip(ids[body], x[body], y[body])}
 
 
+@pytest.mark.tier2  # runs of seconds each: the second tier (README's command stays within 8 minutes)
 @pytest.mark.parametrize("method", ["rings", "lattice"])
 def test_the_cylinder_sends_back_the_scattered_wave(method):
     """At (1.5, 0), between the pulse and the cylinder, the wave the cylinder's front sends back arrives at
@@ -215,6 +217,7 @@ def test_a_solver_that_skips_the_ghosts_fails_check_solver_on_the_cylinder():
     assert "plane-pulse" not in result.message.replace("plane-pulse-3200", "")  # the other scenes agree
 
 
+@pytest.mark.tier2  # runs of seconds each: the second tier (README's command stays within 8 minutes)
 def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_path):
     """Two dx per boundary method (stored rows with chosen errors): the orders are log(e1 / e2) / log 2, the
     target line names the best run at dx >= 0.02 and that it is not reached; both figures are drawn."""
