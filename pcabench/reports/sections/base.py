@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
 import pandas as pd
 
 from pcabench.reports import tables as T
@@ -37,6 +38,14 @@ class Context:
     # the open-edges study's runs too (``pcabench study --open``: open edges, their closed contrasts and cost
     # baselines), which only the "Open edges" section reads: the other sections' scenes are the closed ones
     df_open: pd.DataFrame | None = None
+
+    def every_run(self):
+        """This machine's runs with the open-edges study's (open edges, the cylinder's), for the sections that read
+        them: ``df_open``, else every scene's, else the paper scene's."""
+        for df in (self.df_open, self.df_scenes, self.df):
+            if df is not None:
+                return df
+        return None
 
     @property
     def pid(self) -> str:
@@ -89,6 +98,12 @@ SECTIONS = Registry(
 def in_order() -> list[Section]:
     """Every registered section, in report order (read at each report: one registered since is in it)."""
     return sorted(SECTIONS.all().values(), key=lambda s: (s.order, s.name))
+
+
+def stored_measure(r, name: str) -> float | None:
+    """A scene's stored error measure ``name`` of a report row (``err_<name>``), None where not a finite number."""
+    v = r.get(f"err_{name}")
+    return None if v is None or not np.isfinite(v) else float(v)
 
 
 def limit_words(stable_cfl: float) -> str:

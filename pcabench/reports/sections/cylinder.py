@@ -18,17 +18,12 @@ import numpy as np
 from pcabench.presets.cylinder import CYLINDER, CYLINDER_T_END
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.sections.base import Section
+from pcabench.reports.sections.base import Section, stored_measure
 from pcabench.reports.tables import latest
 from pcabench.spec import scene_from_row
 
 TARGET = 0.02  # the issue's: 2 % relative RMS at the probes
 TARGET_DX = 0.02  # at no more than 10 particles a pulse width
-
-
-def _err(r, name: str) -> float | None:
-    v = r.get(f"err_{name}")
-    return None if v is None or not np.isfinite(v) else float(v)
 
 
 def rows(df) -> dict | None:
@@ -51,10 +46,10 @@ def rows(df) -> dict | None:
                 "t_end": float(scene.t_final),
                 "status": r.status,
                 "failed_step": r.failed_step,
-                "probes": _err(r, "probe_rms"),
-                **{k: _err(r, f"probe_{k}") for k in "ABC"},
-                "near": _err(r, "near_rms"),
-                "far": _err(r, "far_rms"),
+                "probes": stored_measure(r, "probe_rms"),
+                **{k: stored_measure(r, f"probe_{k}") for k in "ABC"},
+                "near": stored_measure(r, "near_rms"),
+                "far": stored_measure(r, "far_rms"),
                 "N": int(r.n_particles),
                 "step_ms": 1e3 * float(r.t_step) if r.status == "ok" else None,
                 "wall_s": float(r.t_solution) if r.status == "ok" else None,
@@ -302,16 +297,9 @@ def error_figure(data, ctx):
     return path
 
 
-def _runs(ctx):
-    for df in (ctx.df_open, ctx.df_scenes, ctx.df):
-        if df is not None:
-            return df
-    return None
-
-
 SECTION = Section(
     "cylinder",
-    lambda ctx: rows(_runs(ctx)),
+    lambda ctx: rows(ctx.every_run()),
     text,
     (probes_figure, error_figure),
     all_scenes=True,

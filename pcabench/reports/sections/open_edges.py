@@ -20,17 +20,12 @@ from pcabench.presets.open_edges import OPEN, OPEN_DX, OPEN_SCENES, open_cost_ro
 from pcabench.presets.stability import LONG_T_END
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.sections.base import Section
+from pcabench.reports.sections.base import Section, stored_measure
 from pcabench.reports.tables import latest, long_run_limits
 from pcabench.spec import scene_from_row
 
 TARGET_AMPLITUDE = 1e-2  # the issue's: at most 1 % of the amplitude left behind
 INCIDENCE = {"plane-pulse": "normal (plane pulse)", "acoustic-pulse": "oblique (2D pulse)"}
-
-
-def _err(r, name: str) -> float | None:
-    v = r.get(f"err_{name}")
-    return None if v is None or not np.isfinite(v) else float(v)
 
 
 def _finished(df, preset: str):
@@ -58,12 +53,12 @@ def left_rows(df) -> list[dict]:
                 "strength": scene.strength,
                 "strength_c0_L": scene.strength * scene.layer / scene.c0,
                 "default": scene.layer_width is None and scene.absorber_strength is None,
-                "reflected": _err(r, "reflected_amplitude"),
-                "reflected_energy": _err(r, "reflected_energy"),
-                "amplitude": _err(r, "left_amplitude"),
-                "energy": _err(r, "left_energy"),
-                "axis": _err(r, "left_axis"),
-                "diagonal": _err(r, "left_diagonal"),
+                "reflected": stored_measure(r, "reflected_amplitude"),
+                "reflected_energy": stored_measure(r, "reflected_energy"),
+                "amplitude": stored_measure(r, "left_amplitude"),
+                "energy": stored_measure(r, "left_energy"),
+                "axis": stored_measure(r, "left_axis"),
+                "diagonal": stored_measure(r, "left_diagonal"),
                 "N": int(r.n_particles),
                 "scored": scene.n_scored,
                 "step_ms": 1e3 * float(r.t_step),
@@ -453,18 +448,9 @@ def figure(data, ctx):
     return path
 
 
-def _runs(ctx):
-    """The machine's runs the section reads: the open study's with the closed ones (the closed scenes' long
-    runs)."""
-    for df in (ctx.df_open, ctx.df_scenes, ctx.df):
-        if df is not None:
-            return df
-    return None
-
-
 SECTION = Section(
     "open_edges",
-    lambda ctx: rows(_runs(ctx)),
+    lambda ctx: rows(ctx.every_run()),
     text,
     (figure,),
     all_scenes=True,

@@ -15,7 +15,7 @@ import numpy as np
 from pcabench.presets import FREE_COUNTERPART, LONG_T_END, WALLS, cost_round
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.sections.base import Section
+from pcabench.reports.sections.base import Section, stored_measure
 from pcabench.reports.sections.scenes import T_FINAL
 from pcabench.reports.tables import is_paper_method, latest, long_run_limits
 from pcabench.spec import scene_from_row
@@ -25,11 +25,6 @@ from solvers import Scene, scenes
 def wall_scenes() -> tuple[str, ...]:
     """The registered scene kinds with a rigid wall."""
     return tuple(name for name, kind in scenes().items() if kind.walls)
-
-
-def _err(r, name: str) -> float | None:
-    v = r.get(f"err_{name}")
-    return None if v is None or not np.isfinite(v) else float(v)
 
 
 def accuracy(df) -> list[dict]:
@@ -60,8 +55,8 @@ def accuracy(df) -> list[dict]:
                 "N": int(r.n_particles),
                 "domain": r.domain,
                 "mse": float(r.mse),
-                "wall_rms": _err(r, "wall_rms"),
-                "bulk_rms": _err(r, "bulk_rms"),
+                "wall_rms": stored_measure(r, "wall_rms"),
+                "bulk_rms": stored_measure(r, "bulk_rms"),
                 "predicted": p.predicted_error,
                 "predicted_wall": measures.get("wall_rms"),
                 "predicted_bulk": measures.get("bulk_rms"),
