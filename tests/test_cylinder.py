@@ -271,7 +271,6 @@ def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_pa
 @pytest.mark.parametrize(
     "words, says",
     [
-        (["accuracy", "--scene", "cylinder", "--dx", "0.05"], "no dispersion prediction exists with a body"),
         (["study", "--front", "--scene", "cylinder"], "front is `pcabench study --cylinder`"),
         (
             ["run", "--solver", "linkedlist-cpu", "--scene", "cylinder", "--dx", "0.05", "--probe", "0.6,0"],

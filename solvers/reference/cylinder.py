@@ -43,6 +43,7 @@ import numpy as np
 
 LN2 = math.log(2.0)
 SPECTRUM_FLOOR = 1e-16  # exp(-k_max^2 b^2 / (4 ln2)): where the pulse's spectrum ends
+FIELD_CHUNK = 1 << 20  # points a whole field is evaluated at in one piece
 SUPPORT_WIDTHS = 8.0  # the pulse's radial support either side of d, in widths (exp(-ln2 64) = 5e-20)
 
 
@@ -151,12 +152,30 @@ class CylinderPulse:
     """The exact linear solution (drho, kg/m^3) of the pulse of amplitude ``amplitude`` = rho0 Ma and width ``b``
     (m) centred at (``xc``, ``yc``) scattered by a rigid cylinder of radius ``a`` (m) centred at (``x0``, ``y0``),
     c0 m/s: :meth:`drho` at points and times, the free pulse plus the scattered field (module docstring), for
-    times up to ``t_max`` (s) and distances from the axis up to ``r_max`` (m), which size the k quadrature."""
+    times up to ``t_max`` (s) and distances from the axis up to ``r_max`` (m), which size the k quadrature.
+
+    ``factor`` (k, t) -> array (len(t), len(k)) is how each wavenumber k (1/m) evolves from rest: cos(c0 k t) for
+    the wave equation (default); a method's own (solvers/reference/dispersive_cylinder.py) gives the same series
+    in a dispersive medium with an exact wall."""
 
     def __init__(
-        self, a, b, xc, yc, amplitude, c0=1.0, x0=0.0, y0=0.0, t_max=10.0, r_max=10.0, r_nodes=160, orders=None
+        self,
+        a,
+        b,
+        xc,
+        yc,
+        amplitude,
+        c0=1.0,
+        x0=0.0,
+        y0=0.0,
+        t_max=10.0,
+        r_max=10.0,
+        r_nodes=160,
+        orders=None,
+        factor=None,
     ):
         self.a, self.b, self.amplitude, self.c0 = float(a), float(b), float(amplitude), float(c0)
+        self.factor = factor or self.wave_factor
         self.x0, self.y0, self.xc, self.yc = float(x0), float(y0), float(xc), float(yc)
         self.d = math.hypot(self.xc - self.x0, self.yc - self.y0)
         self.phase = math.atan2(self.yc - self.y0, self.xc - self.x0)  # the pulse's direction from the axis
@@ -165,6 +184,10 @@ class CylinderPulse:
         k_max = math.sqrt(-math.log(SPECTRUM_FLOOR) * 4.0 * LN2) / self.b
         # Gauss-Legendre nodes for the k integral up to the phase k_max (c0 t + r + d): a few per oscillation
         self.k_nodes = int(math.ceil(0.6 * k_max * (self.c0 * self.t_max + self.r_max + self.d))) + 64
+
+    def wave_factor(self, k, t) -> np.ndarray:
+        """cos(c0 k t), shape (len(t), len(k)): the wave equation's evolution of a standing mode from rest."""
+        return np.cos(self.c0 * np.outer(np.atleast_1d(t), k))
 
     def polar(self, x, y):
         """(r, theta) of points about the cylinder's axis, theta from the pulse's direction."""
@@ -183,7 +206,7 @@ class CylinderPulse:
             raise ValueError(f"the reference is built for t <= {self.t_max:g} s and r <= {self.r_max:g} m")
         k, wk, cj, cy = _spectrum(self.a, self.d, self.b, self.orders, self.k_nodes, self.r_nodes)
         out = np.zeros((t.size, r.size))
-        ckt = np.cos(self.c0 * np.outer(t, k)) * wk  # (t, k)
+        ckt = self.factor(k, t) * wk  # (t, k)
         kr = np.outer(r, k)  # (points, k)
         for n in range(self.orders):
             with np.errstate(over="ignore", invalid="ignore"):
@@ -196,24 +219,27 @@ class CylinderPulse:
 
     def free(self, x, y, t) -> np.ndarray:
         """The pulse without the cylinder (the open plane's Bessel integral), shape (len(t), *x.shape)."""
-        from solvers.reference.pulse2d import open_domain
-
         t = np.atleast_1d(np.asarray(t, float))
-        rr = np.hypot(np.asarray(x, float) - self.xc, np.asarray(y, float) - self.yc)
-        return np.stack([open_domain(rr, ti, self.b, 1.0, self.amplitude, self.c0)[0] for ti in t])
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        rr = np.hypot(x - self.xc, y - self.yc)
+        return self.free_radial(rr.ravel(), t).reshape((t.size, *rr.shape))
 
-    def free_radial(self, radii, t: float) -> np.ndarray:
-        """The free pulse's drho at distances ``radii`` (m) from its centre at ``t`` (s): the Bessel integral of
-        solvers.reference.pulse2d.open_domain, by scipy's J0 (fast for many radii)."""
+    def free_radial(self, radii, t) -> np.ndarray:
+        """The free pulse's drho at distances ``radii`` (m, 1D) from its centre at ``t`` (s; one time, or 1D: then
+        shape (len(t), len(radii))): the Bessel integral of solvers.reference.pulse2d.open_domain with the
+        evolution ``factor``, by scipy's J0 (fast for many radii)."""
         sp = _special()
         beta = self.b**2 / (4.0 * LN2)
         k_max = math.sqrt(math.log(1e18) / beta)
         radii = np.asarray(radii, dtype=np.float64)
-        nodes = int(math.ceil(0.5 * k_max * (abs(self.c0 * t) + radii.max(initial=0.0)))) + 32
+        times = np.atleast_1d(np.asarray(t, float))
+        reach = np.max(np.abs(self.c0 * times), initial=0.0) + radii.max(initial=0.0)
+        nodes = int(math.ceil(0.5 * k_max * reach)) + 32
         z, wz = np.polynomial.legendre.leggauss(nodes)
         k = 0.5 * k_max * (z + 1.0)
-        wk = 0.5 * k_max * wz * np.exp(-beta * k**2) * k * (self.b**2 / (2.0 * LN2)) * np.cos(self.c0 * k * t)
-        return self.amplitude * (sp.j0(np.outer(radii, k)) @ wk)
+        wk = 0.5 * k_max * wz * np.exp(-beta * k**2) * k * (self.b**2 / (2.0 * LN2))
+        out = self.amplitude * ((self.factor(k, times) * wk) @ sp.j0(np.outer(radii, k)).T)
+        return out if np.ndim(t) else out[0]
 
     def drho(self, x, y, t) -> np.ndarray:
         """drho (kg/m^3) at points ``x``, ``y`` and times ``t``: the free pulse plus the scattered field."""
@@ -226,6 +252,14 @@ class CylinderPulse:
         :meth:`drho`, at a cost that does not grow with the points' count."""
         from solvers.reference.pulse2d import lagrange4
 
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        if x.size > FIELD_CHUNK:  # in pieces: each order's interpolation holds a few arrays of the points' size
+            flat_x, flat_y = x.ravel(), y.ravel()
+            parts = [
+                self.field(flat_x[lo : lo + FIELD_CHUNK], flat_y[lo : lo + FIELD_CHUNK], t, dr)
+                for lo in range(0, flat_x.size, FIELD_CHUNK)
+            ]
+            return np.concatenate(parts).reshape(x.shape)
         dr = float(dr or self.b / 25.0)
         r, theta = self.polar(x, y)
         shape = r.shape
@@ -234,7 +268,7 @@ class CylinderPulse:
             raise ValueError(f"the reference is built for t <= {self.t_max:g} s and r <= {self.r_max:g} m")
         k, wk, cj, cy = _spectrum(self.a, self.d, self.b, self.orders, self.k_nodes, self.r_nodes)
         nodes = self.a + dr * np.arange(int(math.ceil((self.r_max - self.a) / dr)) + 4)
-        ckt = np.cos(self.c0 * k * t) * wk
+        ckt = self.factor(k, [t])[0] * wk
         kr = np.outer(nodes, k)
         s = (r - self.a) / dr
         i = np.clip(np.floor(s).astype(np.int64), 1, nodes.size - 3)

@@ -130,6 +130,10 @@ class SceneKind:
         periodic_y = "y" in self.periodic and "y" not in open_edges
         return frozenset(x | {"periodic-y" if periodic_y else "free-y"} | ({"body"} if self.body else set()))
 
+    def headline(self, t_end: float) -> str:
+        """What the headline error (``mse``) of a run to ``t_end`` (s) measures, in words."""
+        return f"relative RMS error of {self.primary} at t = {t_end:.4g} s"
+
     def probe_points(self, scene) -> dict:
         """{name: (x, y)} (m) where every run of this kind records drho: none by default (``--probe`` adds)."""
         return {}

@@ -56,6 +56,11 @@ class Cylinder(SceneKind):
     def body_of(self, scene) -> tuple:
         return 0.0, 0.0, float(scene.cylinder_radius)
 
+    def headline(self, t_end: float) -> str:
+        if t_end < WINDOW[0]:  # no reading in the window: the field's at the end (errors)
+            return super().headline(t_end)
+        return f"relative RMS error of p at the probes over {WINDOW[0]:g} <= t <= {min(t_end, WINDOW[1]):g} s"
+
     def probe_points(self, scene) -> dict:
         return probe_points(scene)
 
@@ -127,8 +132,9 @@ class Cylinder(SceneKind):
         zero = xp.zeros_like(drho)
         return zero, zero.copy(), drho
 
-    def reference(self, scene, t_max: float | None = None):
-        """The exact linear solution (solvers/reference/cylinder.CylinderPulse) for this scene, up to ``t_max``."""
+    def reference(self, scene, t_max: float | None = None, factor=None):
+        """The exact linear solution (solvers/reference/cylinder.CylinderPulse) for this scene, up to ``t_max``;
+        with ``factor``, each wavenumber's evolution from rest in place of cos(c0 k t) (the prediction's)."""
         from solvers.reference.cylinder import CylinderPulse
 
         x0, y0, a = scene.body
@@ -144,6 +150,7 @@ class Cylinder(SceneKind):
             y0,
             t_max=max(t_max if t_max is not None else scene.t_final, 1e-9),
             r_max=corner + 2 * scene.cutoff,
+            factor=factor,
         )
 
     def fluid(self, scene, fields):
@@ -182,19 +189,28 @@ class Cylinder(SceneKind):
             out["mse"], out["me"] = out["field_rms"], float(np.max(np.abs(d)))
         return out
 
-    def exact_fields(self, scene, t: float):
-        from solvers.interface import Fields
-
+    def lattice_sites(self, scene) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) of the scored domain's lattice sites, row by row, m (the body's inside included)."""
         nx, ny = scene.nx - 2 * scene.layer_columns, scene.ny - 2 * scene.layer_rows
         x = scene.x_min + (np.arange(nx) + 0.5) * scene.dx
         y = scene.y_min + (np.arange(ny) + 0.5) * scene.dx
-        gx, gy = (g.ravel() for g in np.meshgrid(x, y))
+        gx, gy = np.meshgrid(x, y)
+        return gx.ravel(), gy.ravel()
+
+    def exact_fields(self, scene, t: float):
+        from solvers.interface import Fields
+
+        gx, gy = self.lattice_sites(scene)
         drho = self.reference(scene, t).field(gx, gy, t)
         zero = np.zeros_like(drho)
         return Fields(x=gx, y=gy, u=zero, v=zero.copy(), drho=np.nan_to_num(drho), t=t)
 
     def predict(self, scene):
-        raise NotImplementedError("the cylinder scene has no dispersion prediction: the body is off the lattice")
+        """The errors the bulk's dispersion alone would give, the wall exact
+        (solvers/reference/dispersive_cylinder.py)."""
+        from solvers.reference.dispersive_cylinder import predict_cylinder
+
+        return predict_cylinder(scene)
 
     def tiny(self, scene):
         """A small square with the body, for the warm-up: a few thousand particles."""

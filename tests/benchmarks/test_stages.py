@@ -202,7 +202,7 @@ def test_scene_step(benchmark, scene):
     from solvers.reference.dispersion import predict
 
     assert record.status == "ok", record.message
-    if s.body is not None:  # no dispersion prediction off the lattice: the all-pair search's run, to round-off
+    if s.body is not None:  # the prediction holds the wall exact, not this boundary method: the all-pair run
         assert record.mse == pytest.approx(run(RunSpec("allpair-cpu", s)).mse, rel=1e-9)
         return
     assert record.mse == pytest.approx(predict(s).predicted_error, rel=SCENE_AGREEMENT[scene])
