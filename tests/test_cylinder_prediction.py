@@ -3,6 +3,7 @@ the method's own evolution of each wavenumber in place of cos(c0 k t), the wall 
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -85,3 +86,35 @@ def test_accuracy_prints_the_workshops_measure_on_the_cylinder(tmp_path):
     assert "predicted relative RMS error of p at the probes over 6 <= t <= 10 s: " in proc.stdout
     value = float(proc.stdout.split("over 6 <= t <= 10 s: ")[1].split()[0])
     assert 0.5 < value < 2.0  # dx 0.05 is four particles per pulse width: an error of order one
+
+
+def test_advise_names_the_cheapest_method_predicted_to_reach_the_probes_target(monkeypatch, tmp_path, capsys):
+    """No stored cylinder run reaches the target: advise searches the prediction (here a grid of two dx and one
+    h) and names the cheapest method predicted to reach it, with the study that runs it; a target none reaches
+    gets the closest method, predicted, in words."""
+    from pcabench import cli, store
+    from pcabench.cli import advise as A
+
+    from .test_study import row
+
+    monkeypatch.setattr(A, "search_grid", lambda kind: ((0.04, 0.02), (1.0,), (0.8,)))
+    path = tmp_path / "results" / "m.jsonl"
+    store.append(row(name="cylinder", dx=0.04, t_end=10.0, model="linear", mse=0.9, open="xy"), path)
+    predicted = {}
+    for kernel in A.kernel_names():
+        for dx in (0.04, 0.02):
+            base = Scene(name="cylinder", dx=dx, t_end=10.0, model="linear", kernel=kernel, h_factor=1.0)
+            trial = base.replace(cfl=round(0.8 * A.stable_cfl(base), 2))
+            predicted[kernel, dx] = (trial.kind.predict_headline(trial).predicted_error, trial)
+    errors = sorted(e for e, _ in predicted.values())
+    target = 0.5 * (errors[0] + errors[1])  # one method reaches it
+    code = cli.main(["advise", "--scene", "cylinder", "--error", f"{target}", "--results", str(path.parent), "--json"])
+    s = json.loads(capsys.readouterr().out)["suggestion"]
+    (kernel, dx), (_, trial) = min(predicted.items(), key=lambda kv: kv[1][0])
+    assert code == 1 and (s["kernel"], s["dx"], s["cfl"]) == (kernel, dx, trial.cfl)
+    assert f"--scene cylinder --kernel {kernel} --h-factor 1 --cfl {trial.cfl:g} --dx {dx:g}" in s["study"]
+    assert s["n_particles"] == trial.n_particles and s["steps"] == trial.n_steps
+    code = cli.main(["advise", "--scene", "cylinder", "--error", f"{0.5 * errors[0]}", "--results", str(path.parent)])
+    text = capsys.readouterr().out
+    assert code == 1 and "relative RMS error of p at the probes over 6 <= t <= 10 s" in text
+    assert f"no method of the searched grid is predicted to reach it (the closest: {kernel}, h = 1 dx" in text

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import itertools
 import shlex
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +37,7 @@ from solvers import (
     kernel_names,
     scene_kind,
 )
-from solvers.reference.dispersion import predict, stable_cfl
+from solvers.reference.dispersion import stable_cfl
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid), for
 # every registered kernel.
@@ -48,6 +49,20 @@ SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
 # accurate and the cheapest).
 SEARCH_DX_2D = (0.5, 0.25, 0.2, 0.125)
 SEARCH_CFL_SHARE_2D = (0.8,)
+# A scene with a body predicts its probes alone (about a second at any dx: solvers/reference/dispersive_cylinder.py):
+# down to 80 particles per pulse width, and wider kernels (each kernel's long-wave phase-speed deficit at fixed
+# h / dx, which no refinement removes, is smallest at h of 2.5 to 3 dx: docs/accuracy.md).
+SEARCH_DX_BODY = (0.04, 0.02, 0.01, 0.005, 0.0025)
+SEARCH_H_BODY = (1.0, 1.3, 1.6, 2.13, 2.5, 3.0)
+
+
+def search_grid(kind) -> tuple:
+    """(dxs, h factors, CFL shares of the predicted stable CFL) :func:`suggest` searches on a scene of ``kind``."""
+    if kind.body:
+        return SEARCH_DX_BODY, SEARCH_H_BODY, SEARCH_CFL_SHARE_2D
+    if kind.strip:
+        return SEARCH_DX, SEARCH_H, SEARCH_CFL_SHARE
+    return SEARCH_DX_2D, SEARCH_H, SEARCH_CFL_SHARE_2D
 
 
 def scene_of(r) -> dict:
@@ -180,15 +195,17 @@ def advise(
 
 
 def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFAULT_SCENE) -> dict:
-    """From the prediction: the cheapest configuration of a small grid predicted to reach ``error`` at ``t_end``
-    on ``scene`` (cost ~ particles x steps x neighbours: on the thinnest strip where a strip serves the scene,
-    else on its own domain, with SEARCH_DX_2D and SEARCH_CFL_SHARE_2D), and the paper configuration's dx."""
+    """From the prediction: the cheapest configuration of a small grid (:func:`search_grid`) predicted to reach
+    ``error`` at ``t_end`` on ``scene`` (cost ~ particles x steps x neighbours: on the thinnest strip where a strip
+    serves the scene, else on its own domain), the one predicted closest to it, and the paper configuration's dx.
+    A scene with a body is predicted with its wall exact (the bulk's dispersion alone: a lower bound of a run's
+    error); its search takes a minute or two and says so on stderr."""
     kind = scene_kind(scene)
-    if kind.body:  # no dispersion prediction off the lattice: nothing to suggest from
-        return {}
-    dxs, shares = (SEARCH_DX, SEARCH_CFL_SHARE) if kind.strip else (SEARCH_DX_2D, SEARCH_CFL_SHARE_2D)
-    best, paper = None, None
-    for kern, h in itertools.product(kernel_names(), SEARCH_H):
+    dxs, hs, shares = search_grid(kind)
+    best, paper, closest = None, None, None
+    for kern, h in itertools.product(kernel_names(), hs):
+        if kind.body:
+            print(f"advise: predicting {scene}'s probes with {kern}, h = {h:g} dx ...", file=sys.stderr, flush=True)
         for share in shares:
             for dx in sorted(dxs, reverse=True):  # coarse to fine: the first that reaches is this method's cheapest
                 try:
@@ -206,7 +223,9 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                 if not limit > 0:
                     break
                 trial = base.replace(cfl=round(share * limit, 2))
-                p = predict(trial)
+                p = kind.predict_headline(trial)
+                if closest is None or p.predicted_error < closest[1].predicted_error:
+                    closest = (trial, p)
                 if p.predicted_error > error:
                     continue
                 cost = (1 / dx) ** (1 if kind.strip else 2) * trial.n_steps * (trial.cutoff / dx) ** 2
@@ -218,14 +237,19 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
             candidate = Scene(dx=dx, name=scene, t_end=t_end, model="linear")
         except Exception:  # noqa: BLE001 - a dx the scene refuses (its wall inside the support) is not searched
             continue
-        if predict(candidate).predicted_error <= error:
+        if kind.predict_headline(candidate).predicted_error <= error:
             paper = candidate
             break
     out = {
         "paper_dx": None if paper is None else paper.dx,
         "smallest_dx_searched": min(dxs),
-        "note": "predicted from the dispersion relation of the linear part",
+        "note": "predicted from the dispersion relation of the linear part" + (", the wall exact" if kind.body else ""),
     }
+    if closest is not None:
+        c, p = closest
+        out["closest"] = dict(
+            kernel=c.kernel, h_factor=c.h_factor, cfl=c.cfl, dx=c.dx, predicted_error=p.predicted_error
+        )
     if best is not None:
         _, s, p = best
         out.update(
@@ -234,6 +258,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
             cfl=s.cfl,
             dx=s.dx,
             predicted_error=p.predicted_error,
+            **({} if kind.strip else {"n_particles": s.n_particles, "steps": s.n_steps}),
             study=shlex.join(
                 [
                     "pcabench",
@@ -254,7 +279,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                     f"{s.cfl:g}",
                     "--dx",
                     f"{s.dx:g}",
-                    f"{s.dx / 2:g}",
+                    *([] if kind.body else [f"{s.dx / 2:g}"]),  # a body's dx is fine already: its own run only
                 ]
             ),
         )
@@ -265,14 +290,12 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
     """``pcabench advise``'s answer in words: the text for :func:`advise`'s result ``out``, and whether a run
     reached the error."""
     lines = []
-    primary = scene_kind(scene).primary
     scene_words = "" if scene == DEFAULT_SCENE else f"{scene}, "
     no_reference = out["error_against"] == "the isothermal solution" and not scene_kind(scene).has_isothermal
     against = "the isothermal solution, which this scene does not have" if no_reference else out["error_against"]
     head = (
-        f"{scene_words}{model} to a relative RMS error of {primary} <= {error:g} "
-        f"(against {against}) at "
-        f"t = {t_end:g} s on {out['machine']}" + (f", {domain} domain" if domain else "")
+        f"{scene_words}{model} to a {scene_kind(scene).headline(t_end)} <= {error:g} "
+        f"(against {against}) on {out['machine']}" + (f", {domain} domain" if domain else "")
     )
     if not out["found"]:
         s = out["suggestion"]
@@ -285,18 +308,23 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
                 f"no {model} run of {scene} can be scored (no isothermal solution is known there); the "
                 "prediction below is of the linear part, the method to try with --model linear"
             )
-        if not s:  # a scene with a body: no dispersion prediction to search with
-            lines.append(
-                f"no prediction can suggest one on {scene} (the body is off the lattice): run finer, or other "
-                "kernels (`pcabench study --cylinder`), and ask again"
-            )
-            return "\n".join(lines), False
         if "study" not in s:
-            lines.append("no method of the searched grid is predicted to reach it")
+            c = s.get("closest")
+            lines.append(
+                "no method of the searched grid is predicted to reach it"
+                + (
+                    f" (the closest: {c['kernel']}, h = {c['h_factor']:g} dx, CFL {c['cfl']:g}, dx {c['dx']:g}: "
+                    f"predicted {c['predicted_error']:.3g}, {s['note']})"
+                    if c
+                    else ""
+                )
+            )
         else:
             lines.append(
                 f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, "
-                f"CFL {s['cfl']:g}, dx {s['dx']:g} (predicted {s['predicted_error']:.3g}); "
+                f"CFL {s['cfl']:g}, dx {s['dx']:g} (predicted {s['predicted_error']:.3g}"
+                + (f"; {s['n_particles']:,} particles, {s['steps']:,} steps" if "steps" in s else "")
+                + "); "
                 f"run:\n  {s['study']}"
             )
         lines.append(

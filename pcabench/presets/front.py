@@ -100,7 +100,7 @@ def front(size: str = "quick", scene: str = DEFAULT_SCENE, fast: bool = True) ->
     other: its own product (FRONT_2D) on its own domain and the paper's method beside it. Then, on a scene with
     an isothermal reference, which model it needs at several amplitudes."""
     kind = scene_kind(scene)
-    if kind.body:  # its dx must resolve the body, and no prediction names its fastest methods
+    if kind.body:  # its dx must resolve the body: its front is the cylinder preset (with the advised method)
         from solvers import SceneError
 
         raise SceneError(

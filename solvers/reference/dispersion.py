@@ -216,8 +216,13 @@ def stable_cfl(scene) -> float:
 def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> float:
     from solvers.scene import Scene
 
+    half = 20.0 + 4.0 * h_factor * max(cutoff_factor, 2.0)  # m: room for 3 cutoffs of any support (only D counts)
     unit = Scene(
         dx=1.0,
+        x_min=-half,
+        x_max=half,
+        y_min=-half,
+        y_max=half,
         kernel=kernel,
         h_factor=h_factor,
         cutoff_factor=cutoff_factor,

@@ -218,6 +218,10 @@ class SceneKind:
         """The linear model's predicted errors from the dispersion relation (solvers/reference/dispersion.py)."""
         raise NotImplementedError
 
+    def predict_headline(self, scene):
+        """:meth:`predict` where only its headline error is wanted (advise's search): a kind may skip the rest."""
+        return self.predict(scene)
+
     def mirror_extension(self, scene, u, v, drho) -> tuple:
         """(u, v, drho, keep): the initial fields (arrays with x the last axis) on the lattice whose periodic
         solution is this scene's, and the slice of its columns that is the scene's lattice. With rigid walls,

@@ -212,6 +212,12 @@ class Cylinder(SceneKind):
 
         return predict_cylinder(scene)
 
+    def predict_headline(self, scene):
+        """The probes' predicted error alone (seconds at any dx: no field of the lattice)."""
+        from solvers.reference.dispersive_cylinder import predict_cylinder
+
+        return predict_cylinder(scene, field=False)
+
     def tiny(self, scene):
         """A small square with the body, for the warm-up: a few thousand particles."""
         a = scene.cylinder_radius
