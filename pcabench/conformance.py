@@ -77,7 +77,14 @@ SCENES = {  # the scene kinds at their smallest: free-x, x-periodic, walled at o
     # a rigid cylinder with its ghost particles (solvers/bodies/: the default boundary method), the pulse's flank
     # at its wall from the first step (a solver that skips the ghosts' values, Solver.fill_body, fails agreement)
     "cylinder": dict(
-        dx=0.125, name="cylinder", x_min=-3.3, x_max=3.3, y_min=-3.3, y_max=3.3, pulse_width=0.3, pulse_center=1.85
+        dx=0.125,
+        name="cylinder",
+        x_min=-1.375,  # the body and the pulse with 3 widths about it (1,376 particles with the layer)
+        x_max=2.75,
+        y_min=-1.375,
+        y_max=1.375,
+        pulse_width=0.3,
+        pulse_center=1.85,
     ),
 }
 # the paper's scene at 3,200 particles, checked once with the defaults: a solver wrong only past the tiny lattices'

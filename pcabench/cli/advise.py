@@ -361,6 +361,8 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
             f"  the paper's configuration: {out['paper_seconds']:.3g} s (error {out['paper_error']:.3g}), "
             f"{out['speedup_over_paper']:.3g} times as long\n  {out['paper_command']}"
         )
+    elif not scene_kind(scene).strip:  # one kind of domain: nowhere else to look
+        lines.append("  no stored run of the paper's configuration with the same threads and commit reaches it")
     else:
         other = {"strip": "full", "full": "strip"}[out["domain"]]
         lines.append(

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -24,6 +25,16 @@ from pcabench.spec import scene_from_row
 
 TARGET = 0.02  # the issue's: 2 % relative RMS at the probes
 TARGET_DX = 0.02  # at no more than 10 particles a pulse width
+# the prediction's dx (the wall exact, the bulk's dispersion alone: solvers/reference/dispersive_cylinder.py), to
+# four times finer than the finest run: where each method would go, and where it floors
+PREDICTED_DX = (0.04, 0.02, 0.01, 0.005, 0.0025)
+
+
+@lru_cache(maxsize=256)
+def predicted(scene) -> float:
+    """The probes' error the bulk's dispersion alone gives ``scene`` (linear, the wall exact): about 1 s."""
+    scene = scene.replace(model="linear", boundary_method="")
+    return float(scene.kind.predict_headline(scene).predicted_error)
 
 
 def rows(df) -> dict | None:
@@ -55,6 +66,7 @@ def rows(df) -> dict | None:
                 "wall_s": float(r.t_solution) if r.status == "ok" else None,
                 "series": json.loads(r.probes) if isinstance(r.get("probes"), str) else {},
                 "scene_value": scene,
+                "predicted": predicted(scene) if scene.model == "linear" and r.status == "ok" else None,
             }
         )
     runs.sort(key=lambda r: (r["model"], r["kernel"], r["h"], r["method"], r["cfl"], -r["dx"]))
@@ -104,6 +116,7 @@ def text(data, ctx) -> list[str]:
             f"{r['cfl']:g}",
             f"{r['N']:,}",
             fmt(r["probes"], ".3g") if r["status"] == "ok" else f"{r['status']} (step {_step(r)})",
+            fmt(r["predicted"], ".3g"),
             " / ".join(fmt(r[k], ".3g") for k in "ABC") if r["status"] == "ok" else "-",
             fmt(r["near"], ".3g"),
             fmt(r["far"], ".3g"),
@@ -120,8 +133,10 @@ def text(data, ctx) -> list[str]:
         "fluid's values at their mirror points (`lattice`: the lattice's own sites, a staircase; `rings`: rings "
         "fitted to the surface). Probes: the relative RMS of p at the workshop's points A (r = 5 m, 90 deg), B "
         "(135 deg), C (180 deg) over 6 <= t <= 10 s, together and each; near the body (within 3 cutoffs of its "
-        "surface) and away from it: the field's error at t = 10 s. `pcabench study --cylinder`, linked list, "
-        "serial.",
+        "surface) and away from it: the field's error at t = 10 s. Predicted: the probes' error the bulk's "
+        "dispersion alone gives, the series solution with each wavenumber evolved by the method's own (its "
+        "kernel's and its step's) instead of cos(c0 k t), the wall exact (`pcabench accuracy --scene cylinder`). "
+        "`pcabench study --cylinder`, linked list, serial.",
         "",
         md_table(
             [
@@ -133,6 +148,7 @@ def text(data, ctx) -> list[str]:
                 "CFL",
                 "N",
                 "probes",
+                "predicted (wall exact)",
                 "A / B / C",
                 "near the body",
                 "away from it",
@@ -163,6 +179,19 @@ def text(data, ctx) -> list[str]:
                 )
             )
         )
+        for key, pts in predicted_curves(ok).items():
+            kernel, h, cfl = key
+            reach = [dx for dx, e in pts if e <= TARGET]
+            lines.append(
+                f"- **Predicted, {kernel}, h = {h:g} dx, CFL {cfl:g}** (the wall exact): "
+                + ", ".join(f"{e:.3g} at dx {dx:g}" for dx, e in pts)
+                + (
+                    f"; 2 % from dx {max(reach):g} m ({scene_pulse_width(ok) / max(reach):g} particles a pulse width)."
+                    if reach
+                    else f"; 2 % not by dx {PREDICTED_DX[-1]:g} m (the kernel's long-wave phase-speed deficit at "
+                    "fixed h / dx, which refinement keeps, floors it: docs/accuracy.md)."
+                )
+            )
         for o in data["orders"]:
             model, kernel, h, method, cfl = o["key"]
             lines.append(
@@ -188,6 +217,22 @@ def text(data, ctx) -> list[str]:
             + (f"; bounded up to CFL {max(held):g}." if held else ".")
         )
     return lines + [""]
+
+
+def scene_pulse_width(runs) -> float:
+    return float(runs[0]["scene_value"].pulse_width)
+
+
+def predicted_curves(runs) -> dict:
+    """{(kernel, h, CFL): [(dx, predicted probes' error)]} on PREDICTED_DX for each linear method of ``runs``
+    run at two dx or more (the stability scan's single runs are not a method's curve)."""
+    out = {}
+    for key in sorted({(r["kernel"], r["h"], r["cfl"]) for r in runs}):
+        mine = [r for r in runs if (r["kernel"], r["h"], r["cfl"]) == key]
+        if len({r["dx"] for r in mine}) < 2:
+            continue
+        out[key] = [(dx, predicted(mine[0]["scene_value"].replace(dx=dx))) for dx in PREDICTED_DX]
+    return out
 
 
 def _exact(scene, series) -> tuple:
@@ -245,16 +290,17 @@ def error_figure(data, ctx):
     if not data:
         return None
     ok = [r for r in data["runs"] if r["status"] == "ok" and r["model"] == "linear" and r["probes"] is not None]
-    ok = [r for r in ok if np.isclose(r["cfl"], min(x["cfl"] for x in ok))]
-    if len({r["dx"] for r in ok}) < 2:
+    curves = predicted_curves(ok)
+    ok = [r for r in ok if (r["kernel"], r["h"], r["cfl"]) in curves]  # methods run at two dx or more
+    if not ok:
         return None
     path = ctx.out / "cylinder_error.png"
-    kernels = sorted({(r["kernel"], r["h"]) for r in ok})
+    kernels = list(curves)
     colours = F.palette(len(kernels))
     with F.figure(
         path,
-        f"Sound around a cylinder: error against dx, linear ({ctx.name}); colour: kernel, solid: lattice ghosts, "
-        "dashed: rings; grey: the 2 % target",
+        f"Sound around a cylinder: error against dx, linear ({ctx.name}); colour: method; solid: lattice ghosts, "
+        "dashed: rings, dotted: predicted (the wall exact); grey: the 2 % target",
         "dx (m)",
         "relative RMS",
         ncols=2,
@@ -270,12 +316,12 @@ def error_figure(data, ctx):
             )
         ):
             ax = axes[i]
-            for (kernel, h), colour in zip(kernels, colours):
+            for (kernel, h, cfl), colour in zip(kernels, colours):
                 for method in ("lattice", "rings"):
                     pts = sorted(
                         (r["dx"], r[what])
                         for r in ok
-                        if (r["kernel"], r["h"], r["method"]) == (kernel, h, method) and r[what]
+                        if (r["kernel"], r["h"], r["cfl"], r["method"]) == (kernel, h, cfl, method) and r[what]
                     )
                     if pts:
                         values[i] += [v for _, v in pts]
@@ -285,13 +331,18 @@ def error_figure(data, ctx):
                             ls="-" if method == "lattice" else "--",
                             marker="o",
                             ms=4,
-                            label=f"{kernel}, h = {h:g} dx, {method}",
+                            label=f"{kernel}, h = {h:g} dx, CFL {cfl:g}, {method}",
                         )
+                if i == 0:
+                    pts = curves[kernel, h, cfl]
+                    values[i] += [v for _, v in pts]
+                    ax.plot(*zip(*pts), color=colour, ls=":", lw=1.5, marker="x", ms=4)
             if i == 0:
                 ax.axhline(TARGET, color="0.6", lw=1.0, label="target: 2 %")
             F.nice_log_ticks(ax, values[i])
-            ax.set_xticks(sorted({r["dx"] for r in ok}))
-            ax.set_xticklabels([f"{d:g}" for d in sorted({r["dx"] for r in ok})])
+            ticks = sorted(set(PREDICTED_DX) if i == 0 else {r["dx"] for r in ok})
+            ax.set_xticks(ticks)
+            ax.set_xticklabels([f"{d:g}" for d in ticks])
             ax.minorticks_off()
             ax.set_title(title, fontsize=9)
     return path
