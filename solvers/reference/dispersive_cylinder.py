@@ -76,10 +76,8 @@ def site_stride(scene) -> int:
 def predicted_probes(scene, method) -> dict:
     """{"t": times, name: drho}: ``method``'s (the series with the method's evolution) drho at the scene's probe
     points at every step of the workshop's window, as a run records them."""
-    from solvers.scenes.cylinder import WINDOW
-
     steps = np.arange(1, scene.n_steps + 1)
-    times = steps[steps * scene.dt >= WINDOW[0] - 1e-9] * scene.dt
+    times = steps[steps * scene.dt >= scene.kind.window[0] - 1e-9] * scene.dt
     probes = {"t": times}
     for name, (px, py) in scene.probe_points().items():
         probes[name] = method.drho(np.array([px]), np.array([py]), times)[:, 0] if times.size else times

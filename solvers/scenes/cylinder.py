@@ -52,6 +52,7 @@ class Cylinder(SceneKind):
     fields = ("drho",)
     primary = "drho"
     body = True
+    window = WINDOW  # s: where the probes are scored
 
     def body_of(self, scene) -> tuple:
         return 0.0, 0.0, float(scene.cylinder_radius)
