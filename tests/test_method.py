@@ -77,9 +77,12 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
     df = frame.load(paths.reference_results())
     data = {(s, m, k, h, i): v for (s, m, k, h, _c, i), v in measured_limits().items()}
     checked = 0
-    for preset in ("stability-long", "walls"):
+    from pcabench.presets.cylinder import CYLINDER_ADVISED
+
+    paper = ("gaussian", 2.13)
+    for preset, methods in (("stability-long", {paper}), ("walls", {paper}), ("cylinder", {CYLINDER_ADVISED})):
         for r in T.long_run_limits(df, preset):
-            if r["kernel"] != "gaussian" or r["h_factor"] != 2.13 or r["blew_up_from"] is None:
+            if (r["kernel"], r["h_factor"]) not in methods or r["blew_up_from"] is None:
                 continue
             key = (r["scene"], r["model"], r["kernel"], r["h_factor"], "verlet")
             if r["blew_up_from"] < r["predicted"]:
@@ -87,4 +90,4 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
                 checked += 1
             else:
                 assert key not in data, (key, r)  # no limit below the prediction where the runs found none
-    assert checked == len(data) == 8
+    assert checked == len(data) == 9

@@ -26,7 +26,7 @@ from pcabench import jsonout, paths
 from pcabench.cli.accuracy import ROUNDED_AS_PRINTED
 from pcabench.cli.exits import EXIT_OK, EXIT_RUN_FAILED
 from pcabench.errors import NoResults
-from pcabench.predict.stability import assess, e_foldings
+from pcabench.predict.stability import assess, e_foldings, scene_limit
 from pcabench.reports.tables import comparable, default_numerics, error_column, latest, numerics_label
 from pcabench.spec import OptionError, scene_from_row
 from solvers import (
@@ -37,7 +37,6 @@ from solvers import (
     kernel_names,
     scene_kind,
 )
-from solvers.reference.dispersion import stable_cfl
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid), for
 # every registered kernel.
@@ -219,7 +218,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                     )
                 except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
                     continue
-                limit = stable_cfl(base)
+                limit = scene_limit(base)  # predicted, or lower where long runs of the scene measured it
                 if not limit > 0:
                     break
                 trial = base.replace(cfl=round(share * limit, 2))

@@ -99,6 +99,13 @@ def stable_limit(r) -> float:
     return linear if measured is None else min(linear, measured)
 
 
+def scene_limit(scene) -> float:
+    """:func:`stable_limit` of a Scene's method on its scene and model (open edges: the measured one, lower)."""
+    from solvers.method import Method
+
+    return stable_limit({"scene": scene.name, "model": scene.model, **Method.of(scene).scene_fields()})
+
+
 def past_limit(cfl: float, limit: float) -> bool:
     """Whether ``cfl`` is at or past the stable ``limit``: the scan's limit is the first unstable step."""
     return float(cfl) >= float(limit)

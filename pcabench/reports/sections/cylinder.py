@@ -16,6 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from pcabench.predict.stability import scene_limit
 from pcabench.presets.cylinder import CYLINDER, CYLINDER_T_END
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
@@ -182,8 +183,15 @@ def text(data, ctx) -> list[str]:
         for key, pts in predicted_curves(ok).items():
             kernel, h, cfl = key
             reach = [dx for dx, e in pts if e <= TARGET]
+            scene = next(r["scene_value"] for r in ok if (r["kernel"], r["h"], r["cfl"]) == key)
+            limit = scene_limit(scene.replace(model="linear"))
+            past = (
+                f" (past this scene's stable CFL {limit:g} that long runs measured: bounded only for t = 10 s)"
+                if cfl >= limit
+                else ""
+            )
             lines.append(
-                f"- **Predicted, {kernel}, h = {h:g} dx, CFL {cfl:g}** (the wall exact): "
+                f"- **Predicted, {kernel}, h = {h:g} dx, CFL {cfl:g}**{past} (the wall exact): "
                 + ", ".join(f"{e:.3g} at dx {dx:g}" for dx, e in pts)
                 + (
                     f"; 2 % from dx {max(reach):g} m ({scene_pulse_width(ok) / max(reach):g} particles a pulse width)."
