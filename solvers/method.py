@@ -77,10 +77,9 @@ class Method:
         """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion
         relation's, solvers/reference/dispersion.py; the same at every dx, so dx = 1 stands for all; 0 where the
         integrator grows at any step)."""
-        from solvers.reference.dispersion import stable_cfl
-        from solvers.scene import Scene
+        from solvers.reference.dispersion import stable_cfl, unit_scene
 
-        return stable_cfl(Scene(dx=1.0, t_end=1.0, model="linear", **{**self.scene_fields(), "cfl": 0.2}))
+        return stable_cfl(unit_scene(**{**self.scene_fields(), "cfl": 0.2}))
 
     def scene_fields(self) -> dict:
         """The Scene fields this method sets (a compact kernel's ``cutoff_factor`` left at its default)."""

@@ -388,11 +388,13 @@ def unstable_lines(rows, what: str) -> list[str]:
             else f"stable {r['stable_cfl']:.3g} measured over long runs"
         )
         limit = f"CFL {r['cfl']:g} is past the {which}" if r["stable_cfl"] > 0 else "its integrator grows at every CFL"
-        lines.append(
-            f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, "
+        why = (
             f"bounded only because its {r['steps']} steps gave the most unstable mode "
             f"{r['e_foldings']:.3g} e-foldings (round-off needs about 37)"
+            if r["limit_from"] == "prediction"
+            else f"bounded only because its {r['steps']} steps were fewer than the long runs' before they blew up"
         )
+        lines.append(f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; {limit}, {why}")
     return lines
 
 

@@ -212,23 +212,20 @@ def stable_cfl(scene) -> float:
     return _stable_cfl(scene.kernel, float(scene.h_factor), float(scene.cutoff_factor), scene.integrator)
 
 
-@lru_cache(maxsize=1024)
-def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> float:
+def unit_scene(**method):
+    """The paper's scene at dx = 1 m with ``method``'s fields (kernel, h_factor, cutoff_factor, integrator, cfl)
+    in a square wide enough for 3 cutoffs of any support: what depends on h/dx only (D dx, the stable CFL) is
+    computed on it."""
     from solvers.scene import Scene
 
-    half = 20.0 + 4.0 * h_factor * max(cutoff_factor, 2.0)  # m: room for 3 cutoffs of any support (only D counts)
-    unit = Scene(
-        dx=1.0,
-        x_min=-half,
-        x_max=half,
-        y_min=-half,
-        y_max=half,
-        kernel=kernel,
-        h_factor=h_factor,
-        cutoff_factor=cutoff_factor,
-        integrator=integrator,
-        model="linear",
-    )
+    reach = method.get("h_factor", 3.0) * max(method.get("cutoff_factor", 3.0), 2.0)
+    half = 20.0 + 4.0 * reach  # m
+    return Scene(dx=1.0, x_min=-half, x_max=half, y_min=-half, y_max=half, model="linear", **method)
+
+
+@lru_cache(maxsize=1024)
+def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> float:
+    unit = unit_scene(kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor, integrator=integrator)
     return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
 
 
