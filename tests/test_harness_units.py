@@ -202,3 +202,23 @@ def test_the_gpu_checks_open_stage_compares_open_scenes_and_tables_their_cost():
     )
     assert "## Open edges" in text and "| acoustic-pulse | 324 | float64 | lagrangian | 1.0 | 3 | 1.00e-14 |" in text
     assert "| plane-pulse | 0.025 | x | sponge | 1,600,000 | 1,984,000 | 2.5 | 3.1 | 1.240 |" in text
+
+
+def test_the_gpu_checks_body_stage_compares_the_cylinder_with_each_boundary_method():
+    """The body stage runs the cylinder (the rehearsal's: check-solver's, one method, model and precision; on a
+    card the workshop's at dx 0.04 with both boundary methods) against the CPU, and the tables list it."""
+    from pcabench.conformance import SCENES
+    from pcabench.gpu import plan, tables
+    from solvers import Scene
+    from solvers.bodies import boundary_method_names
+
+    assert plan.REHEARSAL.body_scenes == (SCENES["cylinder"],)
+    assert all(Scene(**s).body is not None for s in plan.FULL.body_scenes + plan.REHEARSAL.body_scenes)
+    assert set(plan.FULL.body_methods) == set(boundary_method_names())
+    row = {"scene": "cylinder (rings)", "N": 1376, "precision": "float32", "model": "lagrangian", "dx": 0.125}
+    text = tables.markdown(
+        {"id": "m"},
+        {"budget_s": 1, "elapsed_s": 1, "stages": [], "body": [{**row, "steps": 3, "max_rel_diff_u": 2e-7,
+                                                                  "max_rel_diff_drho": 1e-7}]},
+    )  # fmt: skip
+    assert "## A rigid cylinder" in text and "| cylinder (rings) | 1,376 | float32 | lagrangian | 0.125 | 3 |" in text

@@ -42,7 +42,7 @@ def gpu_against_cpu(scene: Scene, out: Path) -> dict:
         flush=True,
     )
     return {
-        "scene": scene.name,
+        "scene": scene.name + (f" ({scene.boundary_method_used})" if scene.body is not None else ""),
         "N": scene.n_particles,
         "precision": scene.precision,
         "model": scene.model,
@@ -76,6 +76,28 @@ def walls_against_cpu(plan: Plan, out: Path) -> list[dict]:
         for walled in plan.wall_scenes
         for precision in PRECISIONS
         for model in plan.wall_models
+    ]
+
+
+def body_against_cpu(plan: Plan, out: Path) -> list[dict]:
+    """The same on each scene of the plan with a body (the cylinder), each boundary method, model and precision."""
+    return [
+        gpu_against_cpu(
+            Scene(
+                **{
+                    **scene,
+                    "steps": plan.compare_steps,
+                    "boundary_method": method,
+                    "model": model,
+                    "precision": precision,
+                }
+            ),
+            out,
+        )
+        for scene in plan.body_scenes
+        for method in plan.body_methods
+        for model in plan.body_models
+        for precision in plan.body_precisions
     ]
 
 

@@ -16,7 +16,8 @@ spent, keeping what it has:
    ``walls``: the same on the scenes with rigid walls (plane-wall, pulse-wall:
    mirror particles), linear and lagrangian, both precisions; ``open``: the same on
    open edges (the 2D pulse's open square with the PML, the paper's pulse's open x
-   with the sponge), and the time per step closed and open, alternating;
+   with the sponge), and the time per step closed and open, alternating; ``body``:
+   the same on the workshop's cylinder, each boundary method (ghost particles);
 3. ``sweep``: linkedlist-gpu, lagrangian Verlet, both precisions, 100K to 62.5M
    particles on the paper's domain, steps sized to the budget; runs go to the
    results store (preset ``gpu``) through the ordinary sweep, in this process
@@ -56,7 +57,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from pcabench.gpu.agreement import agrees, compare_with_cpu, open_against_cpu, open_cost, walls_against_cpu
+from pcabench.gpu.agreement import (
+    agrees,
+    body_against_cpu,
+    compare_with_cpu,
+    open_against_cpu,
+    open_cost,
+    walls_against_cpu,
+)
 from pcabench.gpu.ceilings import measure_ceilings
 from pcabench.gpu.graph_timing import graph_vs_plain
 from pcabench.gpu.plan import FULL, REHEARSAL, Budget, Plan
@@ -116,6 +124,11 @@ def compare(c: Check) -> bool:
 def walls(c: Check) -> bool:
     c.state["walls"] = walls_against_cpu(c.plan, c.out)
     return agrees(c.state["walls"])
+
+
+def body(c: Check) -> bool:
+    c.state["body"] = body_against_cpu(c.plan, c.out)
+    return agrees(c.state["body"])
 
 
 def open_edges(c: Check) -> bool:
@@ -226,6 +239,7 @@ STAGES = (
     Stage("walls", 40, walls),
     Stage("sweep", 60, gpu_sweep),
     Stage("open", 40, open_edges),
+    Stage("body", 40, body),
     Stage("graph", 40, graph),
     Stage("cpu", 40, cpu_peers),
     Stage("asv", 60, asv),

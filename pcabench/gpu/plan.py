@@ -37,6 +37,12 @@ class Plan:
          "open": "xy"},
         {"dx": 0.25, "open": "x"},
     )  # fmt: skip
+    # a body (issue 42): the workshop's cylinder at 5 particles a pulse width (102,400 particles), each boundary
+    # method (its ghosts filled from the fluid on the host), linear and lagrangian, against the CPU solver
+    body_scenes: tuple = ({"name": "cylinder", "dx": 0.04},)
+    body_methods: tuple = ("lattice", "rings")
+    body_models: tuple = ("linear", "lagrangian")
+    body_precisions: tuple = ("float64", "float32")
     open_cost: tuple = ({"dx": 0.025, "open": "x"}, {"name": "acoustic-pulse", "dx": 0.05, "open": "xy"})
     open_cost_steps: int = 50
     open_cost_rounds: int = 3
@@ -67,6 +73,10 @@ REHEARSAL = Plan(
     wall_scenes=(SCENES["pulse-wall"],),
     wall_models=("lagrangian",),
     open_scenes=(SCENES["acoustic-pulse-open"],),  # check-solver's open square: free y edges and the PML
+    body_scenes=(SCENES["cylinder"],),  # check-solver's cylinder (1,376 particles): one run a side in the simulator
+    body_methods=("rings",),
+    body_models=("lagrangian",),
+    body_precisions=("float32",),
     open_cost=({"dx": 1.0, "x_min": -8.0, "x_max": 8.0, "open": "x"},),
     open_cost_steps=2,
     open_cost_rounds=1,

@@ -73,7 +73,11 @@ def markdown(profile: dict, results: dict) -> str:
             f"{r['max_rel_diff_drho']:.2e} |"
             for r in results["compare"]
         ]
-    for key, what in (("walls", "Rigid walls (mirror particles)"), ("open", "Open edges (an absorbing layer)")):
+    for key, what in (
+        ("walls", "Rigid walls (mirror particles)"),
+        ("open", "Open edges (an absorbing layer)"),
+        ("body", "A rigid cylinder (ghost particles)"),
+    ):
         if results.get(key):
             lines += scene_agreement(what, results[key])
     if results.get("open_cost"):
