@@ -78,6 +78,8 @@ def test_advise_command_json_and_what_no_run_reaches(results, capsys):
     assert rc == 1 and "none of the 0 stored runs" in out and "pcabench study" in out
     rc, out, err = cli_main("advise", "--error", "2", "--results", str(results), capsys=capsys)
     assert rc == 2 and "--error" in err and "Traceback" not in err
+    rc, out, err = cli_main("advise", "--error", "0.02", "--t-end", "-3", "--results", str(results), capsys=capsys)
+    assert rc == 2 and "--t-end" in err and "> 0" in err and not out
 
 
 def test_advise_takes_a_machine_prefix_as_runs_does(results, capsys):

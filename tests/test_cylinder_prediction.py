@@ -94,6 +94,8 @@ def test_advise_names_the_cheapest_method_predicted_to_reach_the_probes_target(m
     gets the closest method, predicted, in words."""
     from pcabench import cli, store
     from pcabench.cli import advise as A
+    from pcabench.predict.stability import scene_limit
+    from solvers import kernel_names
 
     from .test_study import row
 
@@ -101,10 +103,10 @@ def test_advise_names_the_cheapest_method_predicted_to_reach_the_probes_target(m
     path = tmp_path / "results" / "m.jsonl"
     store.append(row(name="cylinder", dx=0.04, t_end=10.0, model="linear", mse=0.9, open="xy"), path)
     predicted = {}
-    for kernel in A.kernel_names():
+    for kernel in kernel_names():
         for dx in (0.04, 0.02):
             base = Scene(name="cylinder", dx=dx, t_end=10.0, model="linear", kernel=kernel, h_factor=1.0)
-            trial = base.replace(cfl=round(0.8 * A.scene_limit(base), 2))
+            trial = base.replace(cfl=round(0.8 * scene_limit(base), 2))
             predicted[kernel, dx] = (trial.kind.predict_headline(trial).predicted_error, trial)
     errors = sorted(e for e, _ in predicted.values())
     target = 0.5 * (errors[0] + errors[1])  # one method reaches it

@@ -405,6 +405,8 @@ def cmd_advise(args) -> int:
 
     if not 0 < args.error <= 1:
         raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
+    if not args.t_end > 0:
+        raise OptionError(f"--t-end is a physical time in s, > 0 (got {args.t_end:g})")
     results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
     df = load_frame(results) if results is not None and Path(results).exists() else None
     if df is not None and not df.empty:

@@ -58,9 +58,10 @@ class Cylinder(SceneKind):
         return 0.0, 0.0, float(scene.cylinder_radius)
 
     def headline(self, t_end: float) -> str:
-        if t_end < WINDOW[0]:  # no reading in the window: the field's at the end (errors)
+        start, end = self.window
+        if t_end < start:  # no reading in the window: the field's at the end (errors)
             return super().headline(t_end)
-        return f"relative RMS error of p at the probes over {WINDOW[0]:g} <= t <= {min(t_end, WINDOW[1]):g} s"
+        return f"relative RMS error of p at the probes over {start:g} <= t <= {min(t_end, end):g} s"
 
     def probe_points(self, scene) -> dict:
         return probe_points(scene)

@@ -196,7 +196,7 @@ def text(data, ctx) -> list[str]:
                 f"- **Predicted, {kernel}, h = {h:g} dx, CFL {cfl:g}**{past} (the wall exact): "
                 + ", ".join(f"{e:.3g} at dx {dx:g}" for dx, e in pts)
                 + (
-                    f"; 2 % from dx {max(reach):g} m ({scene_pulse_width(ok) / max(reach):g} particles a pulse width)."
+                    f"; 2 % from dx {max(reach):g} m ({scene.pulse_width / max(reach):g} particles a pulse width)."
                     if reach
                     else f"; 2 % not by dx {PREDICTED_DX[-1]:g} m (the kernel's long-wave phase-speed deficit at "
                     "fixed h / dx, which refinement keeps, floors it: docs/accuracy.md)."
@@ -240,10 +240,6 @@ def text(data, ctx) -> list[str]:
             + f"; the periodic lattice's predicted limit is {stable_cfl(mine[0]['scene_value']):.3g}."
         )
     return lines + [""]
-
-
-def scene_pulse_width(runs) -> float:
-    return float(runs[0]["scene_value"].pulse_width)
 
 
 def predicted_curves(runs) -> dict:
