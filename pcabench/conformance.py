@@ -58,7 +58,8 @@ SCENES = {  # the scene kinds at their smallest: free-x, x-periodic, walled at o
     "plane-wall": dict(name="plane-wall", **TINY_WALLED),
     "pulse-wall": dict(name="pulse-wall", **TINY_WALLED),
     # open x edges: an absorbing layer beyond the domain, the pulse's flank in it from the start (a solver that
-    # skips the layer's damping, Solver.absorb, or scores the layer's particles fails agreement here)
+    # skips the layer's damping, Solver.absorb around each kick and advance, or scores the layer's particles
+    # fails agreement here)
     "plane-pulse-open": dict(dx=1.0, x_min=-8.0, x_max=8.0, open="x", layer_width=3.0, pulse_center=5.0),
     # all four edges open (free y edges) with the split-field PML (the x part of the continuity rate): the pulse
     # off-centre, its flank in the right and the corner layers from the start

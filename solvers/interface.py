@@ -196,6 +196,8 @@ class Solver(abc.ABC):
         self.saved = {}
         self.t = 0.0
         self.reordered = 0  # how many times the arrays were put in a new order (a body's indices follow it)
+        self.moves = 0  # how many times moving particles moved (an advance, a restore)
+        self.layer_key, self.layer_sigma, self.layer_cache = None, (), {}  # the open edges' layer: layer_factors
         self.after_init()
 
     def after_init(self) -> None:
@@ -251,13 +253,17 @@ class Solver(abc.ABC):
 
     # ------------------------------------------------------------ system update
     def kick(self, f: float) -> None:
-        """u += f dt a."""
+        """u += f dt a (damped before and after in an open edge's layer: :meth:`absorb`)."""
         a = self.arrays
+        self.absorb(f, "velocity")
         self.launch("kick", a["u"], a["v"], a["ax"], a["ay"], self.dtype.type(f * self.scene.dt))
+        self.absorb(f, "velocity")
 
     def advance(self, f: float) -> None:
-        """drho += f dt D and, for moving particles, x += f dt u; time += f dt."""
+        """drho += f dt D and, for moving particles, x += f dt u; time += f dt (drho damped before and after in
+        an open edge's layer: :meth:`absorb`)."""
         a = self.arrays
+        self.absorb(f, "density")
         self.launch(
             "advance",
             a["drho"],
@@ -270,8 +276,15 @@ class Solver(abc.ABC):
             self.moving,
         )
         self.advance_split(f)
+        self.absorb(f, "density")
+        self.moved()
         self.pin_body()
         self.t += f * self.scene.dt
+
+    def moved(self) -> None:
+        """Moving particles have new positions: what was computed from the old ones (the layer's factors) goes."""
+        if self.moving:
+            self.moves += 1
 
     def advance_split(self, f: float) -> None:
         """drho_x += f dt ddx: a split absorber's x part of drho, updated with drho."""
@@ -279,26 +292,44 @@ class Solver(abc.ABC):
             a = self.arrays
             a["drho_x"] += self.dtype.type(f * self.scene.dt) * a["ddx"]
 
-    def absorb(self, f: float) -> None:
-        """The open edges' absorbing layers (solvers/absorbers/): the damping factors exp(-sigma f dt) of each
-        axis, sigma from each particle's depth beyond the domain's edges at its current position (0 inside the
-        domain, 1 on a closed axis), applied to the state by the absorber."""
+    def absorb(self, f: float, fields: str) -> None:
+        """The open edges' absorbing layers (solvers/absorbers/): ``fields`` ("velocity" or "density") damped by
+        half of an update of f dt, called before and after that update, so that the damping is a term of the
+        update (stable at the closed scene's CFL: solvers/absorbers/base.py); nothing on a closed scene."""
+        if self.absorber is not None:
+            self.absorber.damp(self.arrays, *self.layer_factors(f), fields)
+
+    def layer_factors(self, f: float) -> tuple:
+        """(fx, fy): exp(-sigma f dt / 2) of each axis, sigma from each particle's depth beyond the domain's edges
+        (0 inside the domain; 1 on a closed axis), kept until the particles move or are put in a new order."""
+        key = (self.reordered, self.moves)
+        if self.layer_key != key:
+            self.layer_key, self.layer_sigma, self.layer_cache = key, self.layer_rates(), {}
+        factors = self.layer_cache.get(f)
+        if factors is None:
+            h = 0.5 * f * self.scene.dt
+            factors = tuple(
+                self.dtype.type(1.0) if sigma is None else self.xp.exp(-sigma * h).astype(self.dtype)
+                for sigma in self.layer_sigma
+            )
+            self.layer_cache[f] = factors
+        return factors
+
+    def layer_rates(self) -> tuple:
+        """(sigma_x, sigma_y) in 1/s at each particle's current position (None on a closed axis)."""
         s, xp, a = self.scene, self.xp, self.arrays
-        if not s.open:
-            return
-        factors = []
+        rates = []
         for axis, lo, near, far, lattice, shift in (
             ("x", s.x_lo, s.x_min, s.x_max, "lx", "sx"),
             ("y", s.y_lo, s.y_min, s.y_max, "ly", "sy"),
         ):
             if axis not in s.open:
-                factors.append(self.dtype.type(1.0))
+                rates.append(None)
                 continue
             pos = lo + (a[lattice].astype(xp.float64) + 0.5) * s.dx + a[shift]
             depth = xp.maximum(xp.maximum(near - pos, pos - far), 0.0)
-            sigma = self.absorber.sigma(depth, s.layer, s.strength, xp)
-            factors.append(xp.exp(-sigma * (f * s.dt)).astype(self.dtype))
-        self.absorber.damp(a, *factors)
+            rates.append(self.absorber.sigma(depth, s.layer, s.strength, xp))
+        return tuple(rates)
 
     def continuity_x(self) -> None:
         """The x part of the continuity rate into ``ddx`` (a split absorber's: the PML): the same sweep with
@@ -323,6 +354,8 @@ class Solver(abc.ABC):
             names = (*names, "drho_x")
         for name in names:
             self.arrays[name][...] = self.saved[name]
+        if "sx" in names:
+            self.moved()
         if "drho" in names:
             self.t = self.saved_t
 

@@ -141,8 +141,10 @@ class LinkedListGPU(CellListSolver):
             self.continuity_x()
 
     def advance(self, f: float) -> None:
-        """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""
+        """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch (in an open
+        edge's layer drho is damped before and after: the coefficients are then recomputed at the next PI)."""
         a = self.arrays
+        self.absorb(f, "density")
         self.launch(
             "advance",
             a["drho"],
@@ -159,15 +161,11 @@ class LinkedListGPU(CellListSolver):
             self.k,
         )
         self.advance_split(f)
+        self.absorb(f, "density")
+        self.moved()
         self.pin_body()
         self.t += f * self.scene.dt
-        self.coefficients_fresh = True
-
-    def absorb(self, f: float) -> None:
-        """The open edges' layers damp drho too: its coefficients are recomputed at the next PI."""
-        super().absorb(f)
-        if self.scene.open:
-            self.coefficients_fresh = False
+        self.coefficients_fresh = self.absorber is None
 
     def restore(self, names) -> None:
         super().restore(names)

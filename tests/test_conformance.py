@@ -259,7 +259,7 @@ class IgnoresTheLayer(LinkedListCPU):
 
     name = "ignores-the-layer"
 
-    def absorb(self, f):
+    def absorb(self, f, fields):
         pass
 
 

@@ -98,24 +98,15 @@ def stable_limit(r) -> float:
     return linear if measured is None else min(linear, measured)
 
 
-# With open edges the layer's damping lowers the stable CFL (docs/accuracy.md "An open layer lowers the stable
-# CFL"): long runs blew up from 0.80 of the predicted limit and held at 0.74-0.75 of it, for the paper's method
-# (the plane and the 2D pulse, `pcabench study --open`) and for Wendland C2 at h = 2.5 dx (the cylinder,
-# measured_limits.csv). A method not measured with open edges is taken to blow up from this share.
-OPEN_EDGES_SHARE = 0.8
-
-
 def scene_limit(scene) -> float:
     """The stable CFL of a Scene's method on its scene and model, for choosing a step: :func:`stable_limit` (the
-    prediction, or the lower limit long runs of the scene measured), and with open edges where no long run of
-    the scene measured it, OPEN_EDGES_SHARE of the prediction."""
+    prediction, or the lower limit long runs of the scene measured). Open edges keep it: their damping is a term
+    of each update (solvers/absorbers/base.py; measured with `pcabench study --open` and the cylinder's long
+    runs, docs/accuracy.md "Open edges")."""
     from solvers.method import Method
 
     row = {"scene": scene.name, "model": scene.model, **Method.of(scene).scene_fields()}
-    limit = stable_limit(row)
-    if scene.open and measured_limit(row) is None:
-        limit = min(limit, OPEN_EDGES_SHARE * _limits(*method_of(row))[0])
-    return limit
+    return stable_limit(row)
 
 
 def past_limit(cfl: float, limit: float) -> bool:

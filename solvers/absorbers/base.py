@@ -1,16 +1,23 @@
 """What an absorber is: a damping rate sigma (1/s) across an open edge's layer of particles, one file each.
 
 An open edge (``Scene.open``) grows the lattice by a layer of ``Scene.layer_width`` beyond the scored domain.
-After every step the solver computes, for each particle, the damping factors of the two axes,
-fx = exp(-sigma(depth_x) dt) and fy = exp(-sigma(depth_y) dt) (depth: how far the particle is beyond the
-domain's x or y edge, 0 inside; sigma from the absorber's profile and strength, its own default unless
-``Scene.absorber_strength`` says otherwise; 1 on a closed axis), and the absorber applies them to the state
-(:meth:`Absorber.damp`): a sponge multiplies u, v and drho by fx fy; a split-field PML damps each field by its
-own axis's factor and needs the continuity rate split by axis (``split``: the solver then also computes the
-x part of d(drho)/dt, ``ddx``, and carries the x part of drho, ``drho_x``, as particle arrays). Each damping is
-exact for its own term (operator splitting), so it is stable at any strength and step; what a profile decides
-is how much of the sound the layer's onset reflects and how much it lets through to the outer (free) end and
-back.
+The damping is a term of each update: around every update of a field over a time h (a kick of u and v, an
+advance of drho), before it and after it, the solver computes for each particle the half-update factors of the
+two axes, fx = exp(-sigma(depth_x) h / 2) and fy = exp(-sigma(depth_y) h / 2) (depth: how far the particle is
+beyond the domain's x or y edge, 0 inside; sigma from the absorber's profile and strength, its own default
+unless ``Scene.absorber_strength`` says otherwise; 1 on a closed axis), and the absorber applies them to the
+fields of that update (:meth:`Absorber.damp`): a sponge multiplies them by fx fy; a split-field PML damps each
+field by its own axis's factor and needs the continuity rate split by axis (``split``: the solver then also
+computes the x part of d(drho)/dt, ``ddx``, and carries the x part of drho, ``drho_x``, as particle arrays).
+
+Why around each update and not after the step: an update damped symmetrically, f (u + h a) f, reads
+s (u' - u) + d (u' + u) = h a with s = cosh(sigma h / 2) >= 1 and d = sinh(sigma h / 2) >= 0 per particle, the
+undamped update with a dissipative term and a heavier particle, so the leapfrog's discrete energy still only
+falls and the scheme keeps the closed scene's stable CFL for any profile and strength. Damping every field once
+after the whole step, the earlier way, does not commute with the pair sums where sigma varies: measured, the
+default layers then blew up from CFL 4.0 where the closed scenes hold to 4.9 (docs/accuracy.md "Open edges").
+What a profile decides is how much of the sound the layer's onset reflects and how much it lets through to the
+outer (free) end and back.
 """
 
 from __future__ import annotations
@@ -19,8 +26,9 @@ from __future__ import annotations
 class Absorber:
     """An absorbing layer: ``sigma(depth, width, strength, xp)`` in 1/s, ``depth`` and ``width`` in m (arrays of
     the solver's module: numpy or CuPy), 0 at depth 0; ``default_strength(scene)``: the strength (1/s) a scene
-    gets when it names none; ``damp(arrays, fx, fy)``: the state after the step's damping (in place: a GPU
-    solver's arrays are views of one block). The base class damps like a sponge."""
+    gets when it names none; ``damp(arrays, fx, fy, fields)``: ``fields`` ("velocity": u and v; "density":
+    drho) damped by the factors, in place (a GPU solver's arrays are views of one block). The base class damps
+    like a sponge."""
 
     name: str = ""
     summary: str = ""
@@ -32,8 +40,11 @@ class Absorber:
     def sigma(self, depth, width: float, strength: float, xp):
         raise NotImplementedError
 
-    def damp(self, arrays, fx, fy) -> None:
-        """u, v and drho times fx fy: every field damped at the rate of both axes together."""
+    def damp(self, arrays, fx, fy, fields: str) -> None:
+        """The fields times fx fy: every field damped at the rate of both axes together."""
         factor = fx * fy
-        for name in ("u", "v", "drho"):
+        for name in FIELDS[fields]:
             arrays[name] *= factor
+
+
+FIELDS = {"velocity": ("u", "v"), "density": ("drho",)}  # what each update changes, by the name damp takes

@@ -19,8 +19,8 @@ class PML(Absorber):
     decays as exp(-int sigma_x dx / (c0 cos theta)); the sponge damps every field at sigma_x + sigma_y, which
     reflects at the onset and at low frequency (the 2D pulse's wake). The x part of the SPH continuity sum is
     the same sweep with v = 0 (the rate is linear in the velocities), computed by the solver (``split``) and
-    carried in ``drho_x`` through the integrator's updates; the damping is exact for its own terms. The profile
-    is the sponge's, sigma = strength (depth / width)^2."""
+    carried in ``drho_x`` through the integrator's updates; each field is damped around its own updates
+    (solvers/absorbers/base.py). The profile is the sponge's, sigma = strength (depth / width)^2."""
 
     name = "pml"
     summary = "split-field perfectly matched layer: u, drho_x damped by sigma_x, v, drho_y by sigma_y"
@@ -32,11 +32,13 @@ class PML(Absorber):
     def sigma(self, depth, width: float, strength: float, xp):
         return Sponge().sigma(depth, width, strength, xp)
 
-    def damp(self, arrays, fx, fy) -> None:
+    def damp(self, arrays, fx, fy, fields: str) -> None:
+        if fields == "velocity":
+            arrays["u"] *= fx
+            arrays["v"] *= fy
+            return
         drho, drho_x = arrays["drho"], arrays["drho_x"]
         drho -= drho_x  # drho's y part
         drho *= fy
         drho_x *= fx
         drho += drho_x
-        arrays["u"] *= fx
-        arrays["v"] *= fy

@@ -23,16 +23,8 @@ POSITION_DENSITY = ("sx", "sy", "drho")
 
 
 def step_program(integrator: str, solver, first: bool) -> list:
-    """The (stage, callable) list of one step of ``integrator`` on ``solver``; on a scene with open edges, the
-    absorbing layers' damping after it (``solver.absorb``, an update)."""
-    program = _program(integrator, solver, first)
-    scene = getattr(solver, "scene", None)
-    if scene is not None and getattr(scene, "open", ""):
-        program.append(("su", lambda: solver.absorb(1.0)))
-    return program
-
-
-def _program(integrator: str, solver, first: bool) -> list:
+    """The (stage, callable) list of one step of ``integrator`` on ``solver`` (on a scene with open edges each
+    kick and advance damps its own fields in the layer: ``Solver.absorb``)."""
     s = solver
     snp = ("snp", s.snp)
     both = ("pi", lambda: s.rates(True, True))
