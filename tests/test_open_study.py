@@ -116,7 +116,10 @@ def _store(path):
 
 
 def test_the_section_renders_the_stores_numbers_and_its_cheapest_layer(tmp_path):
-    df = frame.load(_store(tmp_path / "store" / "m.jsonl").parent)
+    path = _store(tmp_path / "store" / "m.jsonl")
+    closed_long = dict(name="acoustic-pulse", dx=0.25, model="linear", t_end=300.0, cfl=4.0, preset="stability-long")
+    store.append(row(x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0, **closed_long), path)  # closed: held at 4
+    df = frame.load(path.parent)
     data = S.rows(df)
     left = {(r["scene"], r["absorber"], r["layer"]): r for r in data["left"]}
     assert left[("plane-pulse", "pml", 6.0)]["reflected"] == 1.8e-3 and left[("plane-pulse", "pml", 6.0)]["widths"] == 2
@@ -136,12 +139,23 @@ def test_the_section_renders_the_stores_numbers_and_its_cheapest_layer(tmp_path)
     assert opened["particles"] == pytest.approx(1.24)
     (stable,) = data["stability"]
     assert stable["bounded_to"] == 3.0 and stable["blew_up_from"] == 3.5 and stable["first_step"] == 120
+    assert stable["closed"]["bounded_to"] == 4.0 and stable["lowers"] is True  # it blew up where closed held
     text = "\n".join(S.text(data, None))
     assert text.startswith("## Open edges")
     for heading in ("### What the open edges leave behind", "### What a layer costs", "### The stable CFL"):
         assert heading in text
     assert "| normal (plane pulse) | pml | 6 (2; 24) | 12 | 1.80e-03 | 3.24e-06 | 7.80e-03 |" in text
     assert "Cheapest reflecting less than 1 % of the amplitude, oblique (2D pulse): the pml, 6 m of layer" in text
+    assert "closed, bounded up to 4: the layer lowered it." in text
+
+
+def test_open_edges_lower_the_limit_only_where_they_blow_up_at_a_cfl_the_closed_scene_held():
+    closed = {"bounded_to": 4.75, "blew_up_from": 4.8}
+    assert S.lowers_limit({"blew_up_from": 4.0, "closed": closed}) is True
+    assert S.lowers_limit({"blew_up_from": 5.0, "closed": closed}) is False
+    assert S.lowers_limit({"blew_up_from": 4.75, "closed": closed}) is True  # blew up where closed held
+    assert S.lowers_limit({"blew_up_from": None, "closed": closed}) is None  # never blew up: no verdict here
+    assert S.lowers_limit({"blew_up_from": 4.0, "closed": None}) is None
 
 
 def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):

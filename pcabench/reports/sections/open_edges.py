@@ -162,7 +162,17 @@ def stability(df) -> list[dict]:
     closed = {(r["scene"], r["model"]): r for r in long_run_limits(df, preset="stability-long")}
     for r in rows:
         r["closed"] = closed.get((r["scene"], r["model"]))
+        r["lowers"] = lowers_limit(r)
     return rows
+
+
+def lowers_limit(r) -> bool | None:
+    """Whether the open edges lowered the stable CFL of a long-run row: they blew up at a CFL the closed scene
+    held (None where the closed scene's long runs or an open blow-up are missing)."""
+    held = (r.get("closed") or {}).get("bounded_to")
+    if held is None or r.get("blew_up_from") is None:
+        return None
+    return bool(r["blew_up_from"] <= held)
 
 
 def rows(df) -> dict | None:
@@ -343,10 +353,10 @@ def _stability_text(rows_) -> list[str]:
         "",
         "The long runs of `--stability long` with the edges open (the plane pulse's x edges with the sponge, the "
         "2D pulse's four with the PML, each at its default layer), beside the closed scenes' own long runs where "
-        "this store has them. The damping, exact for its own term, is split from the step; near the step's own "
-        "limit a layer whose damping changes by a large factor between neighbours in one step "
-        "(exp(-sigma dt)) excites the lattice's fastest modes, which the step no longer keeps bounded: the "
-        "stronger the layer and the longer the step, the lower the limit.",
+        "this store has them. The layer's damping is a term of each update, half before and half after every "
+        "kick and advance of the fields it damps (solvers/absorbers/base.py), so that the leapfrog's discrete "
+        "energy still only falls: it should hold wherever the closed scene holds. (Damping every field once "
+        "after the step, as runs before 2026-12-05 did, blew up from CFL 4.)",
         "",
         md_table(
             [
@@ -362,7 +372,24 @@ def _stability_text(rows_) -> list[str]:
             table,
         ),
         "",
+        *_stability_findings(rows_),
     ]
+
+
+def _stability_findings(rows_) -> list[str]:
+    """One line per scene and model: whether the open edges lowered the closed scene's stable CFL."""
+    lines = []
+    for r in rows_:
+        closed = r["closed"] or {}
+        if r["lowers"] is None:
+            continue
+        said = "lowered it" if r["lowers"] else "kept it"
+        lines.append(
+            f"- **{r['scene']}, {r['model']}**: open, bounded up to {fmt(r['bounded_to'], 'g')} and blew up from "
+            f"{fmt(r['blew_up_from'], 'g')}; closed, bounded up to {fmt(closed.get('bounded_to'), 'g')}: the "
+            f"layer {said}."
+        )
+    return [*lines, ""] if lines else []
 
 
 def text(data, ctx) -> list[str]:
