@@ -90,4 +90,4 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
                 checked += 1
             else:
                 assert key not in data, (key, r)  # no limit below the prediction where the runs found none
-    assert checked == len(data) == 9
+    assert checked == len(data) > 0  # every row checked against its runs, and there are rows

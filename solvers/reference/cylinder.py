@@ -41,6 +41,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from solvers.reference.pulse2d import gauss_legendre
+
 LN2 = math.log(2.0)
 SPECTRUM_FLOOR = 1e-16  # exp(-k_max^2 b^2 / (4 ln2)): where the pulse's spectrum ends
 FIELD_CHUNK = 1 << 20  # points a whole field is evaluated at in one piece
@@ -61,11 +63,11 @@ def _spectrum(a: float, d: float, b: float, orders: int, k_nodes: int, r_nodes: 
     in the scattered part, arrays (orders, k_nodes), for a unit amplitude."""
     sp = _special()
     k_max = math.sqrt(-math.log(SPECTRUM_FLOOR) * 4.0 * LN2) / b
-    z, w = np.polynomial.legendre.leggauss(k_nodes)
+    z, w = gauss_legendre(k_nodes)
     k = 0.5 * k_max * (z + 1.0)
     wk = 0.5 * k_max * w * k
     lo, hi = max(d - SUPPORT_WIDTHS * b, a), d + SUPPORT_WIDTHS * b
-    zr, wr = np.polynomial.legendre.leggauss(r_nodes)
+    zr, wr = gauss_legendre(r_nodes)
     r = 0.5 * (hi - lo) * (zr + 1.0) + lo
     wr = 0.5 * (hi - lo) * wr * r
     beta = 2.0 * LN2 * r * d / b**2
@@ -235,7 +237,7 @@ class CylinderPulse:
         times = np.atleast_1d(np.asarray(t, float))
         reach = np.max(np.abs(self.c0 * times), initial=0.0) + radii.max(initial=0.0)
         nodes = int(math.ceil(0.5 * k_max * reach)) + 32
-        z, wz = np.polynomial.legendre.leggauss(nodes)
+        z, wz = gauss_legendre(nodes)
         k = 0.5 * k_max * (z + 1.0)
         wk = 0.5 * k_max * wz * np.exp(-beta * k**2) * k * (self.b**2 / (2.0 * LN2))
         out = self.amplitude * ((self.factor(k, times) * wk) @ sp.j0(np.outer(radii, k)).T)
