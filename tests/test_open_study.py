@@ -149,13 +149,15 @@ def test_the_section_renders_the_stores_numbers_and_its_cheapest_layer(tmp_path)
     assert "closed, bounded up to 4: the layer lowered it." in text
 
 
-def test_open_edges_lower_the_limit_only_where_they_blow_up_at_a_cfl_the_closed_scene_held():
+def test_open_edges_lower_the_limit_where_they_blow_up_at_a_cfl_the_closed_scene_held_and_keep_it_only_as_far():
     closed = {"bounded_to": 4.75, "blew_up_from": 4.8}
-    assert S.lowers_limit({"blew_up_from": 4.0, "closed": closed}) is True
-    assert S.lowers_limit({"blew_up_from": 5.0, "closed": closed}) is False
-    assert S.lowers_limit({"blew_up_from": 4.75, "closed": closed}) is True  # blew up where closed held
-    assert S.lowers_limit({"blew_up_from": None, "closed": closed}) is None  # never blew up: no verdict here
-    assert S.lowers_limit({"blew_up_from": 4.0, "closed": None}) is None
+    assert S.lowers_limit({"bounded_to": 3.75, "blew_up_from": 4.0, "closed": closed}) is True
+    assert S.lowers_limit({"bounded_to": 4.75, "blew_up_from": 4.75, "closed": closed}) is True  # closed held it
+    assert S.lowers_limit({"bounded_to": 4.9, "blew_up_from": 5.0, "closed": closed}) is False
+    assert S.lowers_limit({"bounded_to": 5.0, "blew_up_from": None, "closed": closed}) is False  # never blew up
+    # held only to 4.6 and blew up past 4.75 (no run between): the runs do not say
+    assert S.lowers_limit({"bounded_to": 4.6, "blew_up_from": 4.8, "closed": closed}) is None
+    assert S.lowers_limit({"bounded_to": 4.9, "blew_up_from": 5.0, "closed": None}) is None
 
 
 def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):

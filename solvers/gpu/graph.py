@@ -32,6 +32,11 @@ class CapturedSteps:
                 f"integrator: the graph path replays {', '.join(GRAPH_INTEGRATORS)} "
                 f"(got {integrator!r}; rk2 allocates its saved copies inside the step)"
             )
+        if getattr(solver, "absorber", None) is not None:
+            raise ValueError(
+                "--open: the graph path replays closed scenes only (an open edge's layer keeps damping factors "
+                "that capture would record but never compute)"
+            )
         self.solver = solver
         t0, start = solver.t, solver.state()
         self.graphs = {}  # block it starts from -> (graph, block current after it, seconds it advances)

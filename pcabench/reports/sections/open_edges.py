@@ -167,12 +167,17 @@ def stability(df) -> list[dict]:
 
 
 def lowers_limit(r) -> bool | None:
-    """Whether the open edges lowered the stable CFL of a long-run row: they blew up at a CFL the closed scene
-    held (None where the closed scene's long runs or an open blow-up are missing)."""
+    """Whether the open edges lowered the stable CFL of a long-run row: True where they blew up at a CFL the
+    closed scene held, False where they held as far as it did, None where the runs do not say (no closed long
+    runs, or the open ones neither held that far nor blew up within it)."""
     held = (r.get("closed") or {}).get("bounded_to")
-    if held is None or r.get("blew_up_from") is None:
+    if held is None:
         return None
-    return bool(r["blew_up_from"] <= held)
+    if r.get("blew_up_from") is not None and r["blew_up_from"] <= held:
+        return True
+    if r.get("bounded_to") is not None and r["bounded_to"] >= held:
+        return False
+    return None
 
 
 def rows(df) -> dict | None:
@@ -384,10 +389,10 @@ def _stability_findings(rows_) -> list[str]:
         if r["lowers"] is None:
             continue
         said = "lowered it" if r["lowers"] else "kept it"
+        blew = f" and blew up from {fmt(r['blew_up_from'], 'g')}" if r["blew_up_from"] is not None else ""
         lines.append(
-            f"- **{r['scene']}, {r['model']}**: open, bounded up to {fmt(r['bounded_to'], 'g')} and blew up from "
-            f"{fmt(r['blew_up_from'], 'g')}; closed, bounded up to {fmt(closed.get('bounded_to'), 'g')}: the "
-            f"layer {said}."
+            f"- **{r['scene']}, {r['model']}**: open, bounded up to {fmt(r['bounded_to'], 'g')}{blew}; closed, "
+            f"bounded up to {fmt(closed.get('bounded_to'), 'g')}: the layer {said}."
         )
     return [*lines, ""] if lines else []
 
