@@ -262,8 +262,17 @@ class Solver(abc.ABC):
     def advance(self, f: float) -> None:
         """drho += f dt D and, for moving particles, x += f dt u; time += f dt (drho damped before and after in
         an open edge's layer: :meth:`absorb`)."""
-        a = self.arrays
         self.absorb(f, "density")
+        self.advance_launch(f)
+        self.advance_split(f)
+        self.absorb(f, "density")
+        self.moved()
+        self.pin_body()
+        self.t += f * self.scene.dt
+
+    def advance_launch(self, f: float) -> None:
+        """The advance's kernel: drho += f dt D and, for moving particles, x += f dt u."""
+        a = self.arrays
         self.launch(
             "advance",
             a["drho"],
@@ -275,11 +284,6 @@ class Solver(abc.ABC):
             self.dtype.type(f * self.scene.dt),
             self.moving,
         )
-        self.advance_split(f)
-        self.absorb(f, "density")
-        self.moved()
-        self.pin_body()
-        self.t += f * self.scene.dt
 
     def moved(self) -> None:
         """Moving particles have new positions: what was computed from the old ones (the layer's factors) goes."""

@@ -140,11 +140,9 @@ class LinkedListGPU(CellListSolver):
         if continuity and self.split:
             self.continuity_x()
 
-    def advance(self, f: float) -> None:
-        """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch (in an open
-        edge's layer drho is damped before and after: the coefficients are then recomputed at the next PI)."""
+    def advance_launch(self, f: float) -> None:
+        """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""
         a = self.arrays
-        self.absorb(f, "density")
         self.launch(
             "advance",
             a["drho"],
@@ -160,12 +158,13 @@ class LinkedListGPU(CellListSolver):
             a["pr"],
             self.k,
         )
-        self.advance_split(f)
-        self.absorb(f, "density")
-        self.moved()
-        self.pin_body()
-        self.t += f * self.scene.dt
-        self.coefficients_fresh = self.absorber is None
+        self.coefficients_fresh = True
+
+    def absorb(self, f: float, fields: str) -> None:
+        """An open edge's layer damps drho too: its coefficients are then recomputed at the next PI."""
+        super().absorb(f, fields)
+        if self.absorber is not None and fields == "density":
+            self.coefficients_fresh = False
 
     def restore(self, names) -> None:
         super().restore(names)

@@ -22,6 +22,8 @@ outer (free) end and back.
 
 from __future__ import annotations
 
+FIELDS = {"velocity": ("u", "v"), "density": ("drho",)}  # what each update changes, by the name damp takes
+
 
 class Absorber:
     """An absorbing layer: ``sigma(depth, width, strength, xp)`` in 1/s, ``depth`` and ``width`` in m (arrays of
@@ -45,6 +47,3 @@ class Absorber:
         factor = fx * fy
         for name in FIELDS[fields]:
             arrays[name] *= factor
-
-
-FIELDS = {"velocity": ("u", "v"), "density": ("drho",)}  # what each update changes, by the name damp takes
