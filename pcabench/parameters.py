@@ -127,7 +127,8 @@ BOUNDARY = (
     Parameter(
         "layer_width",
         "--layer-width",
-        "the absorbing layer's width, m, in whole columns of dx (default: 2 pulse widths)",
+        "the absorbing layer's width, m, in whole columns of dx (default: the absorber's: the sponge's 1.5 pulse "
+        "widths, the PML's 2)",
         numeric=True,
         per_scene=True,
     ),

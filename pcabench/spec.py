@@ -21,6 +21,9 @@ from solvers.scene import PAPER_PULSE, PER_KIND
 from solvers.scenes import scene_kind
 
 SERIAL = 1
+# Every absorber's default layer, in pulse widths, for the rows stored before a row kept its layer's width (the
+# derived key ``layer``, m) and the sponge's default became 1.5 pulse widths (2026-12-05): :func:`stored_parameters`.
+LAYER_WIDTHS_BEFORE = 2.0
 ALL_CORES = "all"
 
 
@@ -155,8 +158,9 @@ def scene_parameters(scene: Scene) -> dict:
 
 def stored_parameters(scene: dict) -> dict:
     """A stored scene dict's own parameters (derived keys dropped), each one a row predates (absent or null) at
-    its default: the value runs had before the parameter existed (rows without ``kernel`` are Gaussian). The
-    one place old rows are brought up to the current fields (the frame, the resume key, scene_from_row)."""
+    its default: the value runs had before the parameter existed (rows without ``kernel`` are Gaussian), and an
+    open row's default layer the one it ran with (LAYER_WIDTHS_BEFORE, where the row does not state its layer).
+    The one place old rows are brought up to the current fields (the frame, the resume key, scene_from_row)."""
     fields = Scene.__dataclass_fields__
     out = {k: fields[k].default if scene.get(k) is None else scene[k] for k in fields if fields[k].compare}
     try:
@@ -166,6 +170,8 @@ def stored_parameters(scene: dict) -> dict:
     for k in PER_KIND:  # parameters whose default is the scene kind's: the value a Scene resolves
         if out[k] is None:
             out[k] = kind.defaults.get(k, PAPER_PULSE.get(k))
+    if out.get("open") and out.get("layer_width") is None and "n_particles" in scene and "layer" not in scene:
+        out["layer_width"] = LAYER_WIDTHS_BEFORE * out["pulse_width"]  # a stored row from before its layer's key
     return out
 
 

@@ -136,6 +136,11 @@ class LinkedListCPU(CellListSolver):
         self.spare = arr
         return out
 
+    def continuity_x(self) -> None:
+        """The pair list computed the x part with the rate (:meth:`_sweep`); the gather loop sweeps again."""
+        if self.pairs is None:
+            super().continuity_x()
+
     def _sweep(self, continuity: bool, momentum: bool) -> None:
         if self.pairs is None:
             return super()._sweep(continuity, momentum)
@@ -143,7 +148,12 @@ class LinkedListCPU(CellListSolver):
             use_threads(self.threads)
         a = self.arrays
         walls = bool(self.scene.walls)  # the list holds the real pairs; the mirrors' part is added at the walls
-        if continuity:
+        if continuity and self.split:  # a split absorber's x part in the same pass (continuity_x: nothing left)
+            self.pairs.continuity_split(a["u"], a["v"], a["vol"], a["drho"], a["dd"], a["ddx"], self.k)
+            if walls:
+                for v, out in ((a["v"], a["dd"]), (self.no_velocity, a["ddx"])):
+                    self.launch("wall_continuity", *self.geometry(), a["u"], v, a["vol"], a["drho"], out, self.k)
+        elif continuity:
             self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
             if walls:
                 self.launch("wall_continuity", *self.geometry(), a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)

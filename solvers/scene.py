@@ -83,7 +83,7 @@ class Scene:
     probes: tuple = ()  # points ((x, y), ...) m where a run records drho every few steps, beside the kind's own
     open: str = ""  # the edges that are open ("x": both x edges), by an absorbing layer beyond the domain;
     # "": the kind's (closed, but an open problem's: the cylinder's four edges)
-    layer_width: float | None = None  # the layer's width, m (whole rows of dx); None: 2 pulse widths
+    layer_width: float | None = None  # the layer's width, m (whole rows of dx); None: the absorber's default
     absorber: str = ""  # what damps the layer (solvers/absorbers/); "": the scene's (see absorber_used)
     absorber_strength: float | None = None  # its strength, 1/s; None: the absorber's default for the scene
     h_factor: float = 2.13  # h = h_factor * dx
@@ -335,6 +335,12 @@ class Scene:
         for axis in ("x", "y"):
             if axis in self.open and axis not in openable:
                 need(False, f"--open {axis}: {self.kind.closed_reason(axis)}")
+        try:  # first: the layer's default width is the absorber's
+            from solvers.absorbers import absorber_named
+
+            absorber_named(self.absorber_used)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
         for name in ("layer_width", "absorber_strength"):
             if getattr(self, name) is not None:
                 value = finite(name)
@@ -352,12 +358,6 @@ class Scene:
                 self.n_layer >= 1,
                 f"--layer-width must hold one column of dx = {self.dx:g} m (got {self.layer_asked:g} m)",
             )
-        try:
-            from solvers.absorbers import absorber_named
-
-            absorber_named(self.absorber_used)
-        except ValueError as exc:
-            raise SceneError(str(exc)) from None
 
     # ------------------------------------------------------------ open edges
     @property
@@ -372,8 +372,13 @@ class Scene:
 
     @property
     def layer_asked(self) -> float:
-        """The absorbing layer's width asked for, m: ``layer_width``, or two pulse widths."""
-        return self.layer_width if self.layer_width is not None else 2.0 * self.pulse_width
+        """The absorbing layer's width asked for, m: ``layer_width``, or the absorber's default (in pulse widths:
+        solvers/absorbers/)."""
+        if self.layer_width is not None:
+            return self.layer_width
+        from solvers.absorbers import absorber_named
+
+        return absorber_named(self.absorber_used).default_width(self)
 
     @property
     def n_layer(self) -> int:
@@ -610,6 +615,7 @@ class Scene:
             h=self.h,
             cutoff=self.cutoff,
             height=self.height,
+            layer=self.layer,
         )
         return d
 

@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 from pcabench.execute.run import run
-from pcabench.spec import RunSpec
+from pcabench.paths import reference_results
+from pcabench.spec import RunSpec, scene_from_row
+from pcabench.store import read_rows
 from solvers import Scene, SceneError, make_solver
 from solvers.physics.integrators import evolve
 from solvers.reference.dispersion import predicted_velocity
@@ -40,7 +42,7 @@ def departure(scene: Scene, solver: str = "linkedlist-cpu") -> tuple[float, floa
 
 
 def test_a_plane_pulse_leaves_through_an_open_end_within_the_issues_bounds():
-    """With the default layer (two pulse widths, the sponge at its default strength) what the pulse leaves
+    """With the default layer (1.5 pulse widths, the sponge at its default strength) what the pulse leaves
     behind is below 1 % of its amplitude and 1e-4 of its energy; the free end sends back nearly all of it."""
     amplitude, energy = departure(plane(open="x", t_end=T_GONE))
     assert amplitude < 1e-2 and energy < 1e-4, (amplitude, energy)
@@ -64,6 +66,29 @@ def test_the_scored_domain_is_the_closed_scenes_and_the_layer_adds_its_columns()
     assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
     record = run(RunSpec("linkedlist-cpu", opened))
     assert record.status == "ok" and record.n_particles == opened.n_particles, record.message
+
+
+def test_each_absorber_brings_its_own_default_layer():
+    """The sponge's default layer is 1.5 pulse widths (the thinnest inside the targets, above), the PML's two:
+    on the paper's domain (dx 0.1) the sponge's layer adds 18 % to its 100,000 particles."""
+    paper, sponge = Scene(dx=0.1), Scene(dx=0.1, open="x")
+    assert sponge.absorber_used == "sponge" and sponge.layer == pytest.approx(1.5 * sponge.pulse_width)
+    assert sponge.n_particles == paper.n_particles + 2 * 45 * paper.ny
+    pml = Scene(dx=0.1, open="x", absorber="pml")
+    assert pml.layer == pytest.approx(2 * pml.pulse_width) and pml.strength == pytest.approx(12 * pml.c0 / 6.0)
+
+
+def test_stored_open_rows_come_back_with_the_layer_they_ran():
+    """A row keeps its layer's width (the derived key ``layer``); a row stored before it did ran every absorber's
+    layer at two pulse widths and comes back so, not at today's default; every open run of the reference store
+    comes back with the particles it ran."""
+    scene = plane(dx=0.5, steps=2, open="x")
+    row = {"scene": scene.as_dict(), "n_particles": scene.n_particles}
+    assert scene_from_row(row) == scene and scene_from_row(row).n_particles == scene.n_particles
+    old = {k: v for k, v in scene.as_dict().items() if k != "layer"}
+    assert scene_from_row({"scene": old}).layer == pytest.approx(2 * scene.pulse_width)
+    rows = [r for r in read_rows(reference_results()) if (r.get("scene") or {}).get("open")]
+    assert rows and all(scene_from_row(r).n_particles == r["n_particles"] for r in rows)
 
 
 @pytest.mark.parametrize("model", ["linear", "lagrangian"])

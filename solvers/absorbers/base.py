@@ -35,6 +35,11 @@ class Absorber:
     name: str = ""
     summary: str = ""
     split: bool = False  # whether it needs the continuity rate split by axis (ddx) and drho's x part (drho_x)
+    default_widths: float = 2.0  # the layer's width a scene gets when it names none, in pulse widths
+
+    def default_width(self, scene) -> float:
+        """The layer's width (m) a scene gets when it names none: ``default_widths`` of its pulse widths."""
+        return self.default_widths * scene.pulse_width
 
     def default_strength(self, scene) -> float:
         raise NotImplementedError

@@ -166,6 +166,41 @@ def continuity(nbr, fx, fy, start, count, u, v, vol, drho, out, buf, k):
         out[i] = (k[RHO0] + k[NONLIN] * drho[i]) * total
 
 
+def continuity_split(nbr, fx, fy, start, count, u, v, vol, drho, out, outx, buf, bufx, k):
+    """out = d(drho)/dt and outx its x part (the terms in u: a split absorber's ``ddx``) in one pass over the
+    list; ``buf``, ``bufx`` hold one accumulator row per thread. The x part is what :func:`continuity` gives
+    with v = 0, to round-off, for a sixth of the work of that second sweep."""
+    n, nt = U(u.shape[0]), U(buf.shape[0])
+    for tt in prange(nt):
+        t = U(tt)
+        saved = flush_on(flush)
+        acc, accx = buf[t], bufx[t]
+        acc[:] = 0
+        accx[:] = 0
+        for i in range(t * n // nt, (t + U(1)) * n // nt):
+            ui, vi, voli = u[i], v[i], vol[i]
+            a, ax = acc[i], accx[i]
+            for m in range(U(start[i]), U(start[i]) + U(count[i])):
+                j = U(nbr[m])
+                sx = (ui - u[j]) * fx[m]
+                s = sx + (vi - v[j]) * fy[m]
+                a += vol[j] * s
+                ax += vol[j] * sx
+                acc[j] += voli * s
+                accx[j] += voli * sx
+            acc[i] = a
+            accx[i] = ax
+        flush_off(flush, saved)
+    for i in prange(n):
+        total, totalx = buf[0, i], bufx[0, i]
+        for t in range(U(1), nt):
+            total += buf[t, i]
+            totalx += bufx[t, i]
+        rho = k[RHO0] + k[NONLIN] * drho[i]
+        out[i] = rho * total
+        outx[i] = rho * totalx
+
+
 def momentum(nbr, fx, fy, start, count, mass, pr, ax, ay, bufx, bufy):
     """ax, ay = du/dt from the list; ``bufx``, ``bufy`` hold one accumulator row per thread."""
     n, nt = U(mass.shape[0]), U(bufx.shape[0])

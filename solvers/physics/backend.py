@@ -72,7 +72,7 @@ COMPILED = {
     "sorting": ("counting_sort", "sort_cells_by_x"),
     "cells": ("continuity", "momentum", "neighbours", "wall_continuity", "wall_momentum", "cell_ids"),
     "allpair": ("continuity", "momentum", "neighbours"),
-    "pairlist": ("build", "continuity", "momentum"),
+    "pairlist": ("build", "continuity", "continuity_split", "momentum"),
 }
 LOOP_OPTIONS = {"pairlist": {"error_model": "numpy"}}
 

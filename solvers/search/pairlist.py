@@ -130,6 +130,12 @@ class PairList:
             self.nbr, self.fx, self.fy, self.start, self.count, u, v, vol, drho, out, self.buf, k
         )
 
+    def continuity_split(self, u, v, vol, drho, out, outx, k) -> None:
+        """d(drho)/dt into ``out`` and its x part (v's terms left out) into ``outx``, in one pass."""
+        self.kernels["continuity_split"](
+            self.nbr, self.fx, self.fy, self.start, self.count, u, v, vol, drho, out, outx, self.buf, self.bufy, k
+        )
+
     def momentum(self, mass, pr, ax, ay) -> None:
         self.kernels["momentum"](
             self.nbr, self.fx, self.fy, self.start, self.count, mass, pr, ax, ay, self.buf, self.bufy
