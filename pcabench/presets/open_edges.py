@@ -22,9 +22,9 @@ OPEN_SCENES = {
 }
 OPEN_DX = 0.25
 OPEN_ABSORBERS = ("sponge", "pml")
-LAYER_PULSE_WIDTHS = (1.0, 2.0, 3.0)
+LAYER_PULSE_WIDTHS = (1.0, 1.5, 2.0, 3.0)  # 1.5: the sponge's default, 2: the PML's
 LAYER_STRENGTHS = (8.0, 12.0, 24.0)  # c0 / L
-# 2. Resolution: the default layer at half and twice the particles a pulse width (the 2D pulse).
+# 2. Resolution: each absorber's default layer at half and twice the particles a pulse width (the 2D pulse).
 OPEN_RESOLUTION_DX = (0.5, 0.125)
 # 3. Cost: time per step of the paper's scene (full domain, dx 0.1, lagrangian, serial) closed and with its x
 # edges open by each absorber's default layer, and of the 2D pulse's 40 m square closed and open (the PML), in

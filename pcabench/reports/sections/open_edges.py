@@ -279,7 +279,7 @@ def _resolution_text(data) -> list[str]:
         [
             r["absorber"],
             f"{r['dx']:g}",
-            f"{r['layer_particles']}",
+            f"{r['widths']:g} ({r['layer_particles']})",
             fmt(r["reflected"], ".2e"),
             fmt(r["reflected_energy"], ".2e"),
             fmt(r["amplitude"], ".2e"),
@@ -290,15 +290,14 @@ def _resolution_text(data) -> list[str]:
     return [
         "### The default layer against dx (the 2D pulse, four open edges)",
         "",
-        "Two pulse widths of layer at the absorber's default strength (12 c0 / L): what it reflects, what is left "
-        "against the exact solution, and what a perfect absorber leaves (the method's own dispersive tail) at the "
-        "same dx.",
+        "Each absorber's default layer and strength (12 c0 / L): what it reflects, what is left against the exact "
+        "solution, and what a perfect absorber leaves (the method's own dispersive tail) at the same dx.",
         "",
         md_table(
             [
                 "absorber",
                 "dx",
-                "layer particles a side",
+                "layer, pulse widths (particles a side)",
                 "reflected: amplitude",
                 "reflected: energy",
                 "left: amplitude",
