@@ -13,6 +13,7 @@ use, for a solver whose class says it is ``threaded``), resolved to an integer b
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import dataclass
 
@@ -171,8 +172,19 @@ def stored_parameters(scene: dict) -> dict:
         if out[k] is None:
             out[k] = kind.defaults.get(k, PAPER_PULSE.get(k))
     if out.get("open") and out.get("layer_width") is None and "n_particles" in scene and "layer" not in scene:
-        out["layer_width"] = LAYER_WIDTHS_BEFORE * out["pulse_width"]  # a stored row from before its layer's key
+        out["layer_width"] = _layer_before(out)  # a stored row from before its layer's key
     return out
+
+
+def _layer_before(parameters: dict) -> float | None:
+    """The layer's width (m) an open row stored before rows kept theirs ran at its default: LAYER_WIDTHS_BEFORE
+    pulse widths, stated only where today's default differs (the sponge's), else None (the default, the same)."""
+    before = LAYER_WIDTHS_BEFORE * parameters["pulse_width"]
+    try:
+        now = Scene(**parameters).layer_asked
+    except (SceneError, ValueError, TypeError):  # a row this checkout cannot build: as it was
+        return before
+    return None if math.isclose(now, before) else before
 
 
 def scene_from_row(row) -> Scene:

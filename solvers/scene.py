@@ -422,7 +422,8 @@ class Scene:
     def absorber_used(self) -> str:
         """The absorber that damps the layer: ``absorber``, or by default the split-field PML, except on a
         strip (a plane wave along x), where the sponge gives the PML's answer (measured: the same to three
-        digits; there is no y part to split) without its second continuity sweep (docs/accuracy.md)."""
+        digits; there is no y part to split) for less work (no x part of the rate to compute and carry) and a
+        thinner default layer (docs/accuracy.md)."""
         if self.absorber:
             return self.absorber
         return "sponge" if self.kind.strip else "pml"

@@ -13,7 +13,7 @@ import pytest
 
 from pcabench.execute.run import run
 from pcabench.paths import reference_results
-from pcabench.spec import RunSpec, scene_from_row
+from pcabench.spec import RunSpec, scene_from_row, stored_parameters
 from pcabench.store import read_rows
 from solvers import Scene, SceneError, make_solver
 from solvers.physics.integrators import evolve
@@ -87,6 +87,11 @@ def test_stored_open_rows_come_back_with_the_layer_they_ran():
     assert scene_from_row(row) == scene and scene_from_row(row).n_particles == scene.n_particles
     old = {k: v for k, v in scene.as_dict().items() if k != "layer"}
     assert scene_from_row({"scene": old}).layer == pytest.approx(2 * scene.pulse_width)
+    # the PML's default is still two pulse widths: an old row and a new one are one configuration
+    pml = scene.replace(absorber="pml")
+    new_row, old_row = pml.as_dict(), {k: v for k, v in pml.as_dict().items() if k != "layer"}
+    assert stored_parameters(new_row) == stored_parameters(old_row)
+    assert stored_parameters(old_row)["layer_width"] is None
     rows = [r for r in read_rows(reference_results()) if (r.get("scene") or {}).get("open")]
     assert rows and all(scene_from_row(r).n_particles == r["n_particles"] for r in rows)
 

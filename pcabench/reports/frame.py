@@ -48,15 +48,18 @@ def _flat(row: dict) -> dict:
         r[f"err_{name}"] = value
     for stage, seconds in (row.get("stages") or {}).items():
         r[f"t_{stage}"] = seconds
-    scene = row.get("scene") or {}
-    scene = {**stored_parameters(scene), **scene}  # a parameter the row predates at its default (kernel)
+    stored = row.get("scene") or {}
+    parameters = stored_parameters(stored)  # each parameter the row predates at its default (kernel)
+    scene = {**parameters, **stored}
     for key in SCENE_COLUMNS:
         r[key] = scene.get(key)
     r["scene"] = scene["name"]  # rows from before the scene registry: the paper's (stored_parameters)
     # how the run ends: the paper's fixed step count, or a fixed physical time
     r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
     r["domain"] = "strip" if scene.get("strip_height") else "full"
-    r["scene_key"] = json.dumps({k: v for k, v in scene.items() if k != "memory_limit_bytes"}, sort_keys=True)
+    # the configuration: the scene's parameters alone, as the resume key has them (pcabench.spec.identity), so that
+    # a derived key a newer row stores (its layer's width) does not split one configuration in two
+    r["scene_key"] = json.dumps(parameters, sort_keys=True)
     r.setdefault("preset", "")
     r.setdefault("pair_loop", "")  # rows from before the pair list: the gather loop
     r["threads"] = int(r.get("threads") or 1)

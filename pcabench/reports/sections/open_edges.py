@@ -14,6 +14,8 @@ against the open plane).
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 
 from pcabench.presets.open_edges import OPEN, OPEN_DX, OPEN_SCENES, open_cost_round
@@ -23,8 +25,10 @@ from pcabench.reports.md import fmt, md_table
 from pcabench.reports.sections.base import Section, stored_measure
 from pcabench.reports.tables import latest, long_run_limits
 from pcabench.spec import scene_from_row
+from solvers.absorbers import absorber_named
 
 TARGET_AMPLITUDE = 1e-2  # the issue's: at most 1 % of the amplitude left behind
+TARGET_ENERGY = 1e-4  # the issue's for the plane pulse: at most 1e-4 of its energy
 INCIDENCE = {"plane-pulse": "normal (plane pulse)", "acoustic-pulse": "oblique (2D pulse)"}
 
 
@@ -112,7 +116,7 @@ def cheapest(rows) -> list[dict]:
         ok = [r for r in rows if (r["scene"], r["dx"]) == key and r["reflected"] is not None]
         ok = [r for r in ok if r["reflected"] < TARGET_AMPLITUDE]
         if ok:
-            # at equal reflection (two digits) the absorber without the PML's second continuity sweep
+            # at equal reflection (two digits) the absorber without the PML's x part of the rate
             out.append(min(ok, key=lambda r: (r["N"], float(f"{r['reflected']:.2g}"), r["absorber"] == "pml")))
     return out
 
@@ -154,10 +158,13 @@ def cost(df) -> list[dict]:
 
 
 def stability(df) -> list[dict]:
-    """The preset's long runs with open edges (t = LONG_T_END), as the long-run table measures them, each with
-    ``closed``: the same model and method's long runs on the closed scene (``--stability long``), or None."""
+    """The preset's long runs with open edges (t = LONG_T_END) at their default layer, as the long-run table
+    measures them, each with ``closed``: the same model and method's long runs on the closed scene
+    (``--stability long``), or None."""
     long = df[df.preset == OPEN] if "preset" in df and not df.empty else df.iloc[:0]  # unstable runs count
     long = long[np.isclose(long.t_final.astype(float), LONG_T_END)] if not long.empty else long
+    if not long.empty:  # each at its default layer (a row from before the sponge's 1.5 pulse widths ran two)
+        long = long[long.scene_key.map(lambda key: json.loads(key).get("layer_width") is None)]
     rows = long_run_limits(long, preset=OPEN) if not long.empty else []
     closed = {(r["scene"], r["model"]): r for r in long_run_limits(df, preset="stability-long")}
     for r in rows:
@@ -432,8 +439,8 @@ def figure(data, ctx):
         path,
         f"What open edges reflect, against the layer's width, dx = {OPEN_DX:g} m, linear ({ctx.name}): the run "
         "against a perfect absorber once the pulse has gone; colour: absorber, marker: strength (c0 / L); black "
-        "dotted: the closed scene (a free end, the periodic square's images), grey: the 1 % target; on the plane "
-        "pulse the two absorbers are the same",
+        "dotted: the closed scene (a free end, the periodic square's images), grey: the issue's targets, pale "
+        "bands: each absorber's default layer; on the plane pulse the two absorbers are the same",
         "layer width, pulse widths",
         "reflected / the pulse's",
         ncols=len(scenes),
@@ -471,6 +478,17 @@ def figure(data, ctx):
                 if what == "amplitude":
                     ax.axhline(TARGET_AMPLITUDE, color="0.6", lw=1.0, label="target: 1 % of the amplitude")
                     values.append(TARGET_AMPLITUDE)
+                elif scene == "plane-pulse":
+                    ax.axhline(TARGET_ENERGY, color="0.6", ls="--", lw=1.0, label="target: 1e-4 of the energy")
+                    values.append(TARGET_ENERGY)
+                for absorber in sorted({r["absorber"] for r in mine}):
+                    ax.axvline(
+                        absorber_named(absorber).default_widths,
+                        color=colours.get(absorber, "tab:green"),
+                        lw=3,
+                        alpha=0.2,
+                        label=f"{absorber}: its default layer",
+                    )
                 F.nice_log_ticks(ax, values)
                 ax.set_xticks(sorted({r["widths"] for r in mine}))
                 ax.set_title(f"{INCIDENCE[scene]}: {what} reflected", fontsize=9)
