@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel_names, scene_names, scenes
-from solvers.absorbers import absorber_names
+from solvers.absorbers import absorber_named, absorber_names
 from solvers.bodies import DEFAULT_BOUNDARY_METHOD, boundary_method_names
 from solvers.scene import OPEN_EDGES
 
@@ -127,8 +127,11 @@ BOUNDARY = (
     Parameter(
         "layer_width",
         "--layer-width",
-        "the absorbing layer's width, m, in whole columns of dx (default: the absorber's: the sponge's 1.5 pulse "
-        "widths, the PML's 2)",
+        lambda: (
+            "the absorbing layer's width, m, in whole columns of dx (default: the absorber's, in pulse widths: "
+            + ", ".join(f"{n} {absorber_named(n).default_widths:g}" for n in absorber_names())
+            + ")"
+        ),
         numeric=True,
         per_scene=True,
     ),

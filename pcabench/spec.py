@@ -13,7 +13,6 @@ use, for a solver whose class says it is ``threaded``), resolved to an integer b
 from __future__ import annotations
 
 import json
-import math
 import os
 from dataclasses import dataclass
 
@@ -164,27 +163,42 @@ def stored_parameters(scene: dict) -> dict:
     The one place old rows are brought up to the current fields (the frame, the resume key, scene_from_row)."""
     fields = Scene.__dataclass_fields__
     out = {k: fields[k].default if scene.get(k) is None else scene[k] for k in fields if fields[k].compare}
+    ran = _layer_ran(scene, out)
     try:
         kind = scene_kind(out["name"])
-    except ValueError:  # a plug-in's scene not installed here: its row keeps what it stored
+    except ValueError:  # a plug-in's scene not installed here: its row keeps what it stored (and its layer)
+        if ran is not None:
+            out["layer_width"] = ran
         return out
     for k in PER_KIND:  # parameters whose default is the scene kind's: the value a Scene resolves
         if out[k] is None:
             out[k] = kind.defaults.get(k, PAPER_PULSE.get(k))
-    if out.get("open") and out.get("layer_width") is None and "n_particles" in scene and "layer" not in scene:
-        out["layer_width"] = _layer_before(out)  # a stored row from before its layer's key
+    if ran is not None:
+        out["layer_width"] = _default_unless_changed(out, ran)
     return out
 
 
-def _layer_before(parameters: dict) -> float | None:
-    """The layer's width (m) an open row stored before rows kept theirs ran at its default: LAYER_WIDTHS_BEFORE
-    pulse widths, stated only where today's default differs (the sponge's), else None (the default, the same)."""
-    before = LAYER_WIDTHS_BEFORE * parameters["pulse_width"]
+def _layer_ran(scene: dict, parameters: dict) -> float | None:
+    """The width (m) of the default layer a stored open row ran (one that names none): its derived key ``layer``,
+    or for a row stored before rows kept it, LAYER_WIDTHS_BEFORE pulse widths; None for any other row (closed,
+    a width of its own, or a scene dict that is not a stored row: no derived keys)."""
+    if not parameters.get("open") or parameters.get("layer_width") is not None or "n_particles" not in scene:
+        return None
+    if isinstance(scene.get("layer"), (int, float)):
+        return float(scene["layer"])
+    pulse = parameters.get("pulse_width")
+    return LAYER_WIDTHS_BEFORE * pulse if isinstance(pulse, (int, float)) else None
+
+
+def _default_unless_changed(parameters: dict, ran: float) -> float | None:
+    """None (the default) where today's default layer is the one the row ran, to the lattice's columns; else the
+    width it ran, stated, so that the row reads as what ran and is not one configuration with today's runs."""
     try:
-        now = Scene(**parameters).layer_asked
+        now = Scene(**parameters)
+        same = now.n_layer == now.replace(layer_width=ran).n_layer
     except (SceneError, ValueError, TypeError):  # a row this checkout cannot build: as it was
-        return before
-    return None if math.isclose(now, before) else before
+        return ran
+    return None if same else ran
 
 
 def scene_from_row(row) -> Scene:

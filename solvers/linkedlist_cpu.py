@@ -148,7 +148,7 @@ class LinkedListCPU(CellListSolver):
             use_threads(self.threads)
         a = self.arrays
         walls = bool(self.scene.walls)  # the list holds the real pairs; the mirrors' part is added at the walls
-        if continuity and self.split:  # a split absorber's x part in the same pass (continuity_x: nothing left)
+        if continuity and self.split and a["dd"] is not a["ddx"]:  # the x part in the same pass (continuity_x: none)
             self.pairs.continuity_split(a["u"], a["v"], a["vol"], a["drho"], a["dd"], a["ddx"], self.k)
             if walls:
                 for v, out in ((a["v"], a["dd"]), (self.no_velocity, a["ddx"])):

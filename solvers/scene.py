@@ -378,7 +378,11 @@ class Scene:
             return self.layer_width
         from solvers.absorbers import absorber_named
 
-        return absorber_named(self.absorber_used).default_width(self)
+        try:
+            absorber = absorber_named(self.absorber_used)
+        except ValueError as exc:  # an unknown absorber, met before the checks reach it (a wall's place)
+            raise SceneError(str(exc)) from None
+        return absorber.default_width(self)
 
     @property
     def n_layer(self) -> int:

@@ -16,6 +16,7 @@ from pcabench.paths import reference_results
 from pcabench.spec import RunSpec, scene_from_row, stored_parameters
 from pcabench.store import read_rows
 from solvers import Scene, SceneError, make_solver
+from solvers.absorbers.sponge import Sponge
 from solvers.physics.integrators import evolve
 from solvers.reference.dispersion import predicted_velocity
 
@@ -78,7 +79,7 @@ def test_each_absorber_brings_its_own_default_layer():
     assert pml.layer == pytest.approx(2 * pml.pulse_width) and pml.strength == pytest.approx(12 * pml.c0 / 6.0)
 
 
-def test_stored_open_rows_come_back_with_the_layer_they_ran():
+def test_stored_open_rows_come_back_with_the_layer_they_ran(monkeypatch):
     """A row keeps its layer's width (the derived key ``layer``); a row stored before it did ran every absorber's
     layer at two pulse widths and comes back so, not at today's default; every open run of the reference store
     comes back with the particles it ran."""
@@ -92,6 +93,11 @@ def test_stored_open_rows_come_back_with_the_layer_they_ran():
     new_row, old_row = pml.as_dict(), {k: v for k, v in pml.as_dict().items() if k != "layer"}
     assert stored_parameters(new_row) == stored_parameters(old_row)
     assert stored_parameters(old_row)["layer_width"] is None
+    # a default that changes after a row was stored: the row still reads as the layer it ran
+    sponge = plane(dx=0.5, steps=2, open="x")
+    stored = {"scene": sponge.as_dict(), "n_particles": sponge.n_particles}
+    monkeypatch.setattr(Sponge, "default_widths", 2.0)
+    assert scene_from_row(stored).layer == pytest.approx(4.5) and scene_from_row(stored) != sponge.replace()
     rows = [r for r in read_rows(reference_results()) if (r.get("scene") or {}).get("open")]
     assert rows and all(scene_from_row(r).n_particles == r["n_particles"] for r in rows)
 
@@ -118,6 +124,7 @@ def test_every_cpu_solver_and_pair_loop_runs_the_layer_alike(model):
         (dict(open="x", layer_width=60.0), "--layer-width must be at most the domain's width 50 m"),
         (dict(open="x", absorber_strength=-1.0), "--absorber-strength must be > 0"),
         (dict(open="x", absorber="nope"), "--absorber must be one of sponge, pml"),
+        (dict(open="x", name="plane-wall", strip_height=None, absorber="nope"), "--absorber must be one of"),
         (dict(open="z"), "--open must be one of x, y, xy"),
     ],
 )

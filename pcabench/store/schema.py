@@ -127,6 +127,7 @@ SCENE_FIELDS: dict[str, Field] = {
     "h": _SCENE_NUMBER,
     "dt": _SCENE_NUMBER,
     "t_final": _SCENE_NUMBER,
+    "layer": Field(("number",), low=0, high=1e12),  # the open edges' layer, m (0 closed; rows before 2026-12-05: none)
     **{
         k: Field(("number",), low=-1e12, high=1e12)
         for k in (

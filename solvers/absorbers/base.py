@@ -38,7 +38,8 @@ class Absorber:
     default_widths: float = 2.0  # the layer's width a scene gets when it names none, in pulse widths
 
     def default_width(self, scene) -> float:
-        """The layer's width (m) a scene gets when it names none: ``default_widths`` of its pulse widths."""
+        """The layer's width (m) a scene gets when it names none: ``default_widths`` of its pulse widths. (An
+        override must not read ``scene.layer`` or ``scene.strength``: they are computed from it.)"""
         return self.default_widths * scene.pulse_width
 
     def default_strength(self, scene) -> float:
