@@ -16,7 +16,8 @@ import numpy as np
 import pytest
 
 from solvers import Scene, make_solver
-from solvers.interface import Fields
+from solvers.interface import Fields, Solver
+from solvers.linkedlist_cpu import LinkedListCPU
 from solvers.physics.integrators import evolve
 from solvers.reference.dispersion import predict, predicted_fields_2d
 from solvers.reference.pulse2d import OpenPulse, gaussian_pulse, open_domain, periodic_linear
@@ -99,6 +100,28 @@ def test_every_cpu_solver_and_pair_loop_runs_free_y_edges_alike(model, absorber)
             assert np.abs(getattr(got, name) - getattr(ref, name)).max() < 1e-12, (kw, name)
     other = scene.replace(open="x")  # y periodic again: the pulse's images across the y seams
     assert np.abs(evolve(make_solver("allpair-cpu"), other).output().drho - ref.drho).max() > 1e-4
+
+
+class TwoSweeps(LinkedListCPU):
+    """The pair list with the PML's x part by a second sweep with v = 0 (``Solver.continuity_x``, as the gather
+    loop, the all-pair and the GPU solvers compute it) instead of in the rate's own pass."""
+
+    name = "two-sweeps"
+
+    def continuity_x(self):
+        Solver.continuity_x(self)
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("model", ["linear", "lagrangian"])
+def test_the_pair_lists_one_pass_gives_the_pmls_x_part_of_two_sweeps_to_the_bit(model, threads):
+    scene = square(size=12.0, dx=0.5, steps=30, model=model, open="xy", layer_width=3.0, pulse_width=1.5)
+    scene = scene.replace(pulse_center=3.0, mach=0.2, absorber="pml")
+    one = evolve(LinkedListCPU(threads=threads, pair_loop="list"), scene)
+    two = evolve(TwoSweeps(threads=threads, pair_loop="list"), scene)
+    for name in ("u", "v", "drho", "drho_x", "sx", "sy"):
+        assert np.array_equal(one.arrays[name], two.arrays[name]), name
+    assert np.abs(one.arrays["drho_x"]).max() > 0  # the layer's x part was at work
 
 
 def test_open_x_alone_keeps_the_y_images():
