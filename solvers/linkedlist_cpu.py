@@ -148,15 +148,15 @@ class LinkedListCPU(CellListSolver):
             use_threads(self.threads)
         a = self.arrays
         walls = bool(self.scene.walls)  # the list holds the real pairs; the mirrors' part is added at the walls
-        if continuity and self.split and a["dd"] is not a["ddx"]:  # the x part in the same pass (continuity_x: none)
-            self.pairs.continuity_split(a["u"], a["v"], a["vol"], a["drho"], a["dd"], a["ddx"], self.k)
-            if walls:
-                for v, out in ((a["v"], a["dd"]), (self.no_velocity, a["ddx"])):
-                    self.launch("wall_continuity", *self.geometry(), a["u"], v, a["vol"], a["drho"], out, self.k)
-        elif continuity:
-            self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
-            if walls:
-                self.launch("wall_continuity", *self.geometry(), a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+        if continuity:
+            parts = [(a["v"], a["dd"])]  # (v, the rate): the whole rate, and a split absorber's x part (v = 0)
+            if self.split and a["dd"] is not a["ddx"]:  # the x part in the same pass (continuity_x: nothing left)
+                parts.append((self.no_velocity, a["ddx"]))
+                self.pairs.continuity_split(a["u"], a["v"], a["vol"], a["drho"], a["dd"], a["ddx"], self.k)
+            else:
+                self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+            for v, out in parts if walls else ():
+                self.launch("wall_continuity", *self.geometry(), a["u"], v, a["vol"], a["drho"], out, self.k)
         if momentum:
             self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
             if walls:

@@ -335,12 +335,7 @@ class Scene:
         for axis in ("x", "y"):
             if axis in self.open and axis not in openable:
                 need(False, f"--open {axis}: {self.kind.closed_reason(axis)}")
-        try:  # first: the layer's default width is the absorber's
-            from solvers.absorbers import absorber_named
-
-            absorber_named(self.absorber_used)
-        except ValueError as exc:
-            raise SceneError(str(exc)) from None
+        _ = self.absorber_model  # first: a known absorber, or one line (the default layer is the absorber's)
         for name in ("layer_width", "absorber_strength"):
             if getattr(self, name) is not None:
                 value = finite(name)
@@ -374,15 +369,7 @@ class Scene:
     def layer_asked(self) -> float:
         """The absorbing layer's width asked for, m: ``layer_width``, or the absorber's default (in pulse widths:
         solvers/absorbers/)."""
-        if self.layer_width is not None:
-            return self.layer_width
-        from solvers.absorbers import absorber_named
-
-        try:
-            absorber = absorber_named(self.absorber_used)
-        except ValueError as exc:  # an unknown absorber, met before the checks reach it (a wall's place)
-            raise SceneError(str(exc)) from None
-        return absorber.default_width(self)
+        return self.layer_width if self.layer_width is not None else self.absorber_model.default_width(self)
 
     @property
     def n_layer(self) -> int:
@@ -416,11 +403,20 @@ class Scene:
     @property
     def strength(self) -> float:
         """The absorber's strength, 1/s: the scene's, or the absorber's default for it."""
-        from solvers.absorbers import absorber_named
-
         if self.absorber_strength is not None:
             return float(self.absorber_strength)
-        return absorber_named(self.absorber_used).default_strength(self)
+        return self.absorber_model.default_strength(self)
+
+    @property
+    def absorber_model(self):
+        """The absorber of :attr:`absorber_used` (solvers/absorbers/); SceneError naming --absorber and the choices
+        if it is unknown (met wherever asked first: a walled scene's places need the layer's width)."""
+        from solvers.absorbers import absorber_named
+
+        try:
+            return absorber_named(self.absorber_used)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
 
     @property
     def absorber_used(self) -> str:

@@ -21,6 +21,15 @@ flush = (
 
 
 @numba.njit(inline="always")
+def thread_sum(buf, i):
+    """Particle i's sum over the threads' accumulator rows ``buf`` (threads, n), in thread order."""
+    total = buf[0, i]
+    for t in range(U(1), U(buf.shape[0])):
+        total += buf[t, i]
+    return total
+
+
+@numba.njit(inline="always")
 def first_within(j0, j1, lxi, sxi, lx, sx, k):
     """The first j in the x-sorted range [j0, j1) less than a cutoff to the left of i (binary search)."""
     while j0 < j1:
@@ -160,10 +169,7 @@ def continuity(nbr, fx, fy, start, count, u, v, vol, drho, out, buf, k):
             acc[i] = a
         flush_off(flush, saved)
     for i in prange(n):
-        total = buf[0, i]
-        for t in range(U(1), nt):
-            total += buf[t, i]
-        out[i] = (k[RHO0] + k[NONLIN] * drho[i]) * total
+        out[i] = (k[RHO0] + k[NONLIN] * drho[i]) * thread_sum(buf, i)
 
 
 def continuity_split(nbr, fx, fy, start, count, u, v, vol, drho, out, outx, buf, bufx, k):
@@ -192,13 +198,9 @@ def continuity_split(nbr, fx, fy, start, count, u, v, vol, drho, out, outx, buf,
             accx[i] = ax
         flush_off(flush, saved)
     for i in prange(n):
-        total, totalx = buf[0, i], bufx[0, i]
-        for t in range(U(1), nt):
-            total += buf[t, i]
-            totalx += bufx[t, i]
         rho = k[RHO0] + k[NONLIN] * drho[i]
-        out[i] = rho * total
-        outx[i] = rho * totalx
+        out[i] = rho * thread_sum(buf, i)
+        outx[i] = rho * thread_sum(bufx, i)
 
 
 def momentum(nbr, fx, fy, start, count, mass, pr, ax, ay, bufx, bufy):
@@ -226,9 +228,5 @@ def momentum(nbr, fx, fy, start, count, mass, pr, ax, ay, bufx, bufy):
             accy[i] = by
         flush_off(flush, saved)
     for i in prange(n):
-        sx_, sy_ = bufx[0, i], bufy[0, i]
-        for t in range(U(1), nt):
-            sx_ += bufx[t, i]
-            sy_ += bufy[t, i]
-        ax[i] = sx_
-        ay[i] = sy_
+        ax[i] = thread_sum(bufx, i)
+        ay[i] = thread_sum(bufy, i)
