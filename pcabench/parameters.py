@@ -19,6 +19,7 @@ from typing import Callable
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel_names, scene_names, scenes
 from solvers.absorbers import absorber_named, absorber_names
 from solvers.bodies import DEFAULT_BOUNDARY_METHOD, boundary_method_names
+from solvers.corrections import correction_named, correction_names
 from solvers.scene import OPEN_EDGES
 
 
@@ -167,6 +168,15 @@ PRECISION_MODEL = (
 METHOD = (
     Parameter("integrator", "--integrator", "time integrator", lambda: INTEGRATORS),
     Parameter("kernel", "--kernel", _kernel_help, kernel_names),
+    Parameter(
+        "correction",
+        "--correction",
+        lambda: (
+            "kernel correction (solvers/corrections/): "
+            + "; ".join(f"{n}: {correction_named(n).summary}" for n in correction_names())
+        ),
+        correction_names,
+    ),
     Parameter("cutoff_factor", "--cutoff", "the Gaussian's cutoff in units of h", numeric=True),
     Parameter("h_factor", "--h-factor", "h / dx", numeric=True),
     Parameter("cfl", "--cfl", "dt * c0 / dx", numeric=True),

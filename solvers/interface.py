@@ -23,6 +23,7 @@ that reorders particles can permute all of them together.
 from __future__ import annotations
 
 import abc
+import contextlib
 import math
 from dataclasses import dataclass
 
@@ -150,6 +151,7 @@ class Solver(abc.ABC):
         self.k = kernel.constants(scene, self.dtype)
         self.moving = scene.model == "lagrangian"
         self.absorber = absorber_named(scene.absorber_used) if scene.open else None
+        self.correction = scene.sph_correction
         self.split = bool(self.absorber is not None and self.absorber.split)
 
     def check_scene(self, scene: Scene) -> None:
@@ -198,6 +200,7 @@ class Solver(abc.ABC):
         self.reordered = 0  # how many times the arrays were put in a new order (a body's indices follow it)
         self.moves = 0  # how many times moving particles moved (an advance, a restore)
         self.layer_key, self.layer_sigma, self.layer_cache = None, (), {}  # the open edges' layer: layer_factors
+        self.correction_factors = None  # a kernel correction's factors and the positions they are of
         self.after_init()
 
     def after_init(self) -> None:
@@ -212,12 +215,30 @@ class Solver(abc.ABC):
 
     def rates(self, continuity: bool, momentum: bool) -> None:
         """PI: fill dd (continuity) and/or ax, ay (momentum) from the current state (and ddx, the x part of dd,
-        for a split absorber)."""
+        for a split absorber), through the scene's kernel correction (solvers/corrections/: none, the sweeps)."""
         self.fill_body()
-        self.coefficients(continuity, momentum)
-        self._sweep(continuity, momentum)
-        if continuity and self.split:
-            self.continuity_x()
+        vol, pr = self.correction.coefficients(continuity, momentum)
+        self.coefficients(vol or continuity, pr or momentum)
+        self.correction.sweep(self, continuity, momentum)
+
+    @contextlib.contextmanager
+    def swapped(self, **arrays):
+        """The per-particle arrays ``arrays`` stand in for the solver's own of those names inside the block (a
+        correction's sweeps over other fields)."""
+        a = self.arrays
+        kept = {name: a[name] for name in arrays}
+        a.update(arrays)
+        try:
+            yield
+        finally:
+            a.update(kept)
+
+    def moments(self) -> tuple:
+        """The moment matrix (M_xx, M_xy, M_yy) and Gamma (x, y) of every particle at the current positions and
+        volumes (the kernel gradient correction's, solvers/corrections/gradient.py), as new arrays."""
+        out = tuple(self.xp.zeros(self.scene.n_particles, self.dtype) for _ in range(5))
+        self.launch("moments", *self.geometry(), self.arrays["vol"], *out, self.k)
+        return out
 
     def fill_body(self) -> None:
         """A body's ghost particles take the fluid's values mirrored across its wall (solvers/bodies/)."""
@@ -362,6 +383,33 @@ class Solver(abc.ABC):
             self.moved()
         if "drho" in names:
             self.t = self.saved_t
+
+    def accumulate(self, weight: float, first: bool = False) -> None:
+        """A Runge-Kutta stage's rates, times ``weight``, into the step's sums (``first``: they start here): the
+        density rate (and its x part for a split absorber), the acceleration and, for moving particles, the
+        velocity (the positions' rate). Kept beside the saved state, so that a search that reorders the
+        particles reorders them too."""
+        w = self.dtype.type(weight)
+        for name in self.summed():
+            key, arr = "sum_" + name, self.arrays[name]
+            total = self.saved.get(key)
+            if first or total is None:
+                if total is None or total.shape != arr.shape:
+                    total = self.xp.empty_like(arr)
+                self.xp.multiply(arr, w, out=total)
+                self.saved[key] = total
+            else:
+                total += w * arr
+
+    def use_sum(self) -> None:
+        """The step's weighted sums (:meth:`accumulate`) become the rates (and the velocity the positions move
+        with): the next ``advance`` and ``kick`` from the saved state make the Runge-Kutta step."""
+        for name in self.summed():
+            self.arrays[name][...] = self.saved["sum_" + name]
+
+    def summed(self) -> tuple:
+        """The fields a Runge-Kutta step sums over its stages."""
+        return RATES + (("ddx",) if self.split else ()) + (("u", "v") if self.moving else ())
 
     def permute(self, order) -> None:
         """Reorder every per-particle array (state, rates, saved copies) by ``order``."""

@@ -136,9 +136,7 @@ class LinkedListGPU(CellListSolver):
         if not self.coefficients_fresh:
             self.coefficients(True, True)
             self.coefficients_fresh = True
-        self._sweep(continuity, momentum)
-        if continuity and self.split:
-            self.continuity_x()
+        self.correction.sweep(self, continuity, momentum)
 
     def advance_launch(self, f: float) -> None:
         """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-FIELDS = ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator")  # Scene's fields a Method holds
+FIELDS = ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator", "correction")  # Scene's fields a Method holds
 
 
 def _close(a: float, b: float) -> bool:
@@ -22,13 +22,14 @@ def _close(a: float, b: float) -> bool:
 @dataclass(frozen=True)
 class Method:
     """Kernel (a registered name), h / dx, the truncation in units of h (the Gaussian's; None for a kernel cut
-    at its own support), CFL (dt c0 / dx) and time integrator."""
+    at its own support), CFL (dt c0 / dx), time integrator and kernel correction (solvers/corrections/)."""
 
     kernel: str
     h_factor: float
     cutoff_factor: float | None
     cfl: float
     integrator: str
+    correction: str = "none"
 
     @classmethod
     def of(cls, values) -> "Method":
@@ -50,6 +51,7 @@ class Method:
             cutoff_factor=float(get("cutoff_factor")) if truncated(kernel) else None,
             cfl=float(get("cfl")),
             integrator=str(get("integrator")),
+            correction=str(get("correction")),
         )
 
     @classmethod
@@ -62,16 +64,21 @@ class Method:
     def is_paper(self) -> bool:
         """Whether this is the paper's method (floats compared as stored floats are)."""
         paper = self.paper()
-        if (self.kernel, self.integrator) != (paper.kernel, paper.integrator):
+        if (self.kernel, self.integrator, self.correction) != (paper.kernel, paper.integrator, paper.correction):
             return False
         same = _close(self.h_factor, paper.h_factor) and _close(self.cfl, paper.cfl)
         return same and (self.cutoff_factor is None or _close(self.cutoff_factor, paper.cutoff_factor))
 
     @property
     def label(self) -> str:
-        """``kernel, h 2.13dx, 3h, CFL 0.2``: the truncation written only for a kernel that has one."""
+        """``kernel, h 2.13dx, 3h, CFL 0.2``: the truncation written only for a kernel that has one, the integrator
+        and the correction only where they are not the default's (``, rk4, gradient-corrected``)."""
+        from solvers.scene import Scene
+
         cut = f", {self.cutoff_factor:g}h" if self.cutoff_factor is not None else ""
-        return f"{self.kernel}, h {self.h_factor:g}dx{cut}, CFL {self.cfl:g}"
+        step = f", {self.integrator}" if self.integrator != Scene.default("integrator") else ""
+        corrected = f", {self.correction}-corrected" if self.correction != Scene.default("correction") else ""
+        return f"{self.kernel}, h {self.h_factor:g}dx{cut}, CFL {self.cfl:g}{step}{corrected}"
 
     def stable_cfl(self) -> float:
         """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion
@@ -83,7 +90,13 @@ class Method:
 
     def scene_fields(self) -> dict:
         """The Scene fields this method sets (a compact kernel's ``cutoff_factor`` left at its default)."""
-        out = {"kernel": self.kernel, "h_factor": self.h_factor, "cfl": self.cfl, "integrator": self.integrator}
+        out = {
+            "kernel": self.kernel,
+            "h_factor": self.h_factor,
+            "cfl": self.cfl,
+            "integrator": self.integrator,
+            "correction": self.correction,
+        }
         if self.cutoff_factor is not None:
             out["cutoff_factor"] = self.cutoff_factor
         return out

@@ -21,14 +21,15 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field, replace
 
+from solvers.corrections import DEFAULT_CORRECTION, Correction, correction_named
 from solvers.kernels import DEFAULT_KERNEL, Kernel, kernel_named
 from solvers.scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
-INTEGRATORS = ("verlet", "kdk1", "euler", "rk2")
+INTEGRATORS = ("verlet", "kdk1", "euler", "rk2", "rk4")
 PRECISIONS = ("float64", "float32")
 
-# Arrays a solver holds per particle (state, rates, sort buffers, rk2 copies),
+# Arrays a solver holds per particle (state, rates, sort buffers, rk2/rk4 copies and sums),
 # counted generously so that the estimate is an upper bound for every solver.
 FLOAT_ARRAYS_PER_PARTICLE = 26
 INT_ARRAYS_PER_PARTICLE = 4  # cell id, permutation, sort scratch (int32/int64)
@@ -56,10 +57,11 @@ class SceneError(ValueError):
     """A scene parameter is outside its allowed range."""
 
 
-def bytes_per_particle(precision: str) -> int:
-    """Upper bound of the memory one particle costs a solver, in bytes."""
+def bytes_per_particle(precision: str, extra: int = 0) -> int:
+    """Upper bound of the memory one particle costs a solver, in bytes (``extra``: arrays a method keeps beyond
+    the standard solver's: a kernel correction's factors)."""
     item = 8 if precision == "float64" else 4
-    return FLOAT_ARRAYS_PER_PARTICLE * item + INT_ARRAYS_PER_PARTICLE * 8
+    return (FLOAT_ARRAYS_PER_PARTICLE + extra) * item + INT_ARRAYS_PER_PARTICLE * 8
 
 
 @dataclass(frozen=True)
@@ -89,6 +91,7 @@ class Scene:
     h_factor: float = 2.13  # h = h_factor * dx
     cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h (a truncated kernel's, the Gaussian; else the default)
     kernel: str = DEFAULT_KERNEL  # a registered kernel's name (solvers/kernels/)
+    correction: str = DEFAULT_CORRECTION  # a registered kernel correction's name (solvers/corrections/)
     cfl: float = 0.2  # dt = cfl * dx / c0 (lowered slightly to land on t_end)
     model: str = "lagrangian"
     integrator: str = "verlet"
@@ -194,6 +197,7 @@ class Scene:
         )
         try:
             support = kernel_named(self.kernel).support
+            correction_named(self.correction)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
         need(
@@ -472,6 +476,11 @@ class Scene:
         return kernel_named(self.kernel)
 
     @property
+    def sph_correction(self) -> Correction:
+        """The kernel correction ``correction`` names (solvers/corrections/): how PI turns the sweeps into rates."""
+        return correction_named(self.correction)
+
+    @property
     def nx(self) -> int:
         """Lattice columns: the domain's, and an absorbing layer's each side where x is open."""
         return max(int(round((self.x_max - self.x_min) / self.dx)), 0) + 2 * self.layer_columns
@@ -551,12 +560,20 @@ class Scene:
 
     def memory_bytes(self) -> int:
         """Upper bound of the memory the particle arrays need, bytes (a pair list, where used, comes on top)."""
-        return self.n_particles * bytes_per_particle(self.precision)
+        return self.n_particles * bytes_per_particle(self.precision, self.extra_arrays)
+
+    @property
+    def extra_arrays(self) -> int:
+        """Arrays per particle the method keeps beyond the standard solver's (its correction's)."""
+        try:
+            return int(correction_named(self.correction).arrays)
+        except ValueError:
+            return 0
 
     def smallest_dx_fitting(self, limit_bytes: float) -> float:
         """The smallest lattice spacing whose arrays fit in ``limit_bytes``, m."""
         area = (self.x_max - self.x_min) * self.height_span
-        return math.sqrt(area * bytes_per_particle(self.precision) / max(limit_bytes, 1))
+        return math.sqrt(area * bytes_per_particle(self.precision, self.extra_arrays) / max(limit_bytes, 1))
 
     def dx_for_particles(self, n: float) -> float:
         """The lattice spacing that gives about ``n`` particles on this domain, m."""
@@ -622,6 +639,7 @@ class Scene:
 
     def describe(self) -> str:
         scene = "" if self.name == DEFAULT_SCENE else f"{self.name}, "
+        corrected = "" if self.correction == DEFAULT_CORRECTION else f" ({self.correction}-corrected)"
         edges = (
             f"open {self.open} ({self.absorber_used}, {self.layer:g} m of layer, {self.strength:.3g} 1/s), "
             if self.open
@@ -629,7 +647,8 @@ class Scene:
         )
         return (
             f"{scene}{edges}{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
-            f"{self.kernel} kernel, h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
+            f"{self.kernel} kernel{corrected}, "
+            f"h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
             f"{self.n_steps} steps to t = {self.t_final:.4g} s, "
             f"{self.model}/{self.integrator}/{self.precision}, "
             f"arrays <= {self.memory_bytes() / 2**20:.1f} MiB"

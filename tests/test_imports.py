@@ -160,10 +160,11 @@ LAYERS = (
         "solvers.plugins",
         "solvers.kernels",
         "solvers.absorbers",
+        "solvers.corrections",
         "solvers.bodies",
         "solvers.sampling",
         "solvers.jitcache",
-    ),  # registries, kernels, absorbers, boundary methods, sampling between particles
+    ),  # registries, kernels, absorbers, corrections, boundary methods, sampling between particles
     ("solvers.physics",),  # the rates per pair and the integrators, for every backend
     ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method"),  # the problem
     ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops

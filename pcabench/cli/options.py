@@ -40,7 +40,8 @@ integrators:
   verlet  Stormer-Verlet, second order, no amplitude drift (default)
   kdk1    one-sweep kick-drift-kick: first order, amplitude grows
   euler   forward Euler: grows at any dt
-  rk2     explicit midpoint"""
+  rk2     explicit midpoint
+  rk4     classical fourth-order Runge-Kutta (four sweeps of both rates)"""
 
 
 # ---------------------------------------------------------------- option types

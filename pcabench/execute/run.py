@@ -21,6 +21,7 @@ from pcabench.spec import RunSpec
 from pcabench.store.record import RunRecord
 from solvers import SceneError, jitcache, make_solver
 from solvers.bodies import BodyEntered
+from solvers.corrections import SingularMoments
 from solvers.physics.integrators import step_program
 from solvers.reference.dispersion import predicted_primary
 from solvers.scenes.base import scored_axes
@@ -194,7 +195,7 @@ def run(spec: RunSpec, machine: str = "", fields_path=None, progress=None, score
                 record.stages = clock.totals()
             except Exception:  # noqa: BLE001
                 pass
-        if record.status == "error" and not isinstance(exc, BodyEntered):  # the message says it all
+        if record.status == "error" and not isinstance(exc, (BodyEntered, SingularMoments)):  # the message says it all
             import traceback
 
             record.message += "\n" + traceback.format_exc(limit=8)

@@ -22,7 +22,12 @@ WALL_STRIP = {"plane-wall": True, "pulse-wall": False}  # the plane scene's fiel
 # the plane strip) and the prediction (4.97), so that each compares one to one with the free and periodic long runs.
 # plane-wall at Mach 0.01 (as LONG_SCENES: it must not break before t = 300 s); pulse-wall never breaks.
 WALL_STABILITY_MACH = {"plane-wall": 0.01, "pulse-wall": None}
-WALL_LINEAR_METHODS = (("gaussian", 1.3), ("wendland-c2", 2.13), ("wendland-c4", 2.13))  # (kernel, h/dx)
+WALL_LINEAR_METHODS = (
+    ("gaussian", 1.3),
+    ("laguerre-gauss", 1.5),
+    ("wendland-c2", 2.13),
+    ("wendland-c4", 2.13),
+)  # (kernel, h/dx)
 WALL_BRACKET = (0.95, 1.02)  # CFLs as fractions of the method's predicted stable CFL, rounded to 0.01
 WALL_PAPER_CFL = (4.75, 4.9, 5.0)
 # 3. Cost: time per step with and without the wall at the same N, the paper's timing model (lagrangian) on the

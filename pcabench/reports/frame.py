@@ -25,6 +25,7 @@ SCENE_COLUMNS = (
     "strip_height",
     "cutoff_factor",
     "kernel",
+    "correction",
     "h_factor",
     "cfl",
     "t_final",

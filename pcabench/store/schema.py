@@ -148,6 +148,7 @@ SCENE_FIELDS: dict[str, Field] = {
         )
     },
     "kernel": _name(max_len=32, pattern=KERNEL_NAME),  # as the kernel registry checks
+    "correction": _name(max_len=32, pattern=SOLVER_NAME),  # a kernel correction (solvers/corrections/)
     "model": Field(("str",), choices=MODELS),
     "integrator": Field(("str",), choices=INTEGRATORS),
     "precision": Field(("str",), choices=PRECISIONS),

@@ -35,6 +35,7 @@ KERNELS = (
     "scatter",
     "continuity",
     "momentum",
+    "moments",
     "neighbours",
     "coefficients",
     "kick",

@@ -22,3 +22,10 @@ def neighbours(lx, ly, sx, sy, k):
     for i in range(n):
         total += P.neighbours_allpair(i, n, lx, ly, sx, sy, k)
     return total
+
+
+def moments(lx, ly, sx, sy, vol, mxx, mxy, myy, gx, gy, k):
+    """The kernel gradient correction's moment matrix and Gamma of every particle (solvers/corrections/)."""
+    n = lx.shape[0]
+    for i in range(n):
+        mxx[i], mxy[i], myy[i], gx[i], gy[i] = P.moments_allpair(i, n, lx, ly, sx, sy, vol, k)

@@ -38,6 +38,12 @@ def wall_momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
                 ay[i] -= by
 
 
+def moments(cell, begin, ncx, ncy, lx, ly, sx, sy, vol, mxx, mxy, myy, gx, gy, k):
+    """The kernel gradient correction's moment matrix and Gamma of every particle (solvers/corrections/)."""
+    for i in prange(lx.shape[0]):
+        mxx[i], mxy[i], myy[i], gx[i], gy[i] = P.moments_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, vol, k)
+
+
 def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, k):
     total = 0
     for i in prange(lx.shape[0]):

@@ -87,6 +87,18 @@ def momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
         ay[i] = by
 
 
+def moments(cell, begin, ncx, ncy, lx, ly, sx, sy, vol, mxx, mxy, myy, gx, gy, k):
+    """The kernel gradient correction's moment matrix and Gamma of every particle (solvers/corrections/)."""
+    i = cuda.grid(1)
+    if i < lx.shape[0]:
+        a, b, c, d, e = P.moments_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, vol, k)
+        mxx[i] = a
+        mxy[i] = b
+        myy[i] = c
+        gx[i] = d
+        gy[i] = e
+
+
 def neighbours(cell, begin, ncx, ncy, lx, ly, sx, sy, counts, k):
     i = cuda.grid(1)
     if i < lx.shape[0]:

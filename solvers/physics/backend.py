@@ -70,8 +70,8 @@ def cpu_loops(
 COMPILED = {
     "updates": ("coefficients", "kick", "advance", "gather"),
     "sorting": ("counting_sort", "sort_cells_by_x"),
-    "cells": ("continuity", "momentum", "neighbours", "wall_continuity", "wall_momentum", "cell_ids"),
-    "allpair": ("continuity", "momentum", "neighbours"),
+    "cells": ("continuity", "momentum", "moments", "neighbours", "wall_continuity", "wall_momentum", "cell_ids"),
+    "allpair": ("continuity", "momentum", "moments", "neighbours"),
     "pairlist": ("build", "continuity", "continuity_split", "momentum"),
 }
 LOOP_OPTIONS = {"pairlist": {"error_model": "numpy"}}

@@ -14,6 +14,12 @@ The first step may begin with a priming search and sweep (the rates at t=0).
   rate that lags half a step. First order; its amplitude grows.
 - ``euler``: forward Euler, one sweep of both rates; grows at any dt.
 - ``rk2``: explicit midpoint, two sweeps of both rates per step.
+- ``rk4``: classical fourth-order Runge-Kutta, four sweeps of both rates per step. Each stage starts from
+  the step's saved state (``restore``, then ``advance`` and ``kick`` by the stage's fraction of dt); the
+  stages' rates are summed with weights 1/6, 1/3, 1/3, 1/6 (``accumulate``) and the step is one update by
+  the weighted sum (``use_sum``), so an open edge's layer damps it as it damps every other update. With a
+  fourth-order operator (solvers/corrections/, the Laguerre-Gauss kernel) Verlet's second-order phase
+  error is the floor; RK4 removes it. Stable to c0 |D| dt = 2 sqrt(2).
 """
 
 from __future__ import annotations
@@ -63,7 +69,23 @@ def step_program(integrator: str, solver, first: bool) -> list:
             ("su", lambda: s.restore(VELOCITY)),
             ("su", lambda: s.kick(1.0)),
         ]
-    raise ValueError(f"integrator must be one of verlet, kdk1, euler, rk2 (got {integrator!r})")
+    if integrator == "rk4":
+        program = [snp, both, ("su", s.save), ("su", lambda: s.accumulate(1.0 / 6.0, first=True))]
+        for f, weight in ((0.5, 1.0 / 3.0), (0.5, 1.0 / 3.0), (1.0, 1.0 / 6.0)):
+            program += stage(s, f) + [snp, both, ("su", lambda w=weight: s.accumulate(w))]
+        return program + [("su", s.use_sum)] + stage(s, 1.0)
+    raise ValueError(f"integrator must be one of verlet, kdk1, euler, rk2, rk4 (got {integrator!r})")
+
+
+def stage(s, f: float) -> list:
+    """The state at the step's start (``save``) moved by ``f`` dt along the current rates: positions with the
+    current velocity, then the velocity (a Runge-Kutta stage)."""
+    return [
+        ("su", lambda: s.restore(POSITION_DENSITY)),
+        ("su", lambda: s.advance(f)),
+        ("su", lambda: s.restore(VELOCITY)),
+        ("su", lambda: s.kick(f)),
+    ]
 
 
 def advance_steps(solver, integrator: str, steps: int, first: bool = True, each=None) -> None:

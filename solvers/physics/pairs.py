@@ -109,10 +109,35 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
                     count += 1
             return count
 
-        return continuity_range, momentum_range, neighbours_range
+        @jit
+        def moments_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, vol, k):
+            """The kernel gradient correction's sums over j0..j1-1: the moment matrix
+            M = -sum_j vol_j G_ij r_ij (x) r_ij as (M_xx, M_xy, M_yy) and Gamma = sum_j vol_j G_ij r_ij as (x, y)."""
+            mxx = k[ZERO]
+            mxy = k[ZERO]
+            myy = k[ZERO]
+            gx = k[ZERO]
+            gy = k[ZERO]
+            for j in range(j0, j1):
+                if mirror:
+                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+                else:
+                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+                r2 = rx * rx + ry * ry
+                if r2 < k[RC2]:
+                    w = vol[j] * gradient(r2, k)
+                    gx += w * rx
+                    gy += w * ry
+                    mxx -= w * rx * rx
+                    mxy -= w * rx * ry
+                    myy -= w * ry * ry
+            return mxx, mxy, myy, gx, gy
 
-    continuity_range, momentum_range, neighbours_range = ranges(mirror=False)
-    continuity_mirror, momentum_mirror, neighbours_mirror = ranges(mirror=True)
+        return continuity_range, momentum_range, neighbours_range, moments_range
+
+    continuity_range, momentum_range, neighbours_range, moments_range = ranges(mirror=False)
+    continuity_mirror, momentum_mirror, neighbours_mirror, moments_mirror = ranges(mirror=True)
 
     # ---------------------------------------------------------------- cell list
     @jit
@@ -284,6 +309,55 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         return count
 
     @jit
+    def moments_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, vol, k):
+        """The part of the moment sums (:func:`moments_range`) from across i's x boundary."""
+        mxx = k[ZERO]
+        mxy = k[ZERO]
+        myy = k[ZERO]
+        gx = k[ZERO]
+        gy = k[ZERO]
+        if not on_x_boundary(i, cell, ncx):
+            return mxx, mxy, myy, gx, gy
+        for dcy in range(-1, 2):
+            _, _, lyi, q0, q1, lxq = stencil_row(i, dcy, cell, begin, ncx, ncy, ly, lx, k)
+            if k[NX] > 0:
+                a, b, c, d, e = moments_range(q0, q1, lxq, lyi, sx[i], sy[i], lx, ly, sx, sy, vol, k)
+            else:
+                a, b, c, d, e = moments_mirror(q0, q1, lxq, lyi, sx[i], sy[i], lx, ly, sx, sy, vol, k)
+            mxx += a
+            mxy += b
+            myy += c
+            gx += d
+            gy += e
+        return mxx, mxy, myy, gx, gy
+
+    @jit
+    def moments_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, vol, k):
+        """Particle i's moment matrix (M_xx, M_xy, M_yy) and Gamma (x, y) from the 3x3 cells around it and
+        across its x boundary (the kernel gradient correction, solvers/corrections/)."""
+        mxx = k[ZERO]
+        mxy = k[ZERO]
+        myy = k[ZERO]
+        gx = k[ZERO]
+        gy = k[ZERO]
+        for dcy in range(-1, 2):
+            j0, j1, lyi = stencil_range(i, dcy, cell, begin, ncx, ncy, ly, k)
+            a, b, c, d, e = moments_range(j0, j1, lx[i], lyi, sx[i], sy[i], lx, ly, sx, sy, vol, k)
+            mxx += a
+            mxy += b
+            myy += c
+            gx += d
+            gy += e
+        if across:
+            a, b, c, d, e = moments_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, vol, k)
+            mxx += a
+            mxy += b
+            myy += c
+            gx += d
+            gy += e
+        return mxx, mxy, myy, gx, gy
+
+    @jit
     def continuity_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, drho, k):
         """d(drho_i)/dt from the 3x3 cells around particle i and across its x boundary, kg/m^3/s."""
         acc = k[ZERO]
@@ -385,6 +459,33 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         return -ax, -ay
 
     @jit
+    def moments_allpair(i, n, lx, ly, sx, sy, vol, k):
+        """Particle i's moment matrix and Gamma (:func:`moments_cells`) summed over all n particles."""
+        mxx = k[ZERO]
+        mxy = k[ZERO]
+        myy = k[ZERO]
+        gx = k[ZERO]
+        gy = k[ZERO]
+        for j in range(n):
+            lyi = minimum_image_row(ly[i], ly[j], k)
+            lxi = minimum_image_column(lx[i], lx[j], k)
+            a, b, c, d, e = moments_range(j, j + 1, lxi, lyi, sx[i], sy[i], lx, ly, sx, sy, vol, k)
+            mxx += a
+            mxy += b
+            myy += c
+            gx += d
+            gy += e
+            for wall, lxm in ((k[WALL_LO], lx[i] + k[WALL_LO]), (k[WALL_HI], lx[i] - k[MIRROR_HI])):
+                if across and wall > 0:
+                    a, b, c, d, e = moments_mirror(j, j + 1, lxm, lyi, sx[i], sy[i], lx, ly, sx, sy, vol, k)
+                    mxx += a
+                    mxy += b
+                    myy += c
+                    gx += d
+                    gy += e
+        return mxx, mxy, myy, gx, gy
+
+    @jit
     def neighbours_allpair(i, n, lx, ly, sx, sy, k):
         count = 0
         for j in range(n):
@@ -431,6 +532,11 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         continuity_mirror=continuity_mirror,
         momentum_mirror=momentum_mirror,
         neighbours_mirror=neighbours_mirror,
+        moments_range=moments_range,
+        moments_mirror=moments_mirror,
+        moments_across=moments_across,
+        moments_cells=moments_cells,
+        moments_allpair=moments_allpair,
         on_x_boundary=on_x_boundary,
         continuity_across=continuity_across,
         momentum_across=momentum_across,

@@ -63,7 +63,8 @@ def symbol(scene, kx, ky=0.0) -> tuple[np.ndarray, np.ndarray]:
         phase = np.multiply.outer(kx[part], a * scene.dx) + np.multiply.outer(ky[part], b * scene.dx)
         weight = -(scene.dx**2) * np.sin(phase) * g
         out_x[part], out_y[part] = weight @ (a * scene.dx), weight @ (b * scene.dx)
-    return out_x.reshape(shape), out_y.reshape(shape)
+    scale = scene.sph_correction.lattice_factor(scene)  # a correction's factor in the lattice's interior
+    return scale * out_x.reshape(shape), scale * out_y.reshape(shape)
 
 
 def largest_symbol(scene, points: int = 161) -> float:
@@ -111,6 +112,15 @@ class ModeSolver:
             self.u = self.saved["u"].copy()
         if "drho" in names:
             self.drho, self.t = self.saved["drho"].copy(), self.saved["t"]
+
+    def accumulate(self, weight: float, first: bool = False) -> None:
+        """A Runge-Kutta stage's rates, weighted, into the step's sums (solvers/interface.py)."""
+        if first:
+            self.sums = {"dd": 0.0, "ax": 0.0}
+        self.sums = {"dd": self.sums["dd"] + weight * self.dd, "ax": self.sums["ax"] + weight * self.ax}
+
+    def use_sum(self) -> None:
+        self.dd, self.ax = self.sums["dd"], self.sums["ax"]
 
     def state(self) -> np.ndarray:
         return np.stack([self.drho, self.u, self.ax, self.dd])
@@ -207,9 +217,11 @@ def largest_stable_z(integrator: str) -> float:
 
 
 def stable_cfl(scene) -> float:
-    """The largest stable CFL (dt c0 / dx) for the scene's kernel, h/dx, cutoff and integrator (it does not
+    """The largest stable CFL (dt c0 / dx) for the scene's kernel, h/dx, cutoff, integrator and correction (it does not
     depend on dx: D scales as 1/dx at fixed h/dx)."""
-    return _stable_cfl(scene.kernel, float(scene.h_factor), float(scene.cutoff_factor), scene.integrator)
+    return _stable_cfl(
+        scene.kernel, float(scene.h_factor), float(scene.cutoff_factor), scene.integrator, scene.correction
+    )
 
 
 def unit_scene(**method):
@@ -224,8 +236,10 @@ def unit_scene(**method):
 
 
 @lru_cache(maxsize=1024)
-def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> float:
-    unit = unit_scene(kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor, integrator=integrator)
+def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str = "none") -> float:
+    unit = unit_scene(
+        kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor, integrator=integrator, correction=correction
+    )
     return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
 
 

@@ -1,0 +1,120 @@
+"""The kernel gradient correction (Bonet & Lok 1999; Randles & Libersky 1996), in its energy-keeping form.
+
+The corrected gradient of a field f at particle i is
+
+    grad f_i = L_i sum_j V_j (f_j - f_i) grad_i W_ij,   L_i = M_i^-1,   M_i = sum_j V_j (x_j - x_i) (x) grad_i W_ij
+
+(M is symmetric, grad_i W_ij being G_ij r_ij): exact for linear fields, so the phase-speed error a kernel
+keeps at fixed h/dx (its lattice moment's departure from 1) is gone and the operator is second order, fourth
+with the Laguerre-Gauss kernel at h >= 1.5 dx cut at 4 h (design.md, 1c). In the lattice's interior L_i is the
+scalar 1 / M_xx, so the dispersion prediction is the standard symbol divided by its long-wave slope.
+
+The momentum equation takes that gradient of p = c0^2 drho: du_i/dt = -L_i (grad p)_i / rho_i. The
+continuity equation takes its negative adjoint in the volume-weighted inner product,
+
+    d(drho_i)/dt = -rho_i sum_j V_j (L_i u_i + L_j u_j) . grad_i W_ij,
+
+so that for fixed particles the linear system keeps the discrete energy sum_i V_i (rho0 |u_i|^2 +
+c0^2 drho_i^2 / rho0) / 2 exactly in time-continuous form: the pair of operators is skew-adjoint, whatever
+L_i does near a wall, a body or the lattice's edge (the corrected gradient in both equations, the other
+choice, is not: where L_i varies it has growing modes). Both sums are the solver's own sweeps: with
+Gamma_i = sum_j V_j grad_i W_ij,
+
+    sum_j V_j (f_j - f_i) grad_i W_ij = sum_j V_j (f_i + f_j) grad_i W_ij - 2 f_i Gamma_i   (the momentum sweep)
+    sum_j V_j (w_i + w_j) . grad_i W_ij = -sum_j V_j (w_i - w_j) . grad_i W_ij + 2 w_i . Gamma_i   (continuity)
+
+with w = L u, so the correction is the standard sweeps over other arrays plus one pass per particle. M and
+Gamma come from one more sweep (``moments``): once per run for particles that stay on their sites (linear,
+fixed), at each search for moving ones. A fluid particle whose M is singular or near it (too few
+neighbours: h below the lattice, an isolated particle near a body or a layer) fails the run at that step,
+naming where.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from solvers.corrections.base import Correction, SingularMoments
+
+SMALLEST_MOMENT = 0.05  # the smallest eigenvalue of M a fluid particle may have (1 in the lattice's interior)
+
+
+class GradientCorrection(Correction):
+    """L_i (the inverse moment matrix) on the momentum gradient, its negative adjoint in continuity."""
+
+    name = "gradient"
+    summary = "kernel gradient correction (Bonet & Lok): exact for linear fields, energy-keeping form"
+    arrays = 9  # M's inverse (3), Gamma (2), w (2), p and a scratch array
+
+    def coefficients(self, continuity: bool, momentum: bool) -> tuple:
+        """Both sweeps need the volumes; momentum takes p = c0^2 drho, made here."""
+        return True, False
+
+    def sweep(self, solver, continuity: bool, momentum: bool) -> None:
+        s, a, xp = solver.scene, solver.arrays, solver.xp
+        lxx, lxy, lyy, gx, gy = self.factors(solver)
+        two = solver.dtype.type(2.0)
+        rho = a["drho"] * solver.dtype.type(s.model != "linear") + solver.dtype.type(s.rho0)
+        if continuity:
+            u, v = a["u"], a["v"]
+            wx, wy = lxx * u + lxy * v, lxy * u + lyy * v
+            with solver.swapped(u=wx, v=wy):
+                solver._sweep(True, False)
+                if solver.split:
+                    solver.continuity_x()
+            a["dd"] -= two * rho * (wx * gx + wy * gy)
+            if solver.split:  # the x part: w's x terms (in the interior, L u_x's)
+                a["ddx"] -= two * rho * wx * gx
+        if momentum:
+            p = a["drho"] * solver.dtype.type(s.c0**2)
+            with solver.swapped(mass=a["vol"], pr=p):
+                solver._sweep(False, True)
+            bx, by = a["ax"] + two * p * gx, a["ay"] + two * p * gy  # -(the difference form's sum)
+            xp.divide(lxx * bx + lxy * by, rho, out=a["ax"])
+            xp.divide(lxy * bx + lyy * by, rho, out=a["ay"])
+
+    def factors(self, solver) -> tuple:
+        """(L_xx, L_xy, L_yy, Gamma_x, Gamma_y) at the current positions: computed when the particles have moved
+        or been put in a new order since (``Solver.reordered``, ``Solver.moves``), else kept."""
+        key = (solver.reordered, solver.moves)
+        kept = getattr(solver, "correction_factors", None)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+        mxx, mxy, myy, gx, gy = solver.moments()
+        xp = solver.xp
+        smallest = 0.5 * (mxx + myy) - xp.sqrt((0.5 * (mxx - myy)) ** 2 + mxy * mxy)
+        bad = ~(smallest >= SMALLEST_MOMENT)  # NaN too
+        ghost = solver.arrays["role"] != 0 if "role" in solver.arrays else None
+        fluid_bad = bad & ~ghost if ghost is not None else bad
+        if bool(fluid_bad.any()):
+            self.refuse(solver, int(xp.argmax(fluid_bad)), float(smallest[int(xp.argmax(fluid_bad))]))
+        if ghost is not None:  # a body's ghosts only lend their values: where their M is poor, no correction
+            one, zero = solver.dtype.type(1.0), solver.dtype.type(0.0)
+            for arr, value in ((mxx, one), (mxy, zero), (myy, one)):
+                arr[bad] = value
+        det = mxx * myy - mxy * mxy
+        factors = (myy / det, -mxy / det, mxx / det, gx, gy)
+        solver.correction_factors = (key, factors)
+        return factors
+
+    def refuse(self, solver, i: int, smallest: float) -> None:
+        s, a = solver.scene, solver.arrays
+        x = s.x_lo + (float(a["lx"][i]) + 0.5) * s.dx + float(a["sx"][i])
+        y = s.y_lo + (float(a["ly"][i]) + 0.5) * s.dx + float(a["sy"][i])
+        raise SingularMoments(
+            f"--correction gradient: the particle at ({x:.6g}, {y:.6g}) m has a moment matrix with smallest "
+            f"eigenvalue {smallest:.3g} (at least {SMALLEST_MOMENT:g}; 1 inside the lattice): too few neighbours "
+            f"within the cutoff ({s.cutoff / s.dx:.3g} dx at h = {s.h_factor:g} dx) to correct its gradient"
+        )
+
+    def lattice_factor(self, scene) -> float:
+        """1 / M_xx of a particle inside the lattice: the symbol's long-wave slope divided out (D(k) / D'(0))."""
+        reach = int(math.ceil(scene.cutoff / scene.dx))
+        offsets = np.arange(-reach, reach + 1, dtype=np.float64) * scene.dx
+        x, y = np.meshgrid(offsets, offsets, indexing="ij")
+        r = np.hypot(x, y)
+        keep = (r < scene.cutoff) & (r > 0)
+        moment = -(scene.dx**2) * float((scene.sph_kernel.gradient(r[keep], scene.h) * x[keep] ** 2).sum())
+        return 1.0 / moment if math.isfinite(moment) and moment > 0 else 1.0
