@@ -183,6 +183,7 @@ class Solver(abc.ABC):
         self.body = None
         if s.body is not None:  # a rigid body: its particles' roles and places (solvers/bodies/)
             from solvers.bodies import Body, boundary_method_named
+            from solvers.bodies.base import INERT
 
             self.body = Body(boundary_method_named(s.boundary_method_used), s)
             role, shift_x, shift_y = (xp.asarray(v) for v in self.body.place(self.to_host(x), self.to_host(y)))
@@ -190,6 +191,7 @@ class Solver(abc.ABC):
             a["sx"], a["sy"] = shift_x.astype(dt), shift_y.astype(dt)
             for name in ("u", "v", "drho"):
                 a[name][role != 0] = 0
+            a["mass"][role == INERT] = 0  # no volume: no sum counts the inert particles
         if self.split:  # a split absorber's x parts of drho and of its rate (drho_y = drho - drho_x)
             a["drho_x"] = (0.5 * drho).astype(dt)
             a["ddx"] = xp.zeros(s.n_particles, dt)

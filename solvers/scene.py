@@ -312,9 +312,14 @@ class Scene:
         try:
             from solvers.bodies import boundary_method_named
 
-            boundary_method_named(self.boundary_method_used)
+            method = boundary_method_named(self.boundary_method_used)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
+        need(
+            not getattr(method, "needs_correction", False) or self.correction != DEFAULT_CORRECTION,
+            f"--boundary-method {method.name} makes a wall only with a kernel correction: add --correction "
+            f"gradient (got --correction {self.correction})",
+        )
 
     @property
     def body(self) -> tuple | None:

@@ -231,7 +231,7 @@ from pathlib import Path
 from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
-scene = Scene(dx=0.5, name="pulse-wall", model=sys.argv[1], steps=4, integrator="rk4", cfl=0.5,
+scene = Scene(dx=1.0, name="pulse-wall", model=sys.argv[1], steps=4, integrator="rk4", cfl=0.5,
               kernel="laguerre-gauss", h_factor=1.5, cutoff_factor=4.0, correction="gradient")
 out = {}
 with tempfile.TemporaryDirectory() as d:

@@ -26,6 +26,7 @@ from pcabench import jsonout, paths
 from pcabench.cli.accuracy import ROUNDED_AS_PRINTED
 from pcabench.cli.exits import EXIT_OK, EXIT_RUN_FAILED
 from pcabench.errors import NoResults
+from pcabench.predict.methods import HIGH_ORDER_SHARES, high_order_methods, step_weight
 from pcabench.predict.stability import assess, e_foldings, scene_limit
 from pcabench.reports.tables import comparable, default_numerics, error_column, latest, numerics_label
 from pcabench.spec import OptionError, scene_from_row
@@ -37,6 +38,8 @@ from solvers import (
     kernel_names,
     scene_kind,
 )
+from solvers.kernels import truncated
+from solvers.method import Method
 
 # The configurations the prediction searches when no stored run reaches a target (a small, cheap grid), for
 # every registered kernel.
@@ -193,29 +196,34 @@ def advise(
     return out
 
 
+def candidates(hs, shares) -> list[tuple[dict, tuple]]:
+    """(method, CFL shares) :func:`suggest` tries: every kernel at each h of ``hs`` (standard SPH, Verlet) with
+    ``shares``, then the high-order methods (pcabench/predict/methods.py) with their own shares."""
+    standard = [({"kernel": kern, "h_factor": h}, shares) for kern, h in itertools.product(kernel_names(), hs)]
+    return standard + [(m, HIGH_ORDER_SHARES) for m in high_order_methods()]
+
+
 def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFAULT_SCENE) -> dict:
-    """From the prediction: the cheapest configuration of a small grid (:func:`search_grid`) predicted to reach
-    ``error`` at ``t_end`` on ``scene`` (cost ~ particles x steps x neighbours: on the thinnest strip where a strip
-    serves the scene, else on its own domain), the one predicted closest to it, and the paper configuration's dx.
-    A scene with a body is predicted with its wall exact (the bulk's dispersion alone: a lower bound of a run's
-    error); its search takes a minute or two and says so on stderr."""
+    """From the prediction: the cheapest configuration of a small grid (:func:`search_grid`, and the high-order
+    methods: :func:`candidates`) predicted to reach ``error`` at ``t_end`` on ``scene`` (cost ~ particles x steps
+    x neighbours x the step's sweeps: on the thinnest strip where a strip serves the scene, else on its own
+    domain), the one predicted closest to it, and the paper configuration's dx. A scene with a body is predicted
+    with its wall exact (the bulk's dispersion alone: a lower bound of a run's error), a corrected method with
+    the weak wall (solvers/bodies/weak.py: the ghosts' walls grow with a corrected negative-lobe kernel); its
+    search takes a minute or two and says so on stderr."""
     kind = scene_kind(scene)
     dxs, hs, shares = search_grid(kind)
     best, paper, closest = None, None, None
-    for kern, h in itertools.product(kernel_names(), hs):
+    for method, method_shares in candidates(hs, shares):
+        corrected = method.get("correction", "none") != "none"
+        wall = {"boundary_method": "weak"} if kind.body and corrected else {}
         if kind.body:
-            print(f"advise: predicting {scene}'s probes with {kern}, h = {h:g} dx ...", file=sys.stderr, flush=True)
-        for share in shares:
+            label = Method.of(method).label
+            print(f"advise: predicting {scene}'s probes with {label} ...", file=sys.stderr, flush=True)
+        for share in method_shares:
             for dx in sorted(dxs, reverse=True):  # coarse to fine: the first that reaches is this method's cheapest
                 try:
-                    base = Scene(
-                        dx=dx,
-                        name=scene,
-                        t_end=t_end,
-                        model="linear",
-                        kernel=kern,
-                        h_factor=h,
-                    )
+                    base = Scene(dx=dx, name=scene, t_end=t_end, model="linear", **method, **wall)
                 except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
                     continue
                 limit = scene_limit(base)  # predicted, or lower where long runs of the scene measured it
@@ -228,6 +236,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                 if p.predicted_error > error:
                     continue
                 cost = (1 / dx) ** (1 if kind.strip else 2) * trial.n_steps * (trial.cutoff / dx) ** 2
+                cost *= step_weight(trial)
                 if best is None or cost < best[0]:
                     best = (cost, trial, p)
                 break
@@ -246,15 +255,11 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
     }
     if closest is not None:
         c, p = closest
-        out["closest"] = dict(
-            kernel=c.kernel, h_factor=c.h_factor, cfl=c.cfl, dx=c.dx, predicted_error=p.predicted_error
-        )
+        out["closest"] = dict(**method_fields(c), dx=c.dx, predicted_error=p.predicted_error)
     if best is not None:
         _, s, p = best
         out.update(
-            kernel=s.kernel,
-            h_factor=s.h_factor,
-            cfl=s.cfl,
+            **method_fields(s),
             dx=s.dx,
             predicted_error=p.predicted_error,
             **({} if kind.strip else {"n_particles": s.n_particles, "steps": s.n_steps}),
@@ -270,12 +275,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                     f"{t_end:g}",
                     *([] if scene == DEFAULT_SCENE else ["--scene", scene]),
                     *(["--strip"] if kind.strip else []),
-                    "--kernel",
-                    s.kernel,
-                    "--h-factor",
-                    f"{s.h_factor:g}",
-                    "--cfl",
-                    f"{s.cfl:g}",
+                    *method_words(s),
                     "--dx",
                     f"{s.dx:g}",
                     *([] if kind.body else [f"{s.dx / 2:g}"]),  # a body's dx is fine already: its own run only
@@ -283,6 +283,32 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
             ),
         )
     return out
+
+
+def method_fields(scene: Scene) -> dict:
+    """A suggested scene's method as advise reports it: kernel, h/dx, CFL, its label, and the cutoff, integrator,
+    correction and boundary method where they are not the defaults."""
+    out = {"kernel": scene.kernel, "h_factor": scene.h_factor, "cfl": scene.cfl, "method": Method.of(scene).label}
+    for name in ("cutoff_factor", "integrator", "correction", "boundary_method"):
+        if getattr(scene, name) != Scene.default(name) and (name != "cutoff_factor" or truncated(scene.kernel)):
+            out[name] = getattr(scene, name)
+    return out
+
+
+def method_words(scene: Scene) -> list[str]:
+    """The study options of a suggested scene's method (each one away from its default)."""
+    words = ["--kernel", scene.kernel, "--h-factor", f"{scene.h_factor:g}", "--cfl", f"{scene.cfl:g}"]
+    fields = method_fields(scene)
+    for name, option in (
+        ("cutoff_factor", "--cutoff"),
+        ("integrator", "--integrator"),
+        ("correction", "--correction"),
+        ("boundary_method", "--boundary-method"),
+    ):
+        if name in fields:
+            value = fields[name]
+            words += [option, f"{value:g}" if isinstance(value, float) else str(value)]
+    return words
 
 
 def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene: str) -> tuple[str, bool]:
@@ -312,16 +338,16 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
             lines.append(
                 "no method of the searched grid is predicted to reach it"
                 + (
-                    f" (the closest: {c['kernel']}, h = {c['h_factor']:g} dx, CFL {c['cfl']:g}, dx {c['dx']:g}: "
-                    f"predicted {c['predicted_error']:.3g}, {s['note']})"
+                    f" (the closest: {c['method']}, dx {c['dx']:g}: predicted {c['predicted_error']:.3g}, {s['note']})"
                     if c
                     else ""
                 )
             )
         else:
             lines.append(
-                f"predicted cheapest ({s['note']}): {s['kernel']}, h = {s['h_factor']:g} dx, "
-                f"CFL {s['cfl']:g}, dx {s['dx']:g} (predicted {s['predicted_error']:.3g}"
+                f"predicted cheapest ({s['note']}): {s['method']}"
+                + (f", {s['boundary_method']} wall" if "boundary_method" in s else "")
+                + f", dx {s['dx']:g} (predicted {s['predicted_error']:.3g}"
                 + (f"; {s['n_particles']:,} particles, {s['steps']:,} steps" if "steps" in s else "")
                 + "); "
                 f"run:\n  {s['study']}"

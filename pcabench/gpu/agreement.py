@@ -41,8 +41,13 @@ def gpu_against_cpu(scene: Scene, out: Path) -> dict:
         file=sys.stderr,
         flush=True,
     )
+    method = (
+        f", {scene.sph_kernel.name} {scene.correction}-corrected {scene.integrator}"
+        if scene.correction != "none"
+        else ""
+    )
     return {
-        "scene": scene.name + (f" ({scene.boundary_method_used})" if scene.body is not None else ""),
+        "scene": scene.name + (f" ({scene.boundary_method_used})" if scene.body is not None else "") + method,
         "N": scene.n_particles,
         "precision": scene.precision,
         "model": scene.model,
@@ -98,6 +103,17 @@ def body_against_cpu(plan: Plan, out: Path) -> list[dict]:
         for method in plan.body_methods
         for model in plan.body_models
         for precision in plan.body_precisions
+    ]
+
+
+def high_order_against_cpu(plan: Plan, out: Path) -> list[dict]:
+    """The same on each high-order scene of the plan (the kernel gradient correction's moments sweep and passes,
+    RK4's sums, the weak wall), each model and precision."""
+    return [
+        gpu_against_cpu(Scene(**{**scene, "steps": plan.compare_steps, "model": model, "precision": precision}), out)
+        for scene in plan.high_order_scenes
+        for model in plan.high_order_models
+        for precision in plan.high_order_precisions
     ]
 
 

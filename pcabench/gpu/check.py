@@ -61,6 +61,7 @@ from pcabench.gpu.agreement import (
     agrees,
     body_against_cpu,
     compare_with_cpu,
+    high_order_against_cpu,
     open_against_cpu,
     open_cost,
     walls_against_cpu,
@@ -129,6 +130,11 @@ def walls(c: Check) -> bool:
 def body(c: Check) -> bool:
     c.state["body"] = body_against_cpu(c.plan, c.out)
     return agrees(c.state["body"])
+
+
+def high_order(c: Check) -> bool:
+    c.state["high-order"] = high_order_against_cpu(c.plan, c.out)
+    return agrees(c.state["high-order"])
 
 
 def open_edges(c: Check) -> bool:
@@ -240,6 +246,7 @@ STAGES = (
     Stage("sweep", 60, gpu_sweep),
     Stage("open", 40, open_edges),
     Stage("body", 40, body),
+    Stage("high-order", 40, high_order),
     Stage("graph", 40, graph),
     Stage("cpu", 40, cpu_peers),
     Stage("asv", 60, asv),

@@ -14,6 +14,9 @@ GPU_SOLVER = "linkedlist-gpu"  # the solver this check measures (its CUDA graph 
 GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
 CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
 
+# The high-order method (solvers/corrections/gradient.py): Laguerre-Gauss at h 1.5 dx cut at 4 h, corrected.
+HIGH_ORDER = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0, "correction": "gradient"}
+
 RESERVE_S = 25.0  # kept back from every stage for the reports and the tarball
 
 
@@ -43,6 +46,14 @@ class Plan:
     body_methods: tuple = ("lattice", "rings")
     body_models: tuple = ("linear", "lagrangian")
     body_precisions: tuple = ("float64", "float32")
+    # high-order SPH (issue 56): the kernel gradient correction with the Laguerre-Gauss kernel, on the plane pulse
+    # with RK4 and on the cylinder with its weak wall (no ghosts), each model and precision, against the CPU solver
+    high_order_scenes: tuple = (
+        {"dx": 0.25, "integrator": "rk4", "cfl": 1.0, **HIGH_ORDER},
+        {"name": "cylinder", "dx": 0.04, "boundary_method": "weak", "cfl": 0.5, **HIGH_ORDER},
+    )
+    high_order_models: tuple = ("linear", "lagrangian")
+    high_order_precisions: tuple = ("float64", "float32")
     open_cost: tuple = ({"dx": 0.025, "open": "x"}, {"name": "acoustic-pulse", "dx": 0.05, "open": "xy"})
     open_cost_steps: int = 50
     open_cost_rounds: int = 3
@@ -77,6 +88,11 @@ REHEARSAL = Plan(
     body_methods=("rings",),
     body_models=("lagrangian",),
     body_precisions=("float32",),
+    # check-solver's cylinder with the weak wall: the correction's moments and passes, one run a side (RK4 in the
+    # simulator: tests/test_high_order.py)
+    high_order_scenes=({**SCENES["cylinder"], "boundary_method": "weak", "cfl": 0.5, **HIGH_ORDER},),
+    high_order_models=("lagrangian",),
+    high_order_precisions=("float64",),
     open_cost=({"dx": 1.0, "x_min": -8.0, "x_max": 8.0, "open": "x"},),
     open_cost_steps=2,
     open_cost_rounds=1,

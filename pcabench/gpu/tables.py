@@ -77,6 +77,7 @@ def markdown(profile: dict, results: dict) -> str:
         ("walls", "Rigid walls (mirror particles)"),
         ("open", "Open edges (an absorbing layer)"),
         ("body", "A rigid cylinder (ghost particles)"),
+        ("high-order", "High-order SPH (the gradient correction, Laguerre-Gauss, RK4; the weak wall)"),
     ):
         if results.get(key):
             lines += scene_agreement(what, results[key])

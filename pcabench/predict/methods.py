@@ -17,10 +17,20 @@ import math
 from functools import lru_cache
 
 from solvers import DEFAULT_SCENE, Scene, kernel_names
+from solvers.kernels import truncated
 from solvers.method import Method
+from solvers.physics.integrators import sweeps_per_step
 from solvers.reference.dispersion import predict
 
 H_FACTORS = (1.0, 1.1, 1.2, 1.3, 1.4, 1.6, 2.0, 2.13)
+# High-order SPH (solvers/corrections/gradient.py, design.md 1c): each kernel with the gradient correction at
+# h = 1.5 dx, a truncated kernel cut at 4 h (where the Laguerre-Gauss kernel's operator is fourth order), with
+# Verlet and with RK4. A fourth-order operator is most accurate at a short step (Verlet's phase lead no longer
+# offsets a second-order lag): shares of the stable CFL down to a quarter.
+HIGH_ORDER_H = (1.5,)
+HIGH_ORDER_CUTOFF = 4.0
+HIGH_ORDER_INTEGRATORS = ("verlet", "rk4")
+HIGH_ORDER_SHARES = (0.25, 0.5, 0.8)
 DXS = (0.4, 0.3, 0.25, 0.2, 0.15, 0.125, 0.1, 0.075, 0.05)
 CFL_SHARES = (0.5, 0.7, 0.9)  # of the predicted stable CFL
 # The largest share of the predicted stable CFL a model may use: the prediction is exact for `linear`; for the
@@ -29,8 +39,31 @@ MARGIN = {"linear": 0.9, "fixed": 0.7, "lagrangian": 0.7}
 
 
 def cost(scene: Scene) -> float:
-    """Work of a run, particle-neighbour visits: particles x steps x neighbours within the cutoff."""
-    return scene.n_particles * scene.n_steps * math.pi * (scene.cutoff / scene.dx) ** 2
+    """Work of a run, particle-neighbour visits: particles x steps x neighbours within the cutoff x the step's
+    sweeps over Verlet's (RK4: 4)."""
+    return scene.n_particles * scene.n_steps * math.pi * (scene.cutoff / scene.dx) ** 2 * step_weight(scene)
+
+
+def step_weight(scene: Scene) -> float:
+    """A step's sweeps over a Verlet step's (the integrator's program counted: rk4 4, rk2 2)."""
+    return sweeps_per_step(scene.integrator) / sweeps_per_step("verlet")
+
+
+def high_order_methods() -> tuple[dict, ...]:
+    """The corrected methods a search adds to the standard kernels x h/dx (Scene fields: kernel, h_factor,
+    cutoff_factor where the kernel is truncated, correction, integrator)."""
+    return tuple(
+        {
+            "kernel": kernel,
+            "h_factor": h,
+            **({"cutoff_factor": HIGH_ORDER_CUTOFF} if truncated(kernel) else {}),
+            "correction": "gradient",
+            "integrator": integrator,
+        }
+        for kernel in kernel_names()
+        for h in HIGH_ORDER_H
+        for integrator in HIGH_ORDER_INTEGRATORS
+    )
 
 
 @lru_cache(maxsize=256)

@@ -53,7 +53,9 @@ def _value(r, key, default=None):
 
 
 @lru_cache(maxsize=1024)
-def _limits(kernel: str, h_factor: float, cutoff_factor: float, integrator: str) -> tuple[float, float]:
+def _limits(
+    kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str = "none"
+) -> tuple[float, float]:
     """(stable CFL, largest c0 |D| dt per unit CFL) of one method (:class:`solvers.method.Method`). Both are the
     same at every dx (the lattice's offsets are in units of dx, and dx |D| depends on h/dx only), so dx = 1
     stands for all."""
@@ -61,20 +63,21 @@ def _limits(kernel: str, h_factor: float, cutoff_factor: float, integrator: str)
     from solvers.method import Method
     from solvers.reference.dispersion import largest_symbol, unit_scene
 
-    method = Method(kernel, h_factor, cutoff_factor if truncated(kernel) else None, 1.0, integrator)
+    method = Method(kernel, h_factor, cutoff_factor if truncated(kernel) else None, 1.0, integrator, correction)
     scene = unit_scene(**method.scene_fields())
     return method.stable_cfl(), scene.dx * largest_symbol(scene)
 
 
-def method_of(r) -> tuple[str, float, float, str]:
-    """(kernel, h/dx, cutoff/h, integrator) of a stored run or a front point (:meth:`solvers.method.Method.of`:
-    Scene's defaults where missing; a compact kernel's truncation is its support, written as the default)."""
+def method_of(r) -> tuple[str, float, float, str, str]:
+    """(kernel, h/dx, cutoff/h, integrator, correction) of a stored run or a front point
+    (:meth:`solvers.method.Method.of`: Scene's defaults where missing; a compact kernel's truncation is its support,
+    written as the default)."""
     from solvers import Scene
     from solvers.method import Method
 
     m = Method.of(r)
     cut = Scene.default("cutoff_factor") if m.cutoff_factor is None else m.cutoff_factor
-    return m.kernel, m.h_factor, cut, m.integrator
+    return m.kernel, m.h_factor, cut, m.integrator, m.correction
 
 
 def measured_limit(r) -> float | None:
@@ -83,7 +86,9 @@ def measured_limit(r) -> float | None:
     from solvers import DEFAULT_SCENE
     from solvers.kernels import truncated
 
-    kernel, h, cut, integrator = method_of(r)
+    kernel, h, cut, integrator, correction = method_of(r)
+    if correction != "none":  # the file's long runs are of standard SPH
+        return None
     mine = (str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", ""), kernel, integrator)
     for (scene, model, k, hh, cc, integ), (limit, _bounded) in measured_limits().items():
         if (scene, model, k, integ) == mine and math.isclose(h, hh) and (not truncated(k) or math.isclose(cut, cc)):

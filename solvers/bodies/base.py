@@ -2,7 +2,7 @@
 
 A body (``Scene.body``: a cylinder of radius a, its axis at x0, y0) holds the lattice sites inside it. A boundary
 method says which of them are the wall's particles (ghosts) and where they sit (:meth:`BoundaryMethod.place`);
-the others inside are inert (zero fields: deeper than any fluid particle's kernel reaches). Before every sweep
+the others inside are inert (zero fields and no volume: no sum counts them). Before every sweep
 the solver gives each ghost the fluid's values mirrored across the wall (:meth:`Body.fill`): drho (so the
 pressure) even, the normal velocity odd and the tangential one even, the conditions of a rigid wall for the
 linear acoustic equations (u . n = 0 and dp/dn = 0), sampled at the ghost's mirror point across the surface
@@ -41,6 +41,7 @@ class BoundaryMethod:
 
     name: str = ""
     summary: str = ""
+    needs_correction: bool = False  # whether it makes a wall only with a kernel correction (solvers/corrections/)
 
     def place(self, scene, x, y) -> tuple:
         """(ghost, inert, gx, gy) for the lattice sites at ``x``, ``y`` (m, float64 arrays, site order): which

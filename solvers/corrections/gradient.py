@@ -53,27 +53,32 @@ class GradientCorrection(Correction):
         return True, False
 
     def sweep(self, solver, continuity: bool, momentum: bool) -> None:
-        s, a, xp = solver.scene, solver.arrays, solver.xp
+        a, k = solver.arrays, solver.k
         lxx, lxy, lyy, gx, gy = self.factors(solver)
-        two = solver.dtype.type(2.0)
-        rho = a["drho"] * solver.dtype.type(s.model != "linear") + solver.dtype.type(s.rho0)
+        wx, wy, p = self.scratch(solver)
         if continuity:
-            u, v = a["u"], a["v"]
-            wx, wy = lxx * u + lxy * v, lxy * u + lyy * v
+            solver.launch("corrected_velocity", a["u"], a["v"], lxx, lxy, lyy, wx, wy)
             with solver.swapped(u=wx, v=wy):
                 solver._sweep(True, False)
                 if solver.split:
                     solver.continuity_x()
-            a["dd"] -= two * rho * (wx * gx + wy * gy)
-            if solver.split:  # the x part: w's x terms (in the interior, L u_x's)
-                a["ddx"] -= two * rho * wx * gx
+            ddx = a["ddx"] if solver.split else a["dd"]  # the x part: w's x terms (in the interior, L u_x's)
+            solver.launch("corrected_continuity", a["dd"], ddx, a["drho"], wx, wy, gx, gy, solver.split, k)
         if momentum:
-            p = a["drho"] * solver.dtype.type(s.c0**2)
+            solver.launch("pressure", a["drho"], p, k)
             with solver.swapped(mass=a["vol"], pr=p):
                 solver._sweep(False, True)
-            bx, by = a["ax"] + two * p * gx, a["ay"] + two * p * gy  # -(the difference form's sum)
-            xp.divide(lxx * bx + lxy * by, rho, out=a["ax"])
-            xp.divide(lxy * bx + lyy * by, rho, out=a["ay"])
+            solver.launch("corrected_momentum", a["ax"], a["ay"], a["drho"], p, lxx, lxy, lyy, gx, gy, k)
+
+    def scratch(self, solver) -> tuple:
+        """(w_x, w_y, p): the fields the corrected sweeps sum, made anew from the state at every PI (so never
+        reordered), kept from one PI to the next."""
+        kept = getattr(solver, "correction_scratch", None)
+        n = solver.scene.n_particles
+        if kept is None or kept[0].shape[0] != n or kept[0].dtype != solver.dtype:
+            kept = tuple(solver.xp.zeros(n, solver.dtype) for _ in range(3))
+            solver.correction_scratch = kept
+        return kept
 
     def factors(self, solver) -> tuple:
         """(L_xx, L_xy, L_yy, Gamma_x, Gamma_y) at the current positions: computed when the particles have moved

@@ -40,6 +40,10 @@ KERNELS = (
     "coefficients",
     "kick",
     "advance",
+    "corrected_velocity",
+    "corrected_continuity",
+    "pressure",
+    "corrected_momentum",
 )
 
 

@@ -37,6 +37,11 @@ class CapturedSteps:
                 "--open: the graph path replays closed scenes only (an open edge's layer keeps damping factors "
                 "that capture would record but never compute)"
             )
+        if getattr(getattr(solver, "correction", None), "name", "none") != "none":
+            raise ValueError(
+                "--correction: the graph path replays uncorrected steps only (a correction's per-particle passes "
+                "allocate their arrays inside the step)"
+            )
         self.solver = solver
         t0, start = solver.t, solver.state()
         self.graphs = {}  # block it starts from -> (graph, block current after it, seconds it advances)

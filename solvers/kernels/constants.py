@@ -30,7 +30,8 @@ NX = 9  # lattice columns in the periodic width, 0 where the x edges are free
 WALL_LO = 10  # 1 where a rigid wall is the lattice's left edge (mirror particles across it), else 0
 WALL_HI = 11  # 1 where a rigid wall is the lattice's right edge, else 0
 MIRROR_HI = 12  # 2 nx - 1: the right wall mirrors lattice column lx onto column MIRROR_HI - lx (the left: -1 - lx)
-SLOTS = 13
+ONE = 13  # 1 in the solver's float type
+SLOTS = 14
 
 
 def constants(scene, dtype) -> tuple:
@@ -51,6 +52,7 @@ def constants(scene, dtype) -> tuple:
         WALL_LO: 1.0 if "x_min" in scene.kind.walls else 0.0,
         WALL_HI: 1.0 if "x_max" in scene.kind.walls else 0.0,
         MIRROR_HI: float(2 * scene.nx - 1),
+        ONE: 1.0,
     }
     t = np.dtype(dtype).type
     return tuple(t(values[i]) for i in range(SLOTS))

@@ -124,3 +124,28 @@ def advance(drho, dd, sx, sy, u, v, c, moving, mass, vol, pr, k):
     if i < drho.shape[0]:
         P.advance_at(i, drho, dd, sx, sy, u, v, c, moving)
         P.coefficients_at(i, drho, mass, vol, pr, True, True, k)
+
+
+# the kernel gradient correction's passes per particle (solvers/corrections/gradient.py)
+def corrected_velocity(u, v, lxx, lxy, lyy, wx, wy):
+    i = cuda.grid(1)
+    if i < u.shape[0]:
+        P.corrected_velocity_at(i, u, v, lxx, lxy, lyy, wx, wy)
+
+
+def corrected_continuity(dd, ddx, drho, wx, wy, gx, gy, split, k):
+    i = cuda.grid(1)
+    if i < dd.shape[0]:
+        P.corrected_continuity_at(i, dd, ddx, drho, wx, wy, gx, gy, split, k)
+
+
+def pressure(drho, p, k):
+    i = cuda.grid(1)
+    if i < drho.shape[0]:
+        P.pressure_at(i, drho, p, k)
+
+
+def corrected_momentum(ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k):
+    i = cuda.grid(1)
+    if i < ax.shape[0]:
+        P.corrected_momentum_at(i, ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k)

@@ -35,3 +35,23 @@ def gather(src, order, out, parts):
     n = order.shape[0]
     for t in prange(parts):
         gather_range(src, order, out, t * n // parts, (t + 1) * n // parts)
+
+
+def corrected_velocity(u, v, lxx, lxy, lyy, wx, wy):
+    for i in prange(u.shape[0]):
+        P.corrected_velocity_at(i, u, v, lxx, lxy, lyy, wx, wy)
+
+
+def corrected_continuity(dd, ddx, drho, wx, wy, gx, gy, split, k):
+    for i in prange(dd.shape[0]):
+        P.corrected_continuity_at(i, dd, ddx, drho, wx, wy, gx, gy, split, k)
+
+
+def pressure(drho, p, k):
+    for i in prange(drho.shape[0]):
+        P.pressure_at(i, drho, p, k)
+
+
+def corrected_momentum(ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k):
+    for i in prange(ax.shape[0]):
+        P.corrected_momentum_at(i, ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k)

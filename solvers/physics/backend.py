@@ -68,7 +68,16 @@ def cpu_loops(
 # The functions each CPU template compiles (the rest of a template is inlined helpers and constants), and
 # the options a template adds to nogil (and parallel where a solver runs threads).
 COMPILED = {
-    "updates": ("coefficients", "kick", "advance", "gather"),
+    "updates": (
+        "coefficients",
+        "kick",
+        "advance",
+        "gather",
+        "corrected_velocity",
+        "corrected_continuity",
+        "pressure",
+        "corrected_momentum",
+    ),
     "sorting": ("counting_sort", "sort_cells_by_x"),
     "cells": ("continuity", "momentum", "moments", "neighbours", "wall_continuity", "wall_momentum", "cell_ids"),
     "allpair": ("continuity", "momentum", "moments", "neighbours"),

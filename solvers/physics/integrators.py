@@ -106,3 +106,25 @@ def evolve(solver, scene, steps: int | None = None):
     solver.init()
     advance_steps(solver, scene.integrator, scene.n_steps if steps is None else steps)
     return solver
+
+
+class _Count:
+    """Enough of a solver for :func:`step_program` to count its sweeps."""
+
+    def __init__(self):
+        self.sweeps = 0
+
+    def rates(self, continuity: bool, momentum: bool) -> None:
+        self.sweeps += int(continuity) + int(momentum)
+
+    def __getattr__(self, name):
+        return lambda *args, **kwargs: None
+
+
+def sweeps_per_step(integrator: str) -> int:
+    """Neighbour sweeps (continuity or momentum, one each) of one step of ``integrator`` after the first: the
+    step's cost in units of a sweep (verlet 2, rk2 4, rk4 8)."""
+    counter = _Count()
+    for _stage, op in step_program(integrator, counter, first=False):
+        op()
+    return counter.sweeps

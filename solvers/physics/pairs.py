@@ -36,7 +36,20 @@ import math
 from types import ModuleType
 
 from solvers.kernels import kernel_named
-from solvers.kernels.constants import C0SQ, MIRROR_HI, NONLIN, NX, NY, RC2, RHO0, SPACING, WALL_HI, WALL_LO, ZERO
+from solvers.kernels.constants import (
+    C0SQ,
+    MIRROR_HI,
+    NONLIN,
+    NX,
+    NY,
+    ONE,
+    RC2,
+    RHO0,
+    SPACING,
+    WALL_HI,
+    WALL_LO,
+    ZERO,
+)
 
 
 def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -> ModuleType:
@@ -523,6 +536,38 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
             sx[i] += c * u[i]
             sy[i] += c * v[i]
 
+    # ---- the kernel gradient correction's passes per particle (solvers/corrections/gradient.py), L = M^-1
+    @jit
+    def corrected_velocity_at(i, u, v, lxx, lxy, lyy, wx, wy):
+        """w_i = L_i u_i: what continuity's negative adjoint sums (m/s)."""
+        wx[i] = lxx[i] * u[i] + lxy[i] * v[i]
+        wy[i] = lxy[i] * u[i] + lyy[i] * v[i]
+
+    @jit
+    def corrected_continuity_at(i, dd, ddx, drho, wx, wy, gx, gy, split, k):
+        """d(drho_i)/dt -= 2 rho_i w_i . Gamma_i (the sweep gave rho_i sum_j V_j (w_i - w_j) . grad_i W_ij);
+        ``split``: the x part too."""
+        rho2 = (k[RHO0] + k[NONLIN] * drho[i]) * (k[ONE] + k[ONE])
+        dd[i] -= rho2 * (wx[i] * gx[i] + wy[i] * gy[i])
+        if split:
+            ddx[i] -= rho2 * wx[i] * gx[i]
+
+    @jit
+    def pressure_at(i, drho, p, k):
+        """p_i = c0^2 drho_i, Pa: what the corrected momentum sweep sums."""
+        p[i] = k[C0SQ] * drho[i]
+
+    @jit
+    def corrected_momentum_at(i, ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k):
+        """du_i/dt = -L_i (sum_j V_j (p_j - p_i) grad_i W_ij) / rho_i from the sweep's -sum_j V_j (p_i + p_j)
+        grad_i W_ij in (ax, ay)."""
+        rho = k[RHO0] + k[NONLIN] * drho[i]
+        twice = (k[ONE] + k[ONE]) * p[i]
+        bx = ax[i] + twice * gx[i]
+        by = ay[i] + twice * gy[i]
+        ax[i] = (lxx[i] * bx + lxy[i] * by) / rho
+        ay[i] = (lxy[i] * bx + lyy[i] * by) / rho
+
     pairs = ModuleType(f"{__name__}.compiled", "The pair functions for one backend (see make_pairs).")
     pairs.__dict__.update(
         gradient=gradient,
@@ -557,5 +602,9 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         coefficients_at=coefficients_at,
         kick_at=kick_at,
         advance_at=advance_at,
+        corrected_velocity_at=corrected_velocity_at,
+        corrected_continuity_at=corrected_continuity_at,
+        pressure_at=pressure_at,
+        corrected_momentum_at=corrected_momentum_at,
     )
     return pairs
