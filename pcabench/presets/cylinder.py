@@ -32,6 +32,21 @@ CYLINDER_ADVISED_SHARE = 0.8  # of the stable CFL on this scene
 # after the step, before, blew up at 3.52 and held at 3.25).
 CYLINDER_LONG_T_END = 200.0
 CYLINDER_LONG_CFLS = (3.52, 4.0, 4.2, 4.4)
+# 7. High-order SPH (issue 56; solvers/corrections/gradient.py): the Laguerre-Gauss kernel at h = 1.5 dx cut at
+# 4 h with the kernel gradient correction and the weak wall (solvers/bodies/weak.py: ghosts with a corrected
+# negative-lobe kernel grow at the body), Verlet at a quarter of its stable CFL (2.04: the fourth-order operator
+# leaves Verlet's phase error the largest; the shortest step is the most accurate): against dx about the
+# workshop's 10 particles a pulse width, its long run with the body (t = 100 s) and the lagrangian model.
+CYLINDER_HIGH_ORDER = {
+    "kernel": "laguerre-gauss",
+    "h_factor": 1.5,
+    "cutoff_factor": 4.0,
+    "correction": "gradient",
+    "boundary_method": "weak",
+}
+CYLINDER_HIGH_ORDER_CFL = 0.5
+CYLINDER_HIGH_ORDER_DX = (0.04, 0.03, 0.0225, 0.02)
+CYLINDER_HIGH_ORDER_LONG_T_END = 100.0
 
 
 def advised_cfl() -> float:
@@ -56,6 +71,12 @@ def _run(dx, method, kernel, h, **more):
     )
 
 
+def high_order(dx, **more):
+    """A run of part 7's method (CYLINDER_HIGH_ORDER) at ``dx``."""
+    method = {**CYLINDER_HIGH_ORDER, "cfl": CYLINDER_HIGH_ORDER_CFL, **more}
+    return _run(dx, method.pop("boundary_method"), method.pop("kernel"), method.pop("h_factor"), **method)
+
+
 def cylinder() -> list:
     """The cylinder study (CYLINDER_*), smallest runs first within each part."""
     runs = [
@@ -77,6 +98,9 @@ def cylinder() -> list:
     runs += [
         _run(CYLINDER_DX[0], "lattice", kernel, h, cfl=cfl, t_end=CYLINDER_LONG_T_END) for cfl in CYLINDER_LONG_CFLS
     ]
+    runs += [high_order(dx) for dx in CYLINDER_HIGH_ORDER_DX]
+    coarse = CYLINDER_HIGH_ORDER_DX[0]
+    runs += [high_order(coarse, t_end=CYLINDER_HIGH_ORDER_LONG_T_END), high_order(coarse, model="lagrangian")]
     return runs
 
 
@@ -87,6 +111,6 @@ CYLINDER_PRESET = Preset(
     flag="cylinder",
     help="sound around an object: the workshop's pulse scattered by a rigid cylinder, each boundary method's "
     "error at the probes A, B, C and near the body against dx and the kernel, lagrangian beside linear, the "
-    "stable CFL with the body ({size})",
+    "stable CFL with the body, the high-order method (corrected Laguerre-Gauss, the weak wall) ({size})",
     order=57,
 )

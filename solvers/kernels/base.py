@@ -29,6 +29,7 @@ class Kernel(abc.ABC):
     summary: str = ""  # one line for --help
     support: float | None = None  # compact support / h; None: truncated at the scene's cutoff_factor
     norm: float = 0.0  # 2D normalisation sigma: W = sigma / h^2 f(r/h), dimensionless
+    negative_lobe: bool = False  # W < 0 somewhere (a higher-order kernel): the tensile instability's source
 
     @abc.abstractmethod
     def value(self, r, h: float):

@@ -25,6 +25,7 @@ class LaguerreGauss(Kernel):
     summary = "fourth-order Laguerre-Gauss (2 - q^2) exp(-q^2), truncated at --cutoff (in h; 4 for fourth order)"
     support = None
     norm = 2.0 / math.pi  # W = norm / h^2 (1 - q^2 / 2) exp(-q^2)
+    negative_lobe = True  # beyond q = sqrt(2)
 
     def value(self, r, h: float):
         q2 = (np.asarray(r, dtype=np.float64) / h) ** 2
