@@ -73,12 +73,22 @@ class Method:
     def label(self) -> str:
         """``kernel, h 2.13dx, 3h, CFL 0.2``: the truncation written only for a kernel that has one, the integrator
         and the correction only where they are not the default's (``, rk4, gradient-corrected``)."""
+        return self._words(with_step=True)
+
+    @property
+    def numerics(self) -> str:
+        """The label without the CFL (``laguerre-gauss, h 1.5dx, 4h, rk4, gradient-corrected``): a method whose
+        step is shown apart."""
+        return self._words(with_step=False)
+
+    def _words(self, with_step: bool) -> str:
         from solvers.scene import Scene
 
         cut = f", {self.cutoff_factor:g}h" if self.cutoff_factor is not None else ""
+        cfl = f", CFL {self.cfl:g}" if with_step else ""
         step = f", {self.integrator}" if self.integrator != Scene.default("integrator") else ""
         corrected = f", {self.correction}-corrected" if self.correction != Scene.default("correction") else ""
-        return f"{self.kernel}, h {self.h_factor:g}dx{cut}, CFL {self.cfl:g}{step}{corrected}"
+        return f"{self.kernel}, h {self.h_factor:g}dx{cut}{cfl}{step}{corrected}"
 
     def stable_cfl(self) -> float:
         """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion

@@ -15,6 +15,7 @@ that would.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import shlex
 import sys
@@ -83,6 +84,7 @@ def scene_of(r) -> dict:
         "cutoff_factor": r["cutoff_factor"],
         "cfl": r["cfl"],
         "integrator": r["integrator"],
+        "correction": r.get("correction") or Scene.default("correction"),
         "dx": r["dx"],
         "strip_height": r["strip_height"],
     }
@@ -235,19 +237,22 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
         corrected = method.get("correction", "none") != "none"
         wall = {"boundary_method": "weak"} if kind.body and corrected else {}
         if kind.body:
-            label = Method.of(method).label
+            label = Method.of(method).numerics
             print(f"advise: predicting {scene}'s probes with {label} ...", file=sys.stderr, flush=True)
         for share in method_shares:
-            for dx in sorted(method_dxs, reverse=True):  # coarse to fine: the first that reaches is the cheapest
-                try:
-                    base = Scene(dx=dx, name=scene, t_end=t_end, model="linear", **method, **wall)
-                except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
+            tried: dict = {}
+            trial_at = functools.partial(_trial, kind, scene, t_end, {**method, **wall}, share, tried)
+            order = sorted(method_dxs, reverse=True)  # coarse to fine: the first that reaches is the cheapest
+            finest = next((found for found in map(trial_at, order[::-1]) if found is not None), None)
+            if finest is None or finest[1].predicted_error > asked:  # not even at the finest dx: none coarser
+                if finest is not None and (closest is None or finest[1].predicted_error < closest[1].predicted_error):
+                    closest = finest
+                continue
+            for dx in order:
+                found = trial_at(dx)
+                if found is None:
                     continue
-                limit = scene_limit(base)  # predicted, or lower where long runs of the scene measured it
-                if not limit > 0:
-                    break
-                trial = base.replace(cfl=round(share * limit, 2))
-                p = kind.predict_headline(trial)
+                trial, p = found
                 if closest is None or p.predicted_error < closest[1].predicted_error:
                     closest = (trial, p)
                 if p.predicted_error > asked:
@@ -301,6 +306,24 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
             ),
         )
     return out
+
+
+def _trial(kind, scene: str, t_end: float, method: dict, share: float, tried: dict, dx: float):
+    """(scene, prediction) of ``method`` at ``dx`` and ``share`` of its stable CFL, kept in ``tried``; None where
+    Scene refuses the combination or the method grows at any step."""
+    if dx not in tried:
+        try:
+            base = Scene(dx=dx, name=scene, t_end=t_end, model="linear", **method)
+        except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
+            tried[dx] = None
+            return None
+        limit = scene_limit(base)  # predicted, or lower where long runs of the scene measured it
+        if not limit > 0:
+            tried[dx] = None
+            return None
+        trial = base.replace(cfl=round(share * limit, 2))
+        tried[dx] = (trial, kind.predict_headline(trial))
+    return tried[dx]
 
 
 def method_fields(scene: Scene) -> dict:
@@ -377,8 +400,8 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
         )
         return "\n".join(lines), False
     lines.append(
-        f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {out['kernel']}, "
-        f"h = {out['h_factor']:g} dx, CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
+        f"{head}:\n  fastest: {out['seconds']:.3g} s (error {out['error']:.3g}; {Method.of(out).numerics}, "
+        f"CFL {out['cfl']:g} = {out['cfl_fraction']:.2f} of the "
         + (
             f"stable {out['stable_cfl']:.3g} measured over long runs"
             if out["limit_from"] == "long runs"

@@ -123,7 +123,7 @@ def add_parameter_options(p: argparse.ArgumentParser, parameters, many: bool = F
 def preset_given(args, flag: str) -> bool:
     """Whether ``--<flag>`` names a preset on this command line: a preset's switch or choice, or a matrix option
     of the same word given alone (``--open`` with no values: ``[]``)."""
-    value = getattr(args, flag, None)
+    value = getattr(args, flag.replace("-", "_"), None)  # argparse's destination of --high-order: high_order
     return value == [] if isinstance(value, list) else bool(value)
 
 

@@ -132,7 +132,7 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
             + ", ".join(f"--{flag}" for flag in flags())
             + ") takes none of them"
         )
-    value = getattr(args, given[0]) if given else None
+    value = getattr(args, given[0].replace("-", "_")) if given else None
     name = named_by(given[0], True if value == [] else value) if given else DEFAULT_PRESET
     scened = [p.option for p in PRESETS.all().values() if p.scened]
     if scene != [DEFAULT_SCENE] and (len(scene) > 1 or not PRESETS.get(name).scened):

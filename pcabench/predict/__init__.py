@@ -24,6 +24,7 @@ import numpy as np
 
 from pcabench.store.record import step_seconds
 from solvers import solver_class
+from solvers.physics.integrators import sweeps_per_step
 
 START_UP = 2.0  # s: a child process's start, imports, scoring and hand-back, JIT aside (1.9 s measured here)
 COLD_JIT = 6.0  # s: compiling a configuration's loops, where no stored run says (5-12 s measured here)
@@ -69,10 +70,12 @@ def _same_config(row: dict, spec) -> bool:
 
 
 def _reach(solver: str, scene: dict) -> float:
-    """(cutoff / dx)^2 of a scene dict, which the neighbours per particle scale with (1 for all-pair)."""
+    """The work of a particle's step, relative: (cutoff / dx)^2, which the neighbours per particle scale with (1 for
+    all-pair), times the integrator's sweeps over Verlet's (RK4: 4)."""
+    sweeps = sweeps_per_step(scene.get("integrator") or "verlet") / sweeps_per_step("verlet")
     if "all-pairs" in solver_class(solver).pair_loops or not scene.get("cutoff") or not scene.get("dx"):
-        return 1.0
-    return (scene["cutoff"] / scene["dx"]) ** 2
+        return sweeps
+    return sweeps * (scene["cutoff"] / scene["dx"]) ** 2
 
 
 def step_model(spec, rows: list[dict]):

@@ -49,7 +49,7 @@ def cost_round(preset_name: str) -> int | None:
 
 
 def walls() -> list[RunSpec]:
-    """Accuracy, stability and cost at a rigid wall (WALL_*): 64 runs, 34 min on one busy core of the reference
+    """Accuracy, stability and cost at a rigid wall (WALL_*): 68 runs, 34 min on one busy core of the reference
     machine (about 30 s of each run is its JIT compilation)."""
     from solvers.reference.dispersion import stable_cfl
 

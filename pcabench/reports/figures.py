@@ -608,8 +608,8 @@ TAB10 = (
 
 
 def kernel_colour(kernel: str) -> str:
-    """A kernel's colour by its place in the registry (the Gaussian blue, Wendland C2 orange, C4 green); grey
-    for a stored kernel not registered here."""
+    """A kernel's colour by its place in the registry (the Gaussian, the paper's, blue; the others in the
+    registry's order); grey for a stored kernel not registered here."""
     names = kernel_names()
     return TAB10[names.index(kernel) % len(TAB10)] if kernel in names else "grey"
 

@@ -23,10 +23,13 @@ from pcabench.reports.md import fmt, md_table
 from pcabench.reports.sections.base import Section, stored_measure
 from pcabench.reports.tables import latest
 from pcabench.spec import scene_from_row
+from solvers.method import Method
 from solvers.reference.dispersion import stable_cfl
 
 TARGET = 0.02  # the issue's: 2 % relative RMS at the probes
 TARGET_DX = 0.02  # at no more than 10 particles a pulse width
+WALL_STYLE = {"lattice": "-", "rings": "--", "weak": "-."}  # a boundary method's line and marker in the figures
+WALL_MARKER = {"lattice": "o", "rings": "s", "weak": "^"}
 # the prediction's dx (the wall exact, the bulk's dispersion alone: solvers/reference/dispersive_cylinder.py), to
 # four times finer than the finest run: where each method would go, and where it floors
 PREDICTED_DX = (0.04, 0.02, 0.01, 0.005, 0.0025)
@@ -54,6 +57,7 @@ def rows(df) -> dict | None:
                 "method": scene.boundary_method_used,
                 "kernel": scene.kernel,
                 "h": float(scene.h_factor),
+                "label": Method.of(scene).numerics,
                 "model": scene.model,
                 "cfl": float(scene.cfl),
                 "t_end": float(scene.t_final),
@@ -76,7 +80,7 @@ def rows(df) -> dict | None:
 
 
 def _key(r) -> tuple:
-    return (r["model"], r["kernel"], r["h"], r["method"], r["cfl"])
+    return (r["model"], r["label"], r["method"], r["cfl"])
 
 
 def orders(runs) -> list[dict]:
@@ -102,7 +106,7 @@ def _step(r) -> str:
 
 
 def _method(r) -> str:
-    return f"{r['kernel']}, h = {r['h']:g} dx"
+    return r["label"]
 
 
 def text(data, ctx) -> list[str]:
@@ -134,7 +138,9 @@ def text(data, ctx) -> list[str]:
         "scattered by a rigid cylinder of radius 0.5 m at the origin, in the open square [-6, 6]^2 m, scored "
         "against the series solution. The wall is a boundary method: ghost particles inside the body with the "
         "fluid's values at their mirror points (`lattice`: the lattice's own sites, a staircase; `rings`: rings "
-        "fitted to the surface). Probes: the relative RMS of p at the workshop's points A (r = 5 m, 90 deg), B "
+        "fitted to the surface) or none (`weak`: the body's sites carry no volume and the kernel gradient "
+        "correction's energy-keeping operators make the wall, u . n = 0 weakly; the high-order method's, "
+        "solvers/bodies/weak.py). Probes: the relative RMS of p at the workshop's points A (r = 5 m, 90 deg), B "
         "(135 deg), C (180 deg) over 6 <= t <= 10 s, together and each; near the body (within 3 cutoffs of its "
         "surface) and away from it: the field's error at t = 10 s. Predicted: the probes' error the bulk's "
         "dispersion alone gives, the series solution with each wavenumber evolved by the method's own (its "
@@ -183,9 +189,9 @@ def text(data, ctx) -> list[str]:
             )
         )
         for key, pts in predicted_curves(ok).items():
-            kernel, h, cfl = key
+            label, cfl = key
             reach = [dx for dx, e in pts if e <= TARGET]
-            scene = next(r["scene_value"] for r in ok if (r["kernel"], r["h"], r["cfl"]) == key)
+            scene = next(r["scene_value"] for r in ok if (r["label"], r["cfl"]) == key)
             limit = scene_limit(scene.replace(model="linear"))
             past = (
                 f" (at or past CFL {limit:g}, where long runs of this scene blew up: bounded only to t = 10 s)"
@@ -193,7 +199,7 @@ def text(data, ctx) -> list[str]:
                 else ""
             )
             lines.append(
-                f"- **Predicted, {kernel}, h = {h:g} dx, CFL {cfl:g}**{past} (the wall exact): "
+                f"- **Predicted, {label}, CFL {cfl:g}**{past} (the wall exact): "
                 + ", ".join(f"{e:.3g} at dx {dx:g}" for dx, e in pts)
                 + (
                     f"; 2 % from dx {max(reach):g} m ({scene.pulse_width / max(reach):g} particles a pulse width)."
@@ -203,9 +209,9 @@ def text(data, ctx) -> list[str]:
                 )
             )
         for o in data["orders"]:
-            model, kernel, h, method, cfl = o["key"]
+            model, label, method, cfl = o["key"]
             lines.append(
-                f"- **{kernel}, h = {h:g} dx, CFL {cfl:g}, {method}, {model}**: converges from dx {o['dx'][0]:g} to "
+                f"- **{label}, CFL {cfl:g}, {method}, {model}**: converges from dx {o['dx'][0]:g} to "
                 f"{o['dx'][1]:g} "
                 f"at order {fmt(o['probes'], '.2g')} at the probes and {fmt(o['near'], '.2g')} near the body."
             )
@@ -243,11 +249,11 @@ def text(data, ctx) -> list[str]:
 
 
 def predicted_curves(runs) -> dict:
-    """{(kernel, h, CFL): [(dx, predicted probes' error)]} on PREDICTED_DX for each linear method of ``runs``
+    """{(method label, CFL): [(dx, predicted probes' error)]} on PREDICTED_DX for each linear method of ``runs``
     run at two dx or more (the stability scan's single runs are not a method's curve)."""
     out = {}
-    for key in sorted({(r["kernel"], r["h"], r["cfl"]) for r in runs}):
-        mine = [r for r in runs if (r["kernel"], r["h"], r["cfl"]) == key]
+    for key in sorted({(r["label"], r["cfl"]) for r in runs}):
+        mine = [r for r in runs if (r["label"], r["cfl"]) == key]
         if len({r["dx"] for r in mine}) < 2:
             continue
         out[key] = [(dx, predicted(mine[0]["scene_value"].replace(dx=dx))) for dx in PREDICTED_DX]
@@ -274,7 +280,7 @@ def probes_figure(data, ctx):
     held = [r for r in ok if r["cfl"] < scene_limit(r["scene_value"].replace(model="linear"))]
     ok = held or ok  # a run past the limit long runs measured is bounded only because it is short: not shown first
     best = min(ok, key=lambda r: (-1 if r["dx"] == min(x["dx"] for x in ok) else 0, r["probes"]))
-    same = ("dx", "kernel", "h", "cfl")
+    same = ("dx", "label", "cfl")
     shown = [r for r in ok if all(r[k] == best[k] for k in same)]
     path = ctx.out / "cylinder_probes.png"
     t, exact = _exact(best["scene_value"], best["series"])
@@ -290,7 +296,7 @@ def probes_figure(data, ctx):
         ncols=3,
         size=(15.5, 4.4),
     ) as axes:
-        colours = {"lattice": "tab:blue", "rings": "tab:orange"}
+        colours = {"lattice": "tab:blue", "rings": "tab:orange", "weak": "tab:green"}
         for ax, name in zip(axes, "ABC"):
             ax.plot(t[window], c2 * exact[name][window], color="black", lw=2.0, label="exact")
             for r in shown:
@@ -301,7 +307,7 @@ def probes_figure(data, ctx):
                     c2 * np.asarray(r["series"][name])[w],
                     color=colours.get(r["method"], "tab:green"),
                     lw=1.2,
-                    ls="--" if r["method"] == "rings" else "-",
+                    ls=WALL_STYLE.get(r["method"], "-"),
                     label=f"{r['method']} (probes {r['probes']:.2g})",
                 )
             ax.set_title(f"{name} ({ {'A': '90', 'B': '135', 'C': '180'}[name] } deg, r = 5 m)", fontsize=9)
@@ -315,7 +321,7 @@ def error_figure(data, ctx):
     ok = [r for r in data["runs"] if r["status"] == "ok" and r["model"] == "linear" and r["probes"] is not None]
     ok = [r for r in ok if np.isclose(r["t_end"], CYLINDER_T_END)]  # the long runs measure the limit, not the error
     curves = predicted_curves(ok)
-    ok = [r for r in ok if (r["kernel"], r["h"], r["cfl"]) in curves]  # methods run at two dx or more
+    ok = [r for r in ok if (r["label"], r["cfl"]) in curves]  # methods run at two dx or more
     if not ok:
         return None
     path = ctx.out / "cylinder_error.png"
@@ -323,14 +329,15 @@ def error_figure(data, ctx):
     colours = F.palette(len(kernels))
     past_limit = {
         key: " (past the long runs' limit)"
-        if key[2] >= scene_limit(next(r for r in ok if (r["kernel"], r["h"], r["cfl"]) == key)["scene_value"])
+        if key[1] >= scene_limit(next(r for r in ok if (r["label"], r["cfl"]) == key)["scene_value"])
         else ""
         for key in kernels
     }
     with F.figure(
         path,
-        f"Sound around a cylinder: error against dx, linear ({ctx.name}); colour: method; solid: lattice ghosts, "
-        "dashed: rings, dotted: predicted (the wall exact); grey: the 2 % target",
+        f"Sound around a cylinder: error against dx, linear ({ctx.name}); colour: method; solid, circles: lattice "
+        "ghosts; dashed, squares: rings; dash-dot, triangles: the weak wall; dotted, crosses: predicted (the wall "
+        "exact); grey: the 2 % target",
         "dx (m)",
         "relative RMS",
         ncols=2,
@@ -346,28 +353,29 @@ def error_figure(data, ctx):
             )
         ):
             ax = axes[i]
-            for (kernel, h, cfl), colour in zip(kernels, colours):
-                for method in ("lattice", "rings"):
+            for (label, cfl), colour in zip(kernels, colours):
+                for method in ("lattice", "rings", "weak"):
                     pts = sorted(
                         (r["dx"], r[what])
                         for r in ok
-                        if (r["kernel"], r["h"], r["cfl"], r["method"]) == (kernel, h, cfl, method) and r[what]
+                        if (r["label"], r["cfl"], r["method"]) == (label, cfl, method) and r[what]
                     )
                     if pts:
                         values[i] += [v for _, v in pts]
                         ax.plot(
                             *zip(*pts),
                             color=colour,
-                            ls="-" if method == "lattice" else "--",
-                            marker="o",
+                            ls=WALL_STYLE[method],
+                            marker=WALL_MARKER[method],
                             ms=4,
-                            label=f"{kernel}, h = {h:g} dx, CFL {cfl:g}, {method}" + past_limit[kernel, h, cfl],
+                            label=f"{label}, CFL {cfl:g}, {method}" + past_limit[label, cfl],
                         )
                 if i == 0:
-                    pts = curves[kernel, h, cfl]
+                    pts = curves[label, cfl]
                     values[i] += [v for _, v in pts]
                     ax.plot(*zip(*pts), color=colour, ls=":", lw=1.5, marker="x", ms=4)
             if i == 0:
+                ax.plot([], [], color="0.3", ls=":", marker="x", ms=4, label="dotted: predicted (the wall exact)")
                 ax.axhline(TARGET, color="0.6", lw=1.0, label="target: 2 %")
             F.nice_log_ticks(ax, values[i])
             ticks = sorted(set(PREDICTED_DX) if i == 0 else {r["dx"] for r in ok})
