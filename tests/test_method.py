@@ -75,16 +75,23 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
     from pcabench.reports import tables as T
 
     df = frame.load(paths.reference_results())
-    data = {(s, m, k, h, i): v for (s, m, k, h, _c, i), v in measured_limits().items()}
+    data = {(s, m, k, h, i, corr): v for (s, m, k, h, _c, i, corr), v in measured_limits().items()}
     checked = 0
     from pcabench.presets.cylinder import CYLINDER_ADVISED
 
     paper = ("gaussian", 2.13)
-    for preset, methods in (("stability-long", {paper}), ("walls", {paper}), ("cylinder", {CYLINDER_ADVISED})):
+    high_order = ("laguerre-gauss", 1.5)
+    presets = (
+        ("stability-long", {paper}),
+        ("walls", {paper}),
+        ("cylinder", {CYLINDER_ADVISED}),
+        ("high-order", {high_order}),
+    )
+    for preset, methods in presets:
         for r in T.long_run_limits(df, preset):
             if (r["kernel"], r["h_factor"]) not in methods or r["blew_up_from"] is None:
                 continue
-            key = (r["scene"], r["model"], r["kernel"], r["h_factor"], "verlet")
+            key = (r["scene"], r["model"], r["kernel"], r["h_factor"], r["integrator"], r["correction"])
             if r["blew_up_from"] < r["predicted"]:
                 assert data.get(key) == (r["blew_up_from"], r["bounded_to"]), (key, r)
                 checked += 1

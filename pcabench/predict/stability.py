@@ -29,15 +29,23 @@ MEASURED_LIMITS_FILE = Path(__file__).with_name("measured_limits.csv")  # data, 
 
 @lru_cache(maxsize=1)
 def measured_limits() -> dict[tuple, tuple[float, float]]:
-    """(scene, model, kernel, h/dx, cutoff/h, integrator) -> (the smallest CFL that blew up, the largest that
-    stayed bounded below it), where long runs measured a limit below the prediction (:data:`MEASURED_LIMITS_FILE`,
-    each row with its date, machine and command)."""
+    """(scene, model, kernel, h/dx, cutoff/h, integrator, correction) -> (the smallest CFL that blew up, the largest
+    that stayed bounded below it), where long runs measured a limit below the prediction
+    (:data:`MEASURED_LIMITS_FILE`, each row with its date, machine and command)."""
     import csv
 
     with MEASURED_LIMITS_FILE.open(newline="", encoding="utf-8") as f:
         rows = csv.DictReader(line for line in f if not line.startswith("#"))
         return {
-            (r["scene"], r["model"], r["kernel"], float(r["h_factor"]), float(r["cutoff_factor"]), r["integrator"]): (
+            (
+                r["scene"],
+                r["model"],
+                r["kernel"],
+                float(r["h_factor"]),
+                float(r["cutoff_factor"]),
+                r["integrator"],
+                r.get("correction") or "none",
+            ): (
                 float(r["blew_up_from"]),
                 float(r["bounded_to"]),
             )
@@ -87,11 +95,13 @@ def measured_limit(r) -> float | None:
     from solvers.kernels import truncated
 
     kernel, h, cut, integrator, correction = method_of(r)
-    if correction != "none":  # the file's long runs are of standard SPH
-        return None
-    mine = (str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", ""), kernel, integrator)
-    for (scene, model, k, hh, cc, integ), (limit, _bounded) in measured_limits().items():
-        if (scene, model, k, integ) == mine and math.isclose(h, hh) and (not truncated(k) or math.isclose(cut, cc)):
+    mine = (str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", ""), kernel, integrator, correction)
+    for (scene, model, k, hh, cc, integ, corr), (limit, _bounded) in measured_limits().items():
+        if (
+            (scene, model, k, integ, corr) == mine
+            and math.isclose(h, hh)
+            and (not truncated(k) or math.isclose(cut, cc))
+        ):
             return limit
     return None
 

@@ -818,6 +818,7 @@ def long_run_limits(df, preset: str = "stability-long") -> list[dict]:
         "h_factor",
         "cutoff_factor",
         "integrator",
+        "correction",
         "precision",
         "dx",
         "protocol",

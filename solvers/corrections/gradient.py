@@ -46,16 +46,16 @@ class GradientCorrection(Correction):
 
     name = "gradient"
     summary = "kernel gradient correction (Bonet & Lok): exact for linear fields, energy-keeping form"
-    arrays = 9  # M's inverse (3), Gamma (2), w (2), p and a scratch array
+    arrays = 7  # M's inverse (3), Gamma (2), w (2)
 
     def coefficients(self, continuity: bool, momentum: bool) -> tuple:
-        """Both sweeps need the volumes; momentum takes p = c0^2 drho, made here."""
+        """Both sweeps need the volumes (momentum sums drho itself, c0^2 after)."""
         return True, False
 
     def sweep(self, solver, continuity: bool, momentum: bool) -> None:
         a, k = solver.arrays, solver.k
         lxx, lxy, lyy, gx, gy = self.factors(solver)
-        wx, wy, p = self.scratch(solver)
+        wx, wy = self.scratch(solver)
         if continuity:
             solver.launch("corrected_velocity", a["u"], a["v"], lxx, lxy, lyy, wx, wy)
             with solver.swapped(u=wx, v=wy):
@@ -64,19 +64,18 @@ class GradientCorrection(Correction):
                     solver.continuity_x()
             ddx = a["ddx"] if solver.split else a["dd"]  # the x part: w's x terms (in the interior, L u_x's)
             solver.launch("corrected_continuity", a["dd"], ddx, a["drho"], wx, wy, gx, gy, solver.split, k)
-        if momentum:
-            solver.launch("pressure", a["drho"], p, k)
-            with solver.swapped(mass=a["vol"], pr=p):
+        if momentum:  # the sweep sums drho; c0^2 (p = c0^2 drho) comes in the pass after
+            with solver.swapped(mass=a["vol"], pr=a["drho"]):
                 solver._sweep(False, True)
-            solver.launch("corrected_momentum", a["ax"], a["ay"], a["drho"], p, lxx, lxy, lyy, gx, gy, k)
+            solver.launch("corrected_momentum", a["ax"], a["ay"], a["drho"], lxx, lxy, lyy, gx, gy, k)
 
     def scratch(self, solver) -> tuple:
-        """(w_x, w_y, p): the fields the corrected sweeps sum, made anew from the state at every PI (so never
+        """(w_x, w_y): what the corrected continuity sweep sums, made anew from the state at every PI (so never
         reordered), kept from one PI to the next."""
         kept = getattr(solver, "correction_scratch", None)
         n = solver.scene.n_particles
         if kept is None or kept[0].shape[0] != n or kept[0].dtype != solver.dtype:
-            kept = tuple(solver.xp.zeros(n, solver.dtype) for _ in range(3))
+            kept = tuple(solver.xp.zeros(n, solver.dtype) for _ in range(2))
             solver.correction_scratch = kept
         return kept
 

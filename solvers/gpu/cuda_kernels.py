@@ -42,7 +42,6 @@ KERNELS = (
     "advance",
     "corrected_velocity",
     "corrected_continuity",
-    "pressure",
     "corrected_momentum",
 )
 

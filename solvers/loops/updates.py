@@ -47,11 +47,6 @@ def corrected_continuity(dd, ddx, drho, wx, wy, gx, gy, split, k):
         P.corrected_continuity_at(i, dd, ddx, drho, wx, wy, gx, gy, split, k)
 
 
-def pressure(drho, p, k):
-    for i in prange(drho.shape[0]):
-        P.pressure_at(i, drho, p, k)
-
-
-def corrected_momentum(ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k):
+def corrected_momentum(ax, ay, drho, lxx, lxy, lyy, gx, gy, k):
     for i in prange(ax.shape[0]):
-        P.corrected_momentum_at(i, ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k)
+        P.corrected_momentum_at(i, ax, ay, drho, lxx, lxy, lyy, gx, gy, k)

@@ -75,7 +75,6 @@ COMPILED = {
         "gather",
         "corrected_velocity",
         "corrected_continuity",
-        "pressure",
         "corrected_momentum",
     ),
     "sorting": ("counting_sort", "sort_cells_by_x"),

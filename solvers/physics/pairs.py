@@ -553,18 +553,13 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
             ddx[i] -= rho2 * wx[i] * gx[i]
 
     @jit
-    def pressure_at(i, drho, p, k):
-        """p_i = c0^2 drho_i, Pa: what the corrected momentum sweep sums."""
-        p[i] = k[C0SQ] * drho[i]
-
-    @jit
-    def corrected_momentum_at(i, ax, ay, drho, p, lxx, lxy, lyy, gx, gy, k):
-        """du_i/dt = -L_i (sum_j V_j (p_j - p_i) grad_i W_ij) / rho_i from the sweep's -sum_j V_j (p_i + p_j)
-        grad_i W_ij in (ax, ay)."""
+    def corrected_momentum_at(i, ax, ay, drho, lxx, lxy, lyy, gx, gy, k):
+        """du_i/dt = -L_i (sum_j V_j (p_j - p_i) grad_i W_ij) / rho_i, p = c0^2 drho, from the sweep's
+        -sum_j V_j (drho_i + drho_j) grad_i W_ij in (ax, ay)."""
         rho = k[RHO0] + k[NONLIN] * drho[i]
-        twice = (k[ONE] + k[ONE]) * p[i]
-        bx = ax[i] + twice * gx[i]
-        by = ay[i] + twice * gy[i]
+        twice = (k[ONE] + k[ONE]) * drho[i]
+        bx = k[C0SQ] * (ax[i] + twice * gx[i])
+        by = k[C0SQ] * (ay[i] + twice * gy[i])
         ax[i] = (lxx[i] * bx + lxy[i] * by) / rho
         ay[i] = (lxy[i] * bx + lyy[i] * by) / rho
 
@@ -604,7 +599,6 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         advance_at=advance_at,
         corrected_velocity_at=corrected_velocity_at,
         corrected_continuity_at=corrected_continuity_at,
-        pressure_at=pressure_at,
         corrected_momentum_at=corrected_momentum_at,
     )
     return pairs
