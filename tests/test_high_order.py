@@ -253,3 +253,29 @@ def test_the_gpu_kernels_run_the_correction_and_rk4_in_the_simulator(model):
     assert cpu["status"] == "ok" and gpu["status"] == "ok", (cpu["message"], gpu["message"])
     for name in ("u", "v", "drho", "x"):
         assert np.allclose(gpu["fields"][name], cpu["fields"][name], rtol=0, atol=1e-12), name
+
+
+def test_the_weak_wall_keeps_the_energy_where_ghosts_do_not():
+    """A body without ghosts (the body's sites carry no volume): the corrected operators stay each other's negative
+    adjoint over the fluid, so the energy's rate is zero for any fields; ghosts filled from the fluid break it
+    (and grow: docs/accuracy.md)."""
+    from pcabench.conformance import SCENES
+
+    rates = {}
+    for method in ("weak", "lattice"):
+        scene = Scene(**{**SCENES["cylinder"], "model": "linear", "steps": 1, "boundary_method": method, **HIGH})
+        s = prepared(scene)
+        a = s.arrays
+        rng = np.random.default_rng(3)
+        fluid = a["role"] == 0
+        for name in ("u", "v", "drho"):
+            a[name][:] = np.where(fluid, rng.standard_normal(a[name].shape), 0.0)
+        s.rates(True, True)
+        vol = np.where(fluid, scene.dx**2, 0.0)
+        kinetic = vol * scene.rho0 * (a["u"] * a["ax"] + a["v"] * a["ay"])
+        potential = vol * scene.c0**2 * a["drho"] * a["dd"] / scene.rho0
+        rates[method] = abs(kinetic.sum() + potential.sum()) / np.abs(kinetic).sum()
+    assert rates["weak"] < 1e-11
+    assert rates["lattice"] > 1e-4
+    with pytest.raises(SceneError, match="--boundary-method weak makes a wall only with a kernel correction"):
+        Scene(**{**SCENES["cylinder"], "boundary_method": "weak"})

@@ -447,8 +447,8 @@ def accuracy_bars(series) -> list[dict]:
 
 # ---------------------------------------------------------------- speed against accuracy
 def numerics_label(r) -> str:
-    """The method of a run (:attr:`solvers.method.Method.label`): kernel, h/dx, cutoff (a truncated kernel's only:
-    the Gaussian's) and CFL."""
+    """The method of a run (:attr:`solvers.method.Method.label`): kernel, h/dx, cutoff (a truncated kernel's only),
+    CFL, and the integrator and correction where not the defaults."""
     return Method.of(r).label
 
 
@@ -510,6 +510,7 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
                 "h_factor": r.h_factor,
                 "cfl": r.cfl,
                 "integrator": r.integrator,
+                "correction": r.get("correction") or "none",
                 "cutoff_factor": r.cutoff_factor,
                 "precision": r.precision,
                 "model": r.model,

@@ -17,6 +17,7 @@ from pcabench.reports.sections.base import Section
 from pcabench.reports.tables import latest
 from pcabench.spec import scene_from_row
 from solvers.method import Method
+from solvers.reference.dispersion import stable_cfl
 
 TARGET = 1e-4  # the issue's plane-pulse target at dx 0.1 for the high-order method (RK4, CFL 1)
 SCENES = {"plane-pulse": "the plane pulse (5 m strip)", "acoustic-pulse": "the 2D pulse (40 m square)"}
@@ -36,6 +37,7 @@ def rows(df) -> dict | None:
                 "dx": float(scene.dx),
                 "label": method.numerics,
                 "kernel": scene.kernel,
+                "h": float(scene.h_factor),
                 "corrected": scene.correction != "none",
                 "cfl": float(scene.cfl),
                 "model": scene.model,
@@ -45,7 +47,8 @@ def rows(df) -> dict | None:
                 "error": float(r.mse) if r.status == "ok" and np.isfinite(r.mse) else None,
                 "seconds": float(r.t_solution) if r.status == "ok" else None,
                 "N": int(r.n_particles),
-                "limit": scene_limit(scene.replace(model="linear")),
+                "limit": scene_limit(scene),
+                "predicted": stable_cfl(scene),
             }
         )
     return {"runs": runs}
@@ -107,7 +110,7 @@ def text(data, ctx) -> list[str]:
                 + [fmt(rs[-1]["seconds"], ".3g")]
             )
         header = ["method", "CFL", *(f"dx {dx:g}" for dx in dxs), "orders", "s (finest)"]
-        lines += [f"{title.capitalize()}:", "", md_table(header, table), ""]
+        lines += [f"{title[0].upper()}{title[1:]}:", "", md_table(header, table), ""]
     plane = methods(runs, "plane-pulse")
     target = [rs for (label, cfl), rs in plane.items() if label.startswith("laguerre-gauss") and "rk4" in label]
     for rs in target:
@@ -140,18 +143,20 @@ def text(data, ctx) -> list[str]:
         mine = sorted((r for r in long if (r["label"], r["model"]) == key), key=lambda r: r["cfl"])
         lines.append(
             f"- **Long runs, {key[0]}, {key[1]}, dx {mine[0]['dx']:g}, to t = {mine[0]['t_end']:g} s** (Mach 0.01): "
-            + ", ".join(
-                f"CFL {r['cfl']:g} "
-                + ("bounded" if r["status"] == "ok" else f"{r['status']} at step {r['failed_step']}")
-                for r in mine
-            )
-            + f"; the predicted stable CFL is {mine[0]['limit']:.3g}."
+            + ", ".join(f"CFL {r['cfl']:g} {_ended(r)}" for r in mine)
+            + f"; the periodic lattice predicts {mine[0]['predicted']:.3g}, advise keeps below {mine[0]['limit']:.3g}."
         )
     return lines + [""]
 
 
 def _ended(r) -> str:
     return "bounded" if r["status"] == "ok" else f"{r['status']} at step {int(r['failed_step'])}"
+
+
+def kernel_colours(runs) -> dict:
+    """{(kernel, h / dx): colour}: one colour per kernel and h, shared by its corrected and standard runs."""
+    keys = sorted({(r["kernel"], r["h"]) for r in runs})
+    return dict(zip(keys, F.palette(len(keys))))
 
 
 def _style(label: str) -> dict:
@@ -167,9 +172,10 @@ def orders_figure(data, ctx):
     if not panels:
         return None
     path = ctx.out / "high_order_orders.png"
+    colours = kernel_colours(data["runs"])
     with F.figure(
         path,
-        f"High-order SPH: error against dx at fixed h / dx, linear, t = 10 s ({ctx.name}); colour: kernel; "
+        f"High-order SPH: error against dx at fixed h / dx, linear, t = 10 s ({ctx.name}); colour: kernel and h; "
         "solid: gradient-corrected, dashed: standard; triangles: RK4, circles: Verlet",
         "dx (m)",
         "relative RMS",
@@ -187,7 +193,7 @@ def orders_figure(data, ctx):
                 values += [e for _, e in pts]
                 ax.plot(
                     *zip(*pts),
-                    color=F.kernel_colour(rs[0]["kernel"]),
+                    color=colours[rs[0]["kernel"], rs[0]["h"]],
                     ms=5,
                     label=f"{label}, CFL {cfl:g}",
                     **_style(label),
@@ -210,10 +216,11 @@ def work_precision_figure(data, ctx):
     if not panels:
         return None
     path = ctx.out / "high_order_work_precision.png"
+    colours = kernel_colours(data["runs"])
     with F.figure(
         path,
         f"High-order SPH: error against time to solution, linear, t = 10 s, serial ({ctx.name}); a line joins one "
-        "method's runs at dx 0.4 .. 0.1 (plane) or 0.5, 0.25 (2D); colour: kernel; solid: corrected, dashed: "
+        "method's runs at dx 0.4 .. 0.1 (plane) or 0.5, 0.25 (2D); colour: kernel and h; solid: corrected, dashed: "
         "standard; triangles: RK4",
         "time to solution (s, init + steps)",
         "relative RMS",
@@ -232,13 +239,13 @@ def work_precision_figure(data, ctx):
                 times += [t for t, _ in pts]
                 ax.plot(
                     *zip(*pts),
-                    color=F.kernel_colour(rs[0]["kernel"]),
+                    color=colours[rs[0]["kernel"], rs[0]["h"]],
                     ms=5,
                     label=f"{label}, CFL {cfl:g}",
                     **_style(label),
                 )
             F.nice_log_ticks(ax, values)
-            F.plain_log_ticks(ax, times)
+            F.nice_log_ticks(ax, times, axis="x")
             ax.set_title(SCENES[scene], fontsize=9)
     return path
 
