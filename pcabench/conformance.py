@@ -14,7 +14,7 @@ guarantees: agreement with the all-pair reference to round-off for every
 configuration the class claims, neighbour counting without side effects,
 ``memory_bytes`` as an upper bound, threaded runs equal to serial ones, timed
 stages and a blow-up reported as unstable with its step, and the class's
-claims (precisions, models, integrators, kernels, boundaries) true both ways.
+claims (precisions, models, integrators, kernels, corrections, boundaries) true both ways.
 A check that needs what this machine lacks (no GPU: SolverUnavailable) is
 skipped with the reason, never failed. The GPU solver runs them in numba's
 CUDA simulator when ``NUMBA_ENABLE_CUDASIM=1`` is set.
@@ -40,6 +40,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError, SolverUnavailable, kernel_names, solver_class
+from solvers.corrections import correction_names
 from solvers.interface import STAGES, Solver
 from solvers.physics.integrators import advance_steps, evolve
 from solvers.registry import SOLVERS
@@ -92,14 +93,25 @@ SCENES = {  # the scene kinds at their smallest: free-x, x-periodic, walled at o
 # few hundred particles (its cells, blocks or threads laid out otherwise) fails here
 LARGER = "plane-pulse-3200"
 SCENES[LARGER] = dict(dx=0.5, x_min=-20.0, x_max=20.0)
-AXES = ("precision", "model", "integrator", "kernel")  # Scene fields a class claims values of
-ALL_VALUES = {"precision": PRECISIONS, "model": MODELS, "integrator": INTEGRATORS}  # the kernels: all_values
-CLAIMS = {"precision": "precisions", "model": "models", "integrator": "integrators", "kernel": "kernels"}
+AXES = ("precision", "model", "integrator", "kernel", "correction")  # Scene fields a class claims values of
+ALL_VALUES = {"precision": PRECISIONS, "model": MODELS, "integrator": INTEGRATORS}  # kernels, corrections: all_values
+CLAIMS = {
+    "precision": "precisions",
+    "model": "models",
+    "integrator": "integrators",
+    "kernel": "kernels",
+    "correction": "corrections",
+}
 
 
 def all_values(axis: str) -> tuple:
-    """Every value of Scene field ``axis``: the kernels are the registry's now (one registered later counts)."""
-    return kernel_names() if axis == "kernel" else ALL_VALUES[axis]
+    """Every value of Scene field ``axis``: the kernels and corrections are their registries' now (one registered
+    later counts)."""
+    if axis == "kernel":
+        return kernel_names()
+    if axis == "correction":
+        return correction_names()
+    return ALL_VALUES[axis]
 
 
 PYTHON_OBJECTS = 16 * 1024  # B: the interpreter's own objects in a run (solver, dicts, scalars; ~9 KiB measured)
@@ -401,8 +413,8 @@ def memory(subject: Subject) -> str:
     """``memory_bytes(scene, pair_loop)`` is an upper bound of the memory a run allocates: the peak traced
     by tracemalloc (NumPy's allocations are traced) over input, init and two steps, compiled beforehand,
     on a lattice of 1,280 particles, for each pair loop and precision with the default and the rk2
-    integrator (which keeps copies of the state; full: every integrator). The trace also counts the
-    interpreter's own objects (the solver, its dicts, scalars: about 9 KiB), allowed ``PYTHON_OBJECTS``.
+    integrator (which keeps copies of the state; full: every integrator and kernel correction). The trace also
+    counts the interpreter's own objects (the solver, its dicts, scalars: about 9 KiB), allowed ``PYTHON_OBJECTS``.
     On a GPU: CuPy's memory pool after the same; in numba's CUDA simulator
     (host arrays and Python threads, not a device) skipped."""
     cls = subject.cls
@@ -416,16 +428,20 @@ def memory(subject: Subject) -> str:
     if not subject.quick:
         integrators = list(cls.integrators)
     precisions = list(cls.precisions)
+    corrections = [subject.default("correction")] if subject.quick else list(cls.corrections)
     notes, problems = [], []
-    for pair_loop, integrator, precision in itertools.product(cls.pair_loops, dict.fromkeys(integrators), precisions):
-        scene = subject.scene(integrator=integrator, precision=precision, dx=0.5, steps=2)
+    for pair_loop, integrator, precision, correction in itertools.product(
+        cls.pair_loops, dict.fromkeys(integrators), precisions, corrections
+    ):
+        scene = subject.scene(integrator=integrator, precision=precision, dx=0.5, steps=2, correction=correction)
         bound = cls.memory_bytes(scene, pair_loop)
         subject.evolve(scene, pair_loop=pair_loop)  # compiled and first launched outside the measurement
         used = measure(subject, scene, pair_loop)
-        notes.append(f"{pair_loop}/{integrator}/{precision} {used / bound:.1%}")
+        what = f"{pair_loop}/{integrator}/{precision}" + ("" if correction == "none" else f"/{correction}")
+        notes.append(f"{what} {used / bound:.1%}")
         if used > bound + PYTHON_OBJECTS:
             problems.append(
-                f"{pair_loop}/{integrator}/{precision}: a run allocates {used:,} B, more than "
+                f"{what}: a run allocates {used:,} B, more than "
                 f"memory_bytes {bound:,} B and {PYTHON_OBJECTS:,} B of Python objects"
             )
     if problems:

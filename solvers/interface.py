@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from solvers.absorbers import absorber_named
+from solvers.corrections import correction_names
 from solvers.kernels import constants as kernel
 from solvers.kernels import kernel_names
 from solvers.scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
@@ -67,6 +68,14 @@ class EveryKernel:
         return kernel_names()
 
 
+class EveryCorrection:
+    """The class attribute ``corrections`` of a solver that runs any kernel correction (each works through the
+    solver's sweeps and ``launch``: solvers/corrections/): every registered one's name, read at each access."""
+
+    def __get__(self, obj, owner=None) -> tuple:
+        return correction_names()
+
+
 class Solver(abc.ABC):
     """Base class: state, system update, output. Subclasses: ``snp`` and ``launch``, and a neighbour search.
 
@@ -83,6 +92,7 @@ class Solver(abc.ABC):
     models: tuple = MODELS
     integrators: tuple = INTEGRATORS
     kernels: tuple = EveryKernel()  # a tuple of kernel names restricts a solver; by default, every registered one
+    corrections: tuple = EveryCorrection()  # likewise the kernel corrections (solvers/corrections/)
     boundaries: tuple = ("free-x", "periodic-y")  # the boundary kinds it can run (solvers/scenes/base.py)
     pair_loops: tuple = ("gather",)  # how it can visit pairs (gather, list, all-pairs); the first is its default
     threaded: bool = False  # runs on more than one CPU thread (--threads N|all); else serial
@@ -129,6 +139,7 @@ class Solver(abc.ABC):
             ("model", cls.models),
             ("integrator", cls.integrators),
             ("kernel", cls.kernels),
+            ("correction", cls.corrections),
         ):
             if getattr(scene, what) not in offered:
                 raise SceneError(f"{what}: {cls.name} offers {', '.join(offered)} (got {getattr(scene, what)!r})")

@@ -27,6 +27,9 @@ from solvers.scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
 INTEGRATORS = ("verlet", "kdk1", "euler", "rk2", "rk4")
+# Arrays per particle an integrator keeps beyond FLOAT_ARRAYS_PER_PARTICLE: rk4's sums of its stages' rates (the
+# rates, the velocity and a split absorber's x part) and the temporary of each sum.
+INTEGRATOR_ARRAYS = {"rk4": 7}
 PRECISIONS = ("float64", "float32")
 
 # Arrays a solver holds per particle (state, rates, sort buffers, rk2/rk4 copies and sums),
@@ -569,11 +572,13 @@ class Scene:
 
     @property
     def extra_arrays(self) -> int:
-        """Arrays per particle the method keeps beyond the standard solver's (its correction's)."""
+        """Arrays per particle the method keeps beyond the standard solver's: its correction's and its
+        integrator's (INTEGRATOR_ARRAYS)."""
         try:
-            return int(correction_named(self.correction).arrays)
+            corrected = int(correction_named(self.correction).arrays)
         except ValueError:
-            return 0
+            corrected = 0
+        return corrected + INTEGRATOR_ARRAYS.get(self.integrator, 0)
 
     def smallest_dx_fitting(self, limit_bytes: float) -> float:
         """The smallest lattice spacing whose arrays fit in ``limit_bytes``, m."""

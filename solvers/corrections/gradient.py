@@ -46,7 +46,7 @@ class GradientCorrection(Correction):
 
     name = "gradient"
     summary = "kernel gradient correction (Bonet & Lok): exact for linear fields, energy-keeping form"
-    arrays = 7  # M's inverse (3), Gamma (2), w (2)
+    arrays = 14  # M's inverse (3), Gamma (2), w (2), and the moments sweep's and inversion's temporaries
 
     def coefficients(self, continuity: bool, momentum: bool) -> tuple:
         """Both sweeps need the volumes (momentum sums drho itself, c0^2 after)."""
@@ -86,6 +86,7 @@ class GradientCorrection(Correction):
         kept = getattr(solver, "correction_factors", None)
         if kept is not None and kept[0] == key:
             return kept[1]
+        solver.correction_factors = None  # the old factors go before the new are made (the memory's peak)
         mxx, mxy, myy, gx, gy = solver.moments()
         xp = solver.xp
         smallest = 0.5 * (mxx + myy) - xp.sqrt((0.5 * (mxx - myy)) ** 2 + mxy * mxy)
@@ -98,8 +99,14 @@ class GradientCorrection(Correction):
             one, zero = solver.dtype.type(1.0), solver.dtype.type(0.0)
             for arr, value in ((mxx, one), (mxy, zero), (myy, one)):
                 arr[bad] = value
-        det = mxx * myy - mxy * mxy
-        factors = (myy / det, -mxy / det, mxx / det, gx, gy)
+        del smallest, bad, ghost, fluid_bad
+        det = mxx * myy
+        det -= mxy * mxy
+        lxx = myy / det  # then L in place of M: L_yy in M_xx's array, L_xy in M_xy's
+        lyy = xp.divide(mxx, det, out=mxx)
+        lxy = xp.divide(mxy, det, out=mxy)
+        lxy *= solver.dtype.type(-1.0)
+        factors = (lxx, lxy, lyy, gx, gy)
         solver.correction_factors = (key, factors)
         return factors
 

@@ -159,8 +159,11 @@ def kernel_colours(runs) -> dict:
     return dict(zip(keys, F.palette(len(keys))))
 
 
-def _style(label: str) -> dict:
-    return {"ls": "-" if "gradient" in label else "--", "marker": "^" if "rk4" in label else "o"}
+def _style(label: str, cfl: float) -> dict:
+    """Solid: corrected, dashed: standard; triangles: RK4, circles: Verlet at the paper's CFL 0.2, squares: Verlet
+    at another CFL."""
+    marker = "^" if "rk4" in label else "o" if math.isclose(cfl, 0.2) else "s"
+    return {"ls": "-" if "gradient" in label else "--", "marker": marker}
 
 
 def orders_figure(data, ctx):
@@ -176,7 +179,8 @@ def orders_figure(data, ctx):
     with F.figure(
         path,
         f"High-order SPH: error against dx at fixed h / dx, linear, t = 10 s ({ctx.name}); colour: kernel and h; "
-        "solid: gradient-corrected, dashed: standard; triangles: RK4, circles: Verlet",
+        "solid: gradient-corrected, dashed: standard; triangles: RK4, circles: Verlet at CFL 0.2, squares: Verlet at "
+        "another CFL",
         "dx (m)",
         "relative RMS",
         ncols=len(panels),
@@ -196,7 +200,7 @@ def orders_figure(data, ctx):
                     color=colours[rs[0]["kernel"], rs[0]["h"]],
                     ms=5,
                     label=f"{label}, CFL {cfl:g}",
-                    **_style(label),
+                    **_style(label, cfl),
                 )
             F.nice_log_ticks(ax, values)
             ticks = sorted({r["dx"] for rs in found.values() for r in rs})
@@ -221,7 +225,7 @@ def work_precision_figure(data, ctx):
         path,
         f"High-order SPH: error against time to solution, linear, t = 10 s, serial ({ctx.name}); a line joins one "
         "method's runs at dx 0.4 .. 0.1 (plane) or 0.5, 0.25 (2D); colour: kernel and h; solid: corrected, dashed: "
-        "standard; triangles: RK4",
+        "standard; triangles: RK4, squares: Verlet at a CFL other than 0.2",
         "time to solution (s, init + steps)",
         "relative RMS",
         ncols=len(panels),
@@ -242,7 +246,7 @@ def work_precision_figure(data, ctx):
                     color=colours[rs[0]["kernel"], rs[0]["h"]],
                     ms=5,
                     label=f"{label}, CFL {cfl:g}",
-                    **_style(label),
+                    **_style(label, cfl),
                 )
             F.nice_log_ticks(ax, values)
             F.nice_log_ticks(ax, times, axis="x")
