@@ -62,12 +62,22 @@ class GradientCorrection(Correction):
                 solver._sweep(True, False)
                 if solver.split:
                     solver.continuity_x()
-            ddx = a["ddx"] if solver.split else a["dd"]  # the x part: w's x terms (in the interior, L u_x's)
+            # the x part: w's x terms (in the interior, L u_x's); without a split absorber an array never written (the
+            # same array twice is two copies in numba's CUDA simulator, the second written back last)
+            ddx = a["ddx"] if solver.split else self.unused(solver)
             solver.launch("corrected_continuity", a["dd"], ddx, a["drho"], wx, wy, gx, gy, solver.split, k)
         if momentum:  # the sweep sums drho; c0^2 (p = c0^2 drho) comes in the pass after
             with solver.swapped(mass=a["vol"], pr=a["drho"]):
                 solver._sweep(False, True)
             solver.launch("corrected_momentum", a["ax"], a["ay"], a["drho"], lxx, lxy, lyy, gx, gy, k)
+
+    def unused(self, solver):
+        """A one-element array of the solver's type: the x part's slot where there is none."""
+        kept = getattr(solver, "correction_unused", None)
+        if kept is None or kept.dtype != solver.dtype:
+            kept = solver.xp.zeros(1, solver.dtype)
+            solver.correction_unused = kept
+        return kept
 
     def scratch(self, solver) -> tuple:
         """(w_x, w_y): what the corrected continuity sweep sums, made anew from the state at every PI (so never
