@@ -29,6 +29,13 @@ from .conftest import in_simulator
 
 HIGH = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0, "correction": "gradient"}
 SOLVERS = [("allpair-cpu", "all-pairs"), ("linkedlist-cpu", "gather"), ("linkedlist-cpu", "list")]
+# the default tier checks the gather loop; the second tier (pytest -m tier2, CI) every CPU solver and loop
+EVERY_SOLVER = [
+    pytest.param(*pair, marks=())
+    if pair == ("linkedlist-cpu", "gather")
+    else pytest.param(*pair, marks=pytest.mark.tier2)
+    for pair in SOLVERS
+]
 
 
 def prepared(scene, solver="linkedlist-cpu", pair_loop="gather", threads=1):
@@ -52,7 +59,7 @@ def open_square(**method):
     return Scene(dx=1.0, name="acoustic-pulse", open="xy", steps=1, **{**HIGH, "model": "linear", **method})
 
 
-@pytest.mark.parametrize("solver,loop", SOLVERS)
+@pytest.mark.parametrize("solver,loop", EVERY_SOLVER)
 def test_the_corrected_gradient_is_exact_for_linear_fields_at_every_particle(solver, loop):
     s = prepared(open_square(), solver, loop)
     x, y = positions(s)
@@ -93,7 +100,7 @@ def test_the_corrected_divergence_is_exact_inside_the_lattice():
     ],
     ids=["free-edges", "free-edges-gaussian", "walls"],
 )
-@pytest.mark.parametrize("solver,loop", SOLVERS)
+@pytest.mark.parametrize("solver,loop", EVERY_SOLVER)
 def test_the_corrected_operators_keep_the_discrete_energy(scene, solver, loop):
     """sum_i V_i (rho0 u_i . a_i + c0^2 drho_i dd_i / rho0) = 0 for any fields: momentum's corrected gradient and
     continuity's divergence are negative adjoints, wherever L varies (edges, corners, walls)."""
@@ -111,6 +118,7 @@ def test_the_corrected_operators_keep_the_discrete_energy(scene, solver, loop):
     assert np.abs(kinetic).sum() > 1.0  # the fields do move
 
 
+@pytest.mark.tier2
 @pytest.mark.parametrize("model", ["lagrangian", "linear"])
 def test_every_cpu_solver_and_loop_runs_the_same_correction(model, tmp_path):
     scene = Scene(dx=0.5, name="pulse-wall", model=model, steps=6, integrator="rk4", cfl=0.5, **HIGH)
