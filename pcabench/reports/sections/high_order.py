@@ -166,22 +166,27 @@ def _style(label: str, cfl: float) -> dict:
     return {"ls": "-" if "gradient" in label else "--", "marker": marker}
 
 
-def orders_figure(data, ctx):
-    """The error against dx of each method, plane pulse and 2D pulse (log-log)."""
+STYLE_KEY = (
+    "solid: gradient-corrected, dashed: standard; triangles: RK4, circles: Verlet at CFL 0.2, squares: Verlet at "
+)
+STYLE_KEY += "another CFL"
+
+
+def _figure(data, ctx, name: str, title: str, xlabel: str, x_of, dx_ticks: bool):
+    """One panel per scene of the study's linear accuracy runs: the error against ``x_of(run)``, a line per method
+    (colour: kernel and h, :func:`_style`); ``dx_ticks``: the runs' dx as the x ticks."""
     if not data:
         return None
     panels = [(scene, methods(data["runs"], scene)) for scene in SCENES]
     panels = [(scene, found) for scene, found in panels if found]
     if not panels:
         return None
-    path = ctx.out / "high_order_orders.png"
+    path = ctx.out / name
     colours = kernel_colours(data["runs"])
     with F.figure(
         path,
-        f"High-order SPH: error against dx at fixed h / dx, linear, t = 10 s ({ctx.name}); colour: kernel and h; "
-        "solid: gradient-corrected, dashed: standard; triangles: RK4, circles: Verlet at CFL 0.2, squares: Verlet at "
-        "another CFL",
-        "dx (m)",
+        f"High-order SPH: {title}, linear, t = 10 s ({ctx.name}); colour: kernel and h; {STYLE_KEY}",
+        xlabel,
         "relative RMS",
         ncols=len(panels),
         logx=True,
@@ -189,12 +194,13 @@ def orders_figure(data, ctx):
         size=(6.0 * len(panels) + 3.5, 4.6),
     ) as axes:
         for ax, (scene, found) in zip(axes, panels):
-            values = []
+            values, xs = [], []
             for (label, cfl), rs in found.items():
-                pts = [(r["dx"], r["error"]) for r in rs if r["error"]]
+                pts = [(x_of(r), r["error"]) for r in rs if r["error"] and x_of(r)]
                 if not pts:
                     continue
                 values += [e for _, e in pts]
+                xs += [x for x, _ in pts]
                 ax.plot(
                     *zip(*pts),
                     color=colours[rs[0]["kernel"], rs[0]["h"]],
@@ -203,55 +209,36 @@ def orders_figure(data, ctx):
                     **_style(label, cfl),
                 )
             F.nice_log_ticks(ax, values)
-            ticks = sorted({r["dx"] for rs in found.values() for r in rs})
-            ax.set_xticks(ticks)
-            ax.set_xticklabels([f"{d:g}" for d in ticks])
-            ax.minorticks_off()
+            if dx_ticks:
+                ticks = sorted(set(xs))
+                ax.set_xticks(ticks)
+                ax.set_xticklabels([f"{d:g}" for d in ticks])
+                ax.minorticks_off()
+            else:
+                F.nice_log_ticks(ax, xs, axis="x")
             ax.set_title(SCENES[scene], fontsize=9)
     return path
+
+
+def orders_figure(data, ctx):
+    """The error against dx of each method, plane pulse and 2D pulse (log-log)."""
+    return _figure(data, ctx, "high_order_orders.png", "error against dx at fixed h / dx", "dx (m)", _dx, True)
 
 
 def work_precision_figure(data, ctx):
     """The error against the time to solution (init + steps, s) of every accuracy run, plane pulse and 2D pulse."""
-    if not data:
-        return None
-    panels = [(scene, methods(data["runs"], scene)) for scene in SCENES]
-    panels = [(scene, found) for scene, found in panels if found]
-    if not panels:
-        return None
-    path = ctx.out / "high_order_work_precision.png"
-    colours = kernel_colours(data["runs"])
-    with F.figure(
-        path,
-        f"High-order SPH: error against time to solution, linear, t = 10 s, serial ({ctx.name}); a line joins one "
-        "method's runs at dx 0.4 .. 0.1 (plane) or 0.5, 0.25 (2D); colour: kernel and h; solid: corrected, dashed: "
-        "standard; triangles: RK4, squares: Verlet at a CFL other than 0.2",
-        "time to solution (s, init + steps)",
-        "relative RMS",
-        ncols=len(panels),
-        logx=True,
-        logy=True,
-        size=(6.0 * len(panels) + 3.5, 4.6),
-    ) as axes:
-        for ax, (scene, found) in zip(axes, panels):
-            values, times = [], []
-            for (label, cfl), rs in found.items():
-                pts = [(r["seconds"], r["error"]) for r in rs if r["error"] and r["seconds"]]
-                if not pts:
-                    continue
-                values += [e for _, e in pts]
-                times += [t for t, _ in pts]
-                ax.plot(
-                    *zip(*pts),
-                    color=colours[rs[0]["kernel"], rs[0]["h"]],
-                    ms=5,
-                    label=f"{label}, CFL {cfl:g}",
-                    **_style(label, cfl),
-                )
-            F.nice_log_ticks(ax, values)
-            F.nice_log_ticks(ax, times, axis="x")
-            ax.set_title(SCENES[scene], fontsize=9)
-    return path
+    title = "error against time to solution, serial; a line joins one method's runs"
+    return _figure(
+        data, ctx, "high_order_work_precision.png", title, "time to solution (s, init + steps)", _seconds, False
+    )
+
+
+def _dx(r):
+    return r["dx"]
+
+
+def _seconds(r):
+    return r["seconds"]
 
 
 SECTION = Section(
