@@ -259,11 +259,11 @@ def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_pa
         r.probes = {"t": t, **{k: [1e-3 * math.sin(x) for x in t] for k in "ABC"}}
         store.append(r, path)
     data = S.rows(frame.load(path.parent))
-    orders = {o["key"][3]: o for o in data["orders"]}
+    orders = {o["key"][2]: o for o in data["orders"]}
     assert orders["lattice"]["probes"] == pytest.approx(2.0) and orders["lattice"]["near"] == pytest.approx(2.0)
     assert orders["rings"]["probes"] == pytest.approx(1.0) and orders["rings"]["near"] == pytest.approx(math.log2(1.25))
     text = "\n".join(S.text(data, None))
-    assert "has 0.2 (gaussian, h = 1 dx, lattice, dx = 0.02 m): not reached" in text
+    assert "has 0.2 (gaussian, h 1dx, 3h, lattice, dx = 0.02 m): not reached" in text
     ctx = SimpleNamespace(out=tmp_path, name="m")
     assert S.probes_figure(data, ctx).exists() and S.error_figure(data, ctx).exists()
 
