@@ -1,12 +1,13 @@
 """What high-order SPH costs a step (solvers/corrections/, the Laguerre-Gauss kernel, RK4): same-run ratios.
 
-Each configuration's step is timed in turn with its baseline, best of several (on a shared, noisy machine a ratio
+Each configuration's step is timed in turn with its baseline, best of 40 (on a shared, noisy machine a ratio
 taken turn about holds where an absolute time does not). On the paper's scene at dx 0.1 (100K particles),
 linkedlist-cpu, the pair list, serial; the kernel is the high-order method's, Laguerre-Gauss at h = 1.5 dx cut at
 4 h. Each returns t_config / t_baseline (> 1: dearer):
 
 - ``correction-linear``, ``correction-fixed``, ``correction-lagrangian``: the gradient correction against none, for
-  each model (particles that stay build L once; moving ones at every search);
+  each model (particles that stay build L once; moving ones at every search, their moments summed from the
+  pair list);
 - ``kernel``: the Laguerre-Gauss kernel against the Gaussian at the same h and cutoff (the same pairs): its cost
   per neighbour pair;
 - ``rk4``: RK4 against Verlet, both corrected (four sweeps of both rates against one of each).
@@ -16,6 +17,7 @@ from .bench_ratios import best_alternating
 from .common import Prepared, Unsupported
 
 METHOD = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0}
+REPEATS = 40  # turns each: a few per cent apart, so more than the speed ratios' 5 (bench_ratios.py)
 CONFIGS = {  # (baseline, configuration): Scene overrides
     "correction-linear": ({"model": "linear"}, {"model": "linear", "correction": "gradient"}),
     "correction-fixed": ({"model": "fixed"}, {"model": "fixed", "correction": "gradient"}),
@@ -45,5 +47,5 @@ class TrackHighOrderCost:
             raise NotImplementedError(str(exc)) from None
 
     def track_cost(self, dx, what):
-        best = best_alternating(self.prepared)
+        best = best_alternating(self.prepared, REPEATS)
         return best["config"] / best["base"]

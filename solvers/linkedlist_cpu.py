@@ -141,6 +141,20 @@ class LinkedListCPU(CellListSolver):
         if self.pairs is None:
             super().continuity_x()
 
+    def moments(self) -> tuple:
+        """The gradient correction's moments. Moving particles (at every search): from the pair list (its
+        factors, no kernel evaluation; the mirrors' part at walls from the edge columns), with accumulators
+        the list keeps (``list_bytes``). Particles that stay (once a run) or no list: the gather loop's."""
+        if self.pairs is None or not self.moving:
+            return super().moments()
+        if self.threads > 1:
+            use_threads(self.threads)
+        a = self.arrays
+        out = self.pairs.moments(a["lx"], a["ly"], a["sx"], a["sy"], a["vol"], self.k)
+        if self.scene.walls:
+            self.launch("wall_moments", *self.geometry(), a["vol"], *out, self.k)
+        return out
+
     def _sweep(self, continuity: bool, momentum: bool) -> None:
         if self.pairs is None:
             return super()._sweep(continuity, momentum)

@@ -24,10 +24,11 @@ Gamma_i = sum_j V_j grad_i W_ij,
     sum_j V_j (w_i + w_j) . grad_i W_ij = -sum_j V_j (w_i - w_j) . grad_i W_ij + 2 w_i . Gamma_i   (continuity)
 
 with w = L u, so the correction is the standard sweeps over other arrays plus one pass per particle. M and
-Gamma come from one more sweep (``moments``): once per run for particles that stay on their sites (linear,
-fixed), at each search for moving ones. A fluid particle whose M is singular or near it (too few
-neighbours: h below the lattice, an isolated particle near a body or a layer) fails the run at that step,
-naming where.
+Gamma come from one more sweep (``Solver.moments``): once per run for particles that stay on their sites
+(linear, fixed), at each search for moving ones (with the CPU pair list, a stream over its listed factors and
+the positions, no kernel evaluation: solvers/loops/pairlist.py). A fluid particle whose M is singular or
+near it (too few neighbours: h below the lattice, an isolated particle near a body or a layer) fails the run
+at that step, naming where.
 """
 
 from __future__ import annotations

@@ -38,6 +38,20 @@ def wall_momentum(cell, begin, ncx, ncy, lx, ly, sx, sy, mass, pr, ax, ay, k):
                 ay[i] -= by
 
 
+def wall_moments(cell, begin, ncx, ncy, lx, ly, sx, sy, vol, mxx, mxy, myy, gx, gy, k):
+    """The mirror particles' part of the moment sums added, over the grid's edge columns only (with the pair
+    list's :func:`moments`, which holds the real pairs)."""
+    for cy in prange(ncy):
+        for c in (cy * ncx, cy * ncx + ncx - 1):
+            for i in range(begin[c], begin[c + 1]):
+                a, b, d, e, f = P.moments_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, vol, k)
+                mxx[i] += a
+                mxy[i] += b
+                myy[i] += d
+                gx[i] += e
+                gy[i] += f
+
+
 def moments(cell, begin, ncx, ncy, lx, ly, sx, sy, vol, mxx, mxy, myy, gx, gy, k):
     """The kernel gradient correction's moment matrix and Gamma of every particle (solvers/corrections/)."""
     for i in prange(lx.shape[0]):

@@ -230,3 +230,60 @@ def momentum(nbr, fx, fy, start, count, mass, pr, ax, ay, bufx, bufy):
     for i in prange(n):
         ax[i] = thread_sum(bufx, i)
         ay[i] = thread_sum(bufy, i)
+
+
+@numba.njit(inline="always")
+def nearest(d, period):
+    """A lattice offset ``d`` across a periodic seam of ``period`` columns (0: none) as its nearest image."""
+    if period > 0:
+        if d > 0.5 * period:
+            return d - period
+        if d < -0.5 * period:
+            return d + period
+    return d
+
+
+def moments(nbr, fx, fy, start, count, lx, ly, sx, sy, vol, out, buf, k):
+    """The kernel gradient correction's sums from the list (solvers/corrections/gradient.py), both sides of
+    each pair: out = (M_xx, M_xy, M_yy, Gamma_x, Gamma_y) with M_i = -sum_j vol_j r_ij (x) f_ij and
+    Gamma_i = sum_j vol_j f_ij (f = G r_ij, the list's factors; r_ij from the positions, across a periodic
+    seam its nearest image). No kernel evaluation: a stream over the list like the sweeps. ``buf`` (threads,
+    n, 5) holds each thread's accumulators, a particle's five side by side (one cache line for the scattered
+    j side: five rows of n took twice the time, measured here)."""
+    n, nt = U(lx.shape[0]), U(buf.shape[0])
+    spacing, periods = k[SPACING], (k[NX], k[NY])  # locals: the accumulators' stores could alias k
+    for tt in prange(nt):
+        t = U(tt)
+        saved = flush_on(flush)
+        b = buf[t]
+        b[:, :] = 0
+        for i in range(t * n // nt, (t + U(1)) * n // nt):
+            lxi, lyi, sxi, syi, voli = lx[i], ly[i], sx[i], sy[i], vol[i]
+            bi = b[i]
+            mxx, mxy, myy, gx, gy = bi[0], bi[1], bi[2], bi[3], bi[4]
+            for m in range(U(start[i]), U(start[i]) + U(count[i])):
+                j = U(nbr[m])
+                rx = nearest(lxi - lx[j], periods[0]) * spacing + (sxi - sx[j])
+                ry = nearest(lyi - ly[j], periods[1]) * spacing + (syi - sy[j])
+                f1, f2 = fx[m], fy[m]
+                pxx, pxy, pyy = rx * f1, rx * f2, ry * f2
+                vj = vol[j]
+                mxx -= vj * pxx
+                mxy -= vj * pxy
+                myy -= vj * pyy
+                gx += vj * f1
+                gy += vj * f2
+                bj = b[j]
+                bj[0] -= voli * pxx
+                bj[1] -= voli * pxy
+                bj[2] -= voli * pyy
+                bj[3] -= voli * f1
+                bj[4] -= voli * f2
+            bi[0], bi[1], bi[2], bi[3], bi[4] = mxx, mxy, myy, gx, gy
+        flush_off(flush, saved)
+    for i in prange(n):
+        for q in range(5):
+            total = buf[0, i, q]
+            for t in range(U(1), nt):
+                total += buf[t, i, q]
+            out[q, i] = total

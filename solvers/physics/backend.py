@@ -78,9 +78,18 @@ COMPILED = {
         "corrected_momentum",
     ),
     "sorting": ("counting_sort", "sort_cells_by_x"),
-    "cells": ("continuity", "momentum", "moments", "neighbours", "wall_continuity", "wall_momentum", "cell_ids"),
+    "cells": (
+        "continuity",
+        "momentum",
+        "moments",
+        "neighbours",
+        "wall_continuity",
+        "wall_momentum",
+        "wall_moments",
+        "cell_ids",
+    ),
     "allpair": ("continuity", "momentum", "moments", "neighbours"),
-    "pairlist": ("build", "continuity", "continuity_split", "momentum"),
+    "pairlist": ("build", "continuity", "continuity_split", "momentum", "moments"),
 }
 LOOP_OPTIONS = {"pairlist": {"error_model": "numpy"}}
 

@@ -14,6 +14,10 @@ the list and update both particles (Newton's third law):
 In Stormer-Verlet the continuity sweep of step n + 1 runs at the positions of
 the momentum sweep of step n, so one list serves both; particles that never
 move (the fixed and linear models) build it once per run.
+Where moving particles are corrected (solvers/corrections/gradient.py), the
+moment matrix M_i = -sum_j vol_j r_ij (x) f_ij and Gamma_i = sum_j vol_j f_ij
+come from the list too, both sides of each pair, r_ij from the positions: no
+kernel evaluation at every search (the gather loop's moments cost 2.5 steps).
 
 The list needs each cell's particles sorted by x (``sort_cells_by_x`` in solvers/loops/sorting.py,
 after the counting sort): a stencil row is then sorted by x, so binary
@@ -50,6 +54,7 @@ ROW_BYTES = 4 + 8  # per particle: its pair count (uint32) and where its pairs s
 # thread's particles share one stretch of the list, so the budget is an average with a margin for
 # compressed regions; a stretch that overflows all the same is grown and the search redone.
 MEAN_SHARE = 0.55
+MOMENT_SUMS = 5  # the gradient correction's sums a particle (M_xx, M_xy, M_yy, Gamma_x, Gamma_y)
 CAPACITY_MARGIN = 1.1  # growth when a stretch overflows all the same
 
 
@@ -64,16 +69,19 @@ def capacity(scene) -> int:
 
 
 def list_bytes(scene, budget: int | None = None) -> int:
-    """Memory the pair list takes at ``scene``, bytes: per pair an index and two kernel factors."""
+    """Memory the pair list takes at ``scene``, bytes: per pair an index and two kernel factors (and the
+    correction's moment sums, per particle, where they are summed from the list at every search)."""
     item = np.dtype(scene.precision).itemsize
     per_particle = capacity(scene) if budget is None else budget
-    return scene.n_particles * (per_particle * (INDEX_BYTES + 2 * item) + ROW_BYTES)
+    # a correction's moments summed from the list at every search where particles move: their accumulators
+    moments = MOMENT_SUMS * item if scene.correction != "none" and scene.model == "lagrangian" else 0
+    return scene.n_particles * (per_particle * (INDEX_BYTES + 2 * item) + ROW_BYTES + moments)
 
 
 @lru_cache(maxsize=None)
 def kernels(precision: str, kernel: str, parallel: bool) -> dict:
-    """The list build (with ``kernel``'s G) and the two sweeps for ``precision``, serial or on numba's threads
-    (solvers/loops/pairlist.py, compiled once per machine)."""
+    """The list build (with ``kernel``'s G), the two sweeps and the correction's moments for ``precision``,
+    serial or on numba's threads (solvers/loops/pairlist.py, compiled once per machine)."""
     loops = cpu_loops("pairlist", precision, kernel, parallel, flush=precision == "float32")
     return {name: getattr(loops, name) for name in COMPILED["pairlist"]}
 
@@ -91,6 +99,7 @@ class PairList:
         self.count = np.zeros(n, np.uint32)
         self.buf = np.zeros((threads, n), dt)
         self.bufy = np.zeros((threads, n), dt)
+        self.bufm = None  # the correction's moments' accumulators, made at the first use
         self.scratch = None
 
     def _allocate(self, n, budget, dt):
@@ -140,6 +149,19 @@ class PairList:
         self.kernels["momentum"](
             self.nbr, self.fx, self.fy, self.start, self.count, mass, pr, ax, ay, self.buf, self.bufy
         )
+
+    def moments(self, lx, ly, sx, sy, vol, k) -> tuple:
+        """(M_xx, M_xy, M_yy, Gamma_x, Gamma_y) of every particle from the listed pairs (the gradient correction's
+        sums: solvers/corrections/gradient.py), as rows of one new (5, n) array; the accumulators (five a
+        particle a thread) kept for the next search."""
+        n = lx.shape[0]
+        if self.bufm is None or self.bufm.shape[1] != n:
+            self.bufm = np.zeros((self.threads, n, MOMENT_SUMS), self.fx.dtype)
+        out = np.empty((MOMENT_SUMS, n), self.fx.dtype)
+        self.kernels["moments"](
+            self.nbr, self.fx, self.fy, self.start, self.count, lx, ly, sx, sy, vol, out, self.bufm, k
+        )
+        return tuple(out)
 
     def row(self, i: int) -> tuple:
         """Particle ``i``'s pairs: (neighbour indices, x and y kernel factors)."""
