@@ -729,18 +729,21 @@ def main(solver: str, quick: bool = False, as_json: bool = False, out=None) -> i
             print(result.line(), file=out, flush=True)
     failed = any(r.failed for r in results)
     if as_json:
-        print(
-            json.dumps(
-                {
-                    "solver": solver,
-                    "quick": quick,
-                    "ok": not failed,
-                    "seconds": time.perf_counter() - t0,
-                    "checks": [asdict(r) for r in results],
-                }
-            ),
-            file=out,
+        text = json.dumps(
+            {
+                "solver": solver,
+                "quick": quick,
+                "ok": not failed,
+                "seconds": time.perf_counter() - t0,
+                "checks": [asdict(r) for r in results],
+            }
         )
+        if out is sys.stdout:
+            from pcabench import jsonout
+
+            jsonout.emit(text)
+        else:
+            print(text, file=out)
     else:
         word = "FAILED" if failed else "conforms" if any(r.status == "ok" for r in results) else "not checked here"
         print(

@@ -3,7 +3,7 @@
 Bad input is :class:`~pcabench.spec.OptionError` (a harness option) or
 :class:`~solvers.scene.SceneError` (a scene or solver parameter); a store that
 cannot be read or written is :class:`StoreError` (raised by the store and by what checks names that become
-store paths).
+store paths), one whose disk is full :class:`StoreFull` (an exit code of its own).
 """
 
 from __future__ import annotations
@@ -15,3 +15,7 @@ class NoResults(Exception):
 
 class StoreError(OSError):
     """The store cannot be written (one line naming the path)."""
+
+
+class StoreFull(StoreError):
+    """The store's disk (or quota, or file size limit) is full: the machine's state, not bad input."""

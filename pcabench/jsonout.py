@@ -4,8 +4,34 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import sys
 
 import numpy as np
+
+_json_fd = {"fd": None}  # the real stdout, kept for the one JSON object once stdout is the process's stderr
+
+
+def stdout_to_stderr() -> None:
+    """For a ``--json`` command, from here to the process's end: whatever anything prints on stdout (Python's
+    sys.stdout and file descriptor 1, so a plug-in at import, compiled code, an atexit handler) goes to
+    stderr; :func:`emit` writes to the real stdout, which so holds exactly one JSON object."""
+    if _json_fd["fd"] is not None:
+        return
+    sys.stdout.flush()
+    _json_fd["fd"] = os.dup(1)
+    os.dup2(2, 1)
+
+
+def emit(text: str) -> None:
+    """``text`` and a newline on the real stdout (after :func:`stdout_to_stderr`), else printed."""
+    fd = _json_fd["fd"]
+    if fd is None:
+        print(text, flush=True)
+        return
+    data = (text + "\n").encode()
+    while data:
+        data = data[os.write(fd, data) :]
 
 
 def plain(value):

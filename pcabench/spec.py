@@ -115,9 +115,9 @@ class RunSpec:
             resolve_pair_loop(self.solver, self.scene, self.pair_loop),
         )
 
-    def key(self, machine: str, commit: str, host: str) -> str:
-        """:func:`identity` of this (resolved) spec run on ``machine``/``host`` at ``commit``."""
-        return identity(self.solver, self.threads, self.scene, self.preset, machine, commit, host, self.pair_loop)
+    def key(self, machine: str, code: str, host: str) -> str:
+        """:func:`identity` of this (resolved) spec run on ``machine``/``host`` by ``code``."""
+        return identity(self.solver, self.threads, self.scene, self.preset, machine, code, host, self.pair_loop)
 
     @property
     def label(self) -> str:
@@ -216,11 +216,14 @@ def identity(
     scene: Scene | dict,
     preset: str,
     profile: str,
-    commit: str,
+    code: str,
     host: str,
     pair_loop: str = "",
 ) -> str:
     """The key of a run for resuming and de-duplication: the same key is the same run.
+
+    ``code`` is the code that made it (:func:`pcabench.store.provenance.code_key`, a content hash; a stored
+    row older than it: its commit), so a run of other code, committed or not, is another run.
 
     ``scene`` may be a Scene or a stored row's scene dict (its derived keys are ignored, the parameters
     it predates take their defaults: :func:`stored_parameters`).
@@ -228,8 +231,14 @@ def identity(
     """
     scene = stored_parameters(scene) if isinstance(scene, dict) else scene_parameters(scene)
     return json.dumps(
-        [solver, int(threads), scene, preset or "", profile, commit, host, pair_loop or ""], sort_keys=True, default=str
+        [solver, int(threads), scene, preset or "", profile, code, host, pair_loop or ""], sort_keys=True, default=str
     )
+
+
+def row_code(row: dict) -> str:
+    """The code a stored row was made by, as :func:`identity` takes it: its ``code``, or in a row older than
+    the content key its commit (which then never equals a content key: such a row is not resumed)."""
+    return row.get("code") or row.get("commit", "") or ""
 
 
 def row_identity(row: dict) -> str:
@@ -240,7 +249,7 @@ def row_identity(row: dict) -> str:
         row.get("scene") or {},
         row.get("preset", ""),
         row.get("profile_id", ""),
-        row.get("commit", ""),
+        row_code(row),
         row.get("host", ""),
         row.get("pair_loop", ""),
     )

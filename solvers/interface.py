@@ -539,7 +539,9 @@ def across_x(scene: Scene) -> bool:
 
 
 def tiny_scene(scene: Scene) -> Scene:
-    """A few hundred particles with the same scene kind, model, integrator and precision (for JIT warm-up)."""
+    """A few hundred particles with the same scene kind, model, integrator and precision (for JIT warm-up): no
+    probes (the run's own points lie in the run's domain, not in this one)."""
+    scene = scene.replace(probes=())
     own = scene.kind.tiny(scene)
     if own is not None:
         return own

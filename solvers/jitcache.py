@@ -11,7 +11,8 @@ such as the pair functions ``P``), then a footer that binds those names (``P = c
 
 * the generated text (the template's source, the bindings, the compile options);
 * the source of every first-party module the template imports and of every module the bindings compile
-  (``depends``: the pair physics, the kernel's own file, a plug-in kernel's file too);
+  (``depends``: the pair physics, the kernel's class with every class it inherits from, so a plug-in kernel
+  that subclasses a built-in is compiled again when the built-in's file changes);
 * numba's, llvmlite's and Python's versions and the CPU target (the folder: :func:`target`).
 
 An edit to any of them makes another name, hence another compile; undoing the edit finds the earlier file
@@ -22,6 +23,10 @@ Where: ``$PCABENCH_CACHE``, else ``$XDG_CACHE_HOME/pcabench``, else ``~/.cache/p
 ``pcabench cache`` shows and clears it. Faults end in a correct run with one :class:`JitCacheWarning`: an
 unwritable or full cache folder (the loops are compiled in memory), a corrupt cache file (dropped and
 rebuilt), a cache cleared under a running process (that process keeps its loops; later ones rebuild).
+Nothing another user could have written is loaded (numba's index files are pickles, which run code): a
+cache folder, from the root down, that is a link, is not the user's or is writable by others, or a cache
+file that is not the user's, is not used (one warning naming it; the loops compiled in memory), as ssh
+treats its folder; the folders jitcache makes are the user's alone (mode 700).
 """
 
 from __future__ import annotations
@@ -32,6 +37,7 @@ import importlib.util
 import inspect
 import os
 import shutil
+import stat
 import sys
 import threading
 import warnings
@@ -99,6 +105,43 @@ def jit_folder() -> Path:
     return cache_root() / "jit" / target()
 
 
+class UntrustedCache(OSError):
+    """A cache folder or file another user could have written: its contents are never loaded (numba's index is
+    a pickle, and a pickle runs code)."""
+
+
+def untrusted(path: Path, folder: bool) -> str:
+    """Why ``path`` may not be trusted ('' if it may): a link; not owned by this user; a folder writable by its
+    group or by all (anyone there could plant a file). As ssh treats its folder."""
+    try:
+        st = os.lstat(path)
+    except FileNotFoundError:
+        return ""
+    uid = os.getuid()
+    if stat.S_ISLNK(st.st_mode):
+        return "is a link"
+    if st.st_uid != uid:
+        return f"is owned by user id {st.st_uid}, not by you ({uid})"
+    if folder and st.st_mode & 0o022:
+        return f"is writable by others (mode {stat.S_IMODE(st.st_mode):o}; chmod go-w it)"
+    return ""
+
+
+def trusted_folder(folder: Path) -> Path:
+    """``folder`` (the JIT folder of this target) and its ``__pycache__``, made where missing (mode 700) and
+    checked with every folder from the cache root down: UntrustedCache naming the first that fails."""
+    root = cache_root()
+    parts = folder.relative_to(root).parts
+    chain = [root, *(root.joinpath(*parts[: i + 1]) for i in range(len(parts))), folder / "__pycache__"]
+    for path in chain:
+        if not os.path.lexists(path):
+            path.mkdir(mode=0o700, parents=True, exist_ok=True)
+        why = untrusted(path, folder=True)
+        if why:
+            raise UntrustedCache(f"{path} {why}")
+    return folder
+
+
 def _warn(kind: str, what: str, exc: BaseException | None = None) -> None:
     """One JitCacheWarning per kind of fault (``folder``, ``read``, ``write``) and process."""
     if kind in _warned:
@@ -118,6 +161,26 @@ def _source_file(dep) -> Path:
             raise ValueError(f"jitcache: no source for module {dep!r}")
         return Path(spec.origin)
     return Path(inspect.getsourcefile(dep))
+
+
+def class_sources(cls: type) -> list[Path]:
+    """The source files of ``cls`` and of every class it inherits from (its whole MRO, built-in types left
+    out): a subclass's compiled code can come from any of them (``class K(Gaussian)`` compiles Gaussian's
+    ``compiled_gradient`` unless it overrides it)."""
+    out = []
+    for c in cls.__mro__:
+        if c.__module__ in ("builtins", "abc", "typing"):
+            continue
+        try:
+            out.append(Path(inspect.getsourcefile(c)))
+        except (TypeError, OSError):  # a class made at run time (no file): its module's name cannot key it
+            raise ValueError(f"jitcache: no source file for class {c.__qualname__} (of {cls.__qualname__})") from None
+    return list(dict.fromkeys(out))
+
+
+def _sources(dep) -> list[Path]:
+    """The source files ``dep`` stands for: a class's whole MRO (:func:`class_sources`), else its one file."""
+    return class_sources(dep) if inspect.isclass(dep) else [_source_file(dep)]
 
 
 def imports_of(text: str) -> list[str]:
@@ -159,7 +222,7 @@ def render(template: str, bind: dict, functions: dict, imports: tuple = (), cach
 def key(text: str, depends: tuple = ()) -> str:
     """SHA-256 of the generated ``text``, the source of the modules it imports and of ``depends``, and the target."""
     h = hashlib.sha256(text.encode())
-    for dep in sorted({str(_source_file(d)) for d in (*imports_of(text), *depends)}):
+    for dep in sorted({str(p) for d in (*imports_of(text), *depends) for p in _sources(d)}):
         h.update(dep.encode() + b"\0" + _digest(dep) + b"\0")
     h.update(target().encode())
     return h.hexdigest()
@@ -209,11 +272,14 @@ def specialise(
 def _written(text: str, name: str, template: str) -> Path:
     """The generated file for ``name``, created once: written aside, then linked into place (never replaced,
     so a file another process is reading never changes; numba's index is stamped by the file's mtime)."""
-    folder = jit_folder()
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = trusted_folder(jit_folder())
     path = folder / f"{template.rsplit('.', 1)[-1]}_{name[:24]}.py"
     if path.is_symlink():
         raise OSError(f"{path} is a link")
+    for file in (path, *sorted((folder / "__pycache__").glob(f"{path.stem}.*"))):  # numba's index and code
+        why = untrusted(file, folder=False)
+        if why:
+            raise UntrustedCache(f"{file} {why}")
     if path.exists() and path.read_text() == text:
         return path
     tmp = folder / f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp"

@@ -54,6 +54,7 @@ PAPER_DOMAIN = {"x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
 # a body's radius only where the kind has a body).
 PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
 PER_KIND = ("pulse_width", "pulse_center", "cylinder_radius")
+LAYER_UNSET = {"absorber": "", "layer_width": None, "absorber_strength": None}  # a closed scene's layer options
 
 
 class SceneError(ValueError):
@@ -338,7 +339,7 @@ class Scene:
 
     def _validate_open(self, need, finite) -> None:
         """The open edges: free edges of the scene, a layer of positive width no wider than the domain, a known
-        absorber of positive strength."""
+        absorber of positive strength; none of the layer's options on a closed scene."""
         need(
             self.open in OPEN_EDGES,
             f"--open must be one of {', '.join(e for e in OPEN_EDGES if e)} (got {self.open!r})",
@@ -347,6 +348,13 @@ class Scene:
         for axis in ("x", "y"):
             if axis in self.open and axis not in openable:
                 need(False, f"--open {axis}: {self.kind.closed_reason(axis)}")
+        if not self.open:  # a closed scene has no layer: its options would be stored as if they did something
+            for name, unset in LAYER_UNSET.items():
+                need(
+                    getattr(self, name) == unset,
+                    f"--{name.replace('_', '-')}: the scene's edges are closed (add --open x, y or xy)",
+                )
+            return
         _ = self.absorber_model  # first: a known absorber, or one line (the default layer is the absorber's)
         for name in ("layer_width", "absorber_strength"):
             if getattr(self, name) is not None:
@@ -630,6 +638,10 @@ class Scene:
 
     # ------------------------------------------------------------ helpers
     def replace(self, **changes) -> "Scene":
+        """This scene with ``changes``; closing its edges (``open=""``) lets go of the layer's options too (a
+        closed scene takes none of them), unless the changes set them."""
+        if "open" in changes and not changes["open"]:
+            changes = {**LAYER_UNSET, **changes}
         return replace(self, **changes)
 
     def as_dict(self) -> dict:

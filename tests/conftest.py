@@ -53,7 +53,7 @@ def requires_gpu():
 
 
 def run_children(pid: int) -> list[int]:
-    """The run children among the descendants of ``pid``: forked by the sweep's forkserver (named
+    """The running run children among the descendants of ``pid``: forked by the sweep's forkserver (named
     pcabench-run, pcabench/execute/forkserver.py) or fresh interpreters (``python -m pcabench.execute.child``)."""
     found, todo = [], [pid]
     while todo:
@@ -63,7 +63,10 @@ def run_children(pid: int) -> list[int]:
             try:
                 comm = open(f"/proc/{child}/comm", "rb").read().strip()
                 cmdline = open(f"/proc/{child}/cmdline", "rb").read()
-            except OSError:
+                state = open(f"/proc/{child}/stat", "rb").read().rsplit(b")", 1)[1].split()[0]
+            except (OSError, IndexError):
+                continue
+            if state == b"Z":  # ended (not yet reaped by its parent): not running
                 continue
             if comm == b"pcabench-run" or b"pcabench.execute.child" in cmdline:
                 found.append(child)

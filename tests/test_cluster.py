@@ -119,3 +119,23 @@ def test_a_local_cluster_listens_on_loopback_only():
         ]
         assert listening and all(addr.ip == "127.0.0.1" for addr in listening), listening
         assert "127.0.0.1" in client.dashboard_link
+
+
+def test_a_local_cluster_takes_no_client_but_its_own():
+    """Another process on the machine (any user) that reaches the local scheduler cannot be its client, so
+    cannot run code on the workers: the cluster speaks TLS with credentials made for this sweep only."""
+    from contextlib import ExitStack
+
+    import dask.distributed as dd
+
+    from pcabench.execute.cluster import connect
+
+    with ExitStack() as stack:
+        client = connect("local:1", stack)
+        address = client.scheduler.address
+        assert address.startswith("tls://127.0.0.1:"), address
+        assert client.submit(lambda: 6 * 7).result(timeout=60) == 42  # its own client works
+        # a stranger with TLS credentials of its own (not signed by this cluster's authority); one in plain TCP
+        for stranger, security in ((address, dd.Security.temporary()), (address.replace("tls://", "tcp://"), None)):
+            with pytest.raises((OSError, TimeoutError)):
+                dd.Client(stranger, security=security, timeout="3s")

@@ -47,3 +47,40 @@ def test_only_the_run_time_variables_may_differ_from_the_servers():
     assert not forkserver.usable({**env, "NUMBA_OPT": "0"})  # read by numba at import: a fresh interpreter
     assert not forkserver.usable({**env, "PYTHONPATH": "/a/plugin"})
     assert not forkserver.usable({**env, forkserver.ENV: "0"})
+
+
+def test_a_run_killed_with_its_forkserver_is_run_again_in_a_fresh_interpreter(tmp_path):
+    """The server killed while it holds a run (its child dies with it): the run is made again in a fresh
+    interpreter, not stored as an `error` (exit 255), and the sweep's next runs start a new server."""
+    import signal
+    import sys
+
+    from pcabench import store
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "pcabench.cli", "study", "--dx", "0.5", "0.25", "--steps", "400", "--model", "linear"]
+        + ["--solver", "linkedlist-cpu", "--no-report", "--results", str(tmp_path)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        killed, deadline = False, time.time() + 180
+        while not killed and time.time() < deadline and proc.poll() is None:
+            for child in run_children(proc.pid):
+                with open(f"/proc/{child}/stat") as f:
+                    server = int(f.read().rsplit(")", 1)[1].split()[1])  # a forked run's parent: the server
+                if server != proc.pid:
+                    os.kill(server, signal.SIGKILL)
+                    killed = True
+                    break
+            time.sleep(0.01)
+        assert killed, "no forked run seen"
+        _, err = proc.communicate(timeout=300)
+        rows = store.read_rows(tmp_path)
+        assert proc.returncode == 0 and sorted(r["status"] for r in rows) == ["ok", "ok"], err[-2000:]
+        assert "its forkserver ended under it; run again in a fresh interpreter" in err
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)

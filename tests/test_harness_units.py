@@ -46,11 +46,12 @@ def test_a_spec_and_its_stored_row_have_one_identity():
     spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=3, cfl=0.3), ALL_CORES, "quick").resolved()
     assert RunSpec.from_json(spec.to_json()) == spec
     record = RunRecord.from_spec(spec.resolved(), "machine-a")
-    record.preset, record.commit, record.host = spec.preset, "abc", "h1"
+    record.preset, record.code, record.host = spec.preset, "abc", "h1"
     row = store.to_row(record)
     key = spec.key("machine-a", "abc", "h1")
-    assert row_identity(row) == key
-    # a different scene, thread count, preset, machine, commit or host is another run
+    assert row_identity(row) == key  # the code key, whatever the commit: a commit of documents reruns nothing
+    assert row_identity(dict(row, commit="other")) == key
+    # a different scene, thread count, preset, machine, code or host is another run
     others = [
         identity(spec.solver, spec.threads, spec.scene.replace(cfl=0.2), "quick", "machine-a", "abc", "h1"),
         identity(spec.solver, spec.threads + 1, spec.scene, "quick", "machine-a", "abc", "h1"),

@@ -121,6 +121,29 @@ def test_an_edit_to_a_plugin_kernel_recompiles_and_undoing_it_restores_the_machi
     assert undone["digest"] == first["digest"]
 
 
+def test_a_kernel_that_subclasses_another_recompiles_when_the_class_it_inherits_from_is_edited(tmp_path):
+    """The key holds the kernel class's whole MRO: ``class Plugin(Parent)`` compiles Parent's
+    ``compiled_gradient``, so an edit to Parent's file (a built-in's, or another plug-in's) must not be served
+    from the cache under the subclass's unchanged file."""
+    parent = tmp_path / "parent_kernel.py"
+    child = tmp_path / "child_kernel.py"
+    parent.write_text(PLUGIN.replace("class Plugin(Kernel):", "class Parent(Kernel):").replace("SCALE", "1.0"))
+    child.write_text(
+        "import sys, os\n"
+        "sys.path.insert(0, os.path.dirname(__file__))\n"
+        "from parent_kernel import Parent\n\n\n"
+        "class Plugin(Parent):\n"
+        '    name = "plugin-sub"\n'
+    )
+    cache = tmp_path / "cache"
+    first = probe(cache, kernel_file=child)
+    assert first["compiled"] > 0
+    parent.write_text(PLUGIN.replace("class Plugin(Kernel):", "class Parent(Kernel):").replace("SCALE", "1.25"))
+    edited = probe(cache, kernel_file=child)
+    assert edited["compiled"] > 0, "the subclass's loops were served from the cache after its parent's edit"
+    assert edited["digest"] != first["digest"]
+
+
 def test_the_key_covers_the_pair_physics_numba_and_the_target(monkeypatch):
     text = jitcache.render("solvers.loops.allpair", {"P": "cpu_pairs('float64', 'gaussian')"}, {})
     base = jitcache.key(text, ("solvers.physics.pairs",))
@@ -193,6 +216,38 @@ def test_an_unusable_cache_folder_compiles_in_memory_with_one_warning(tmp_path):
     assert out["digest"] == reference["digest"]
     assert out["compiled"] > 0 and out["loaded"] == 0
     assert len(out["warnings"]) == 1 and "JitCacheWarning" in out["warnings"][0]
+
+
+def test_a_cache_folder_others_can_write_is_not_loaded_from(tmp_path):
+    """A shared cache folder (mode 777: another user could plant numba's pickled index there) is never loaded
+    from: one warning naming it, the loops compiled in memory, the same numbers."""
+    cache = tmp_path / "cache"
+    first = probe(cache)
+    assert first["compiled"] > 0
+    (target,) = cache.glob("jit/*")
+    for index in target.glob("__pycache__/*.nbi"):  # what a planted pickle would look like: it must not be read
+        index.write_bytes(b"cos\nsystem\n(S'touch " + str(tmp_path / "pwned").encode() + b"'\ntR.")
+    target.chmod(0o777)
+    out = probe(cache)
+    assert out["digest"] == first["digest"] and out["loaded"] == 0 and out["compiled"] > 0
+    assert len(out["warnings"]) == 1 and f"{target} is writable by others" in out["warnings"][0]
+    assert not (tmp_path / "pwned").exists()
+
+
+def test_a_cache_file_of_another_user_is_not_loaded(tmp_path, monkeypatch):
+    """Owned by another user id (this process made it, so it is shown as another's by the uid it compares
+    with): refused, naming the folder or file, before any of it is read."""
+    from solvers import jitcache
+
+    monkeypatch.setenv("PCABENCH_CACHE", str(tmp_path))
+    folder = jitcache.trusted_folder(jitcache.jit_folder())
+    assert jitcache.untrusted(folder, folder=True) == ""
+    planted = folder / "__pycache__" / "x.nbi"
+    planted.write_bytes(b"")
+    monkeypatch.setattr(jitcache.os, "getuid", lambda: os.stat(planted).st_uid + 1)
+    assert "is owned by user id" in jitcache.untrusted(planted, folder=False)
+    with pytest.raises(jitcache.UntrustedCache, match="is owned by user id"):
+        jitcache.trusted_folder(jitcache.jit_folder())
 
 
 TEMPLATE = """

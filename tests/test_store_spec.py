@@ -72,10 +72,41 @@ def test_an_unknown_key_beside_a_missing_stage_breaks_no_reader(tmp_path, capsys
         assert code == 0 and "pcabench run --solver linkedlist-cpu" in out, (out, err)
 
 
+@pytest.mark.parametrize(
+    "change, says",
+    [
+        ({"n_particles": 10**9}, "'n_particles' 1000000000 is not its scene's"),
+        ({"n_particles": 10**9, "scene.n_particles": 10**9}, "not the 1000 particles its scene's lattice holds"),
+        ({"steps": 10**6}, "'steps' 1000000 is more than its scene's"),
+        ({"model": "lagrangian"}, "'model' 'lagrangian' is not its scene's 'linear'"),
+        ({"dx": 0.5}, "'dx' 0.5 is not its scene's 1.0"),
+    ],
+)
+def test_a_rows_derived_fields_are_checked_against_its_scene(tmp_path, change, says):
+    """A row that claims another particle count, more steps than asked, or another model or dx than its scene
+    (a forged or hand-edited line: 1e9 particles for a 2,500-particle scene would reach the report) is skipped
+    with one warning naming the field; the good row beside it is read."""
+    path = tmp_path / "m--h.jsonl"
+    good = store.append(advisable(), path)
+    forged = json.loads(json.dumps(good))
+    forged["run_id"] = "forged"
+    for key, value in change.items():
+        where, _, name = key.rpartition(".")
+        (forged[where] if where else forged)[name] = value
+    with open(path, "a") as f:
+        f.write(json.dumps(forged) + "\n")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rows = store.read_rows(path)
+    assert [r["run_id"] for r in rows] == [good["run_id"]]
+    (message,) = [str(w.message) for w in caught]
+    assert f"{path}:2:" in message and says in message, message
+
+
 def test_one_run_id_with_two_records_warns_naming_both_and_the_later_write_wins(tmp_path):
     results = tmp_path / "results"
     real = store.append(advisable(timestamp="2026-12-01T10:00:00+00:00"), results / "m--h.jsonl")
-    forged = dict(real, mse=1e-12, timestamp="2026-11-01T10:00:00+00:00")  # read first, written earlier
+    forged = dict(real, mse=1e-12, timestamp="2027-11-01T10:00:00+00:00")  # read first, a later time claimed
     (results / "a--h.jsonl").write_text(json.dumps(forged) + "\n")
     copy = results / "z--h.jsonl"
     copy.write_text(json.dumps(real) + "\n")  # the same record copied into another store: one run, no warning
@@ -86,8 +117,9 @@ def test_one_run_id_with_two_records_warns_naming_both_and_the_later_write_wins(
     (message,) = [str(w.message) for w in caught]
     assert f"{results / 'a--h.jsonl'}:1" in message and f"{results / 'm--h.jsonl'}:1" in message
     assert "later write" in message and str(copy) not in message
-    # at equal timestamps the later line wins: the order of appends
-    again = dict(real, mse=0.2)
+    # the later line wins, whatever the rows' own times say: the order of appends (issue 57: a copy of the real
+    # row with a later timestamp, written before it, must not win)
+    again = dict(real, mse=0.2, timestamp="2020-01-01T00:00:00+00:00")
     with open(results / "m--h.jsonl", "a") as f:
         f.write(json.dumps(again) + "\n")
     with warnings.catch_warnings():

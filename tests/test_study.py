@@ -91,6 +91,7 @@ def row(
 ):
     """A stored run with chosen stage times (SNP, PI, SU in ms per step) and error."""
     s = Scene(**scene) if "t_end" in scene else Scene(steps=steps, **scene)
+    steps = min(steps, s.n_steps)  # no more than its scene's (the reader checks)
     stages = {
         "input": 0.001,
         "init": 0.002,

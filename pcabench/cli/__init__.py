@@ -13,12 +13,15 @@ allowed range, never a traceback).
 
 from __future__ import annotations
 
+import errno
 import os
 import signal
 import sys
 import warnings
 
+from pcabench import jsonout
 from pcabench.cli.exits import (  # noqa: F401 - the package's face
+    EXIT_DISK_FULL,
     EXIT_HELP,
     EXIT_INTERRUPTED,
     EXIT_NO_RESULTS,
@@ -34,7 +37,7 @@ from pcabench.cli.options import (
 )
 from pcabench.cli.parsers import build_parser
 from pcabench.cli.study import study_specs  # noqa: F401 - the package's face
-from pcabench.errors import NoResults
+from pcabench.errors import NoResults, StoreFull
 from pcabench.parser import EXIT_BAD_INPUT, Parser
 from pcabench.spec import OptionError
 from pcabench.store import StoreError
@@ -60,11 +63,15 @@ def main(argv=None) -> int:
     on_term = None
     if threading.current_thread() is threading.main_thread():
         on_term = signal.signal(signal.SIGTERM, _terminated)
+    if argv is None and "--json" in sys.argv[1:]:  # the process's own command: one JSON object on its stdout,
+        jsonout.stdout_to_stderr()  # whatever a plug-in prints at import or at exit (in-process calls: the run's)
     try:
         parser = build_parser()  # finds the solvers: a plug-in left out is one warning line
         args = parser.parse_args(argv)
         prog = f"pcabench {args.command}"
         return args.func(args)
+    except StoreFull as exc:  # the machine's state, not the input
+        parser.exit(EXIT_DISK_FULL, f"{prog}: error: {exc}\n")
     except (SceneError, OptionError, StoreError) as exc:
         parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {option_words(str(exc))} (see {prog} --help)\n")
     except BrokenPipeError:  # `pcabench ... | head`: the reader has what it wanted
@@ -73,7 +80,8 @@ def main(argv=None) -> int:
         return EXIT_PIPE
     except OSError as exc:  # a path the checks before the work could not foresee: one line all the same
         where = f"{exc.filename}: " if exc.filename else ""
-        parser.exit(EXIT_BAD_INPUT, f"{prog}: error: {where}{exc.strerror or exc}\n")
+        full = exc.errno in (errno.ENOSPC, errno.EDQUOT)  # a report's figures on a full disk: not bad input
+        parser.exit(EXIT_DISK_FULL if full else EXIT_BAD_INPUT, f"{prog}: error: {where}{exc.strerror or exc}\n")
     except SolverUnavailable as exc:
         parser.exit(EXIT_UNAVAILABLE, f"{prog}: {exc}\n")
     except NoResults as exc:

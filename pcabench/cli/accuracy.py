@@ -21,13 +21,14 @@ def cmd_accuracy(args) -> int:
         t_end=args.t_end,
         model="linear",
         memory_limit_bytes=memory.available_memory_bytes(),
+        probes=tuple(getattr(args, "probe", None) or ()),  # checked as a run checks them (in the body: refused)
         **given,
         **domain_of(args),
     )
     p = predict(scene)
     past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/predict/stability.py)
     if args.json:
-        print(jsonout.dumps({"scene": scene.as_dict(), **p.as_dict(), "past_stable_cfl": past}, sort_keys=True))
+        jsonout.emit(jsonout.dumps({"scene": scene.as_dict(), **p.as_dict(), "past_stable_cfl": past}, sort_keys=True))
         return 0
     if past:
         print(

@@ -508,7 +508,7 @@ def cmd_advise(args) -> int:
         shown = {key: jsonout.significant(out[key]) for key in ROUNDED_AS_PRINTED if out.get(key) is not None}
         if out.get("cfl_fraction") is not None:
             shown["cfl_fraction"] = round(out["cfl_fraction"], 2)  # printed as "0.66 of the predicted stable"
-        print(jsonout.dumps({**out, **shown}, sort_keys=True))
+        jsonout.emit(jsonout.dumps({**out, **shown}, sort_keys=True))
         return EXIT_OK if out["found"] else EXIT_RUN_FAILED
     text, found = advice_text(out, args.error, args.t_end, args.model, args.domain, args.scene)
     print(text)

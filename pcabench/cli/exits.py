@@ -11,6 +11,7 @@ largest stable step the dispersion relation predicts (accuracy)."""
 
 # exit codes: each one means one thing
 EXIT_OK, EXIT_RUN_FAILED, EXIT_UNAVAILABLE, EXIT_NO_RESULTS, EXIT_INTERRUPTED = 0, 1, 3, 4, 130
+EXIT_DISK_FULL = 5  # the store's disk is full (not bad input: free space and rerun)
 EXIT_PIPE, EXIT_TERMINATED = 141, 143  # 128 + SIGPIPE (the reader of stdout left: `| head`), 128 + SIGTERM
 EXIT_HELP = f"""exit codes:
   {EXIT_OK}    ok
@@ -19,5 +20,6 @@ EXIT_HELP = f"""exit codes:
   {EXIT_BAD_INPUT}    bad input: one line naming the parameter and its allowed range, before any work
   {EXIT_UNAVAILABLE}    the solver cannot run here (no GPU)
   {EXIT_NO_RESULTS}    no results: no stored runs to report or advise from (run `pcabench study` first)
+  {EXIT_DISK_FULL}    the results store's disk is full: every finished run is kept; free space and rerun to resume
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); {EXIT_TERMINATED}: terminated (SIGTERM); {EXIT_PIPE}: the reader of the
        output left (`| head`), silently. A sweep stopped either way keeps every finished run and resumes"""

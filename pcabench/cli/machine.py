@@ -23,7 +23,7 @@ def cmd_profile(args) -> int:
     if args.save:
         out = check_folder(args.out, "--out") if args.out else check_folder(paths.user_profiles(), home_option())
         print(f"wrote {profiles.save(profile, out)}", file=sys.stderr)
-    print(jsonout.dumps(profile, indent=2))
+    jsonout.emit(jsonout.dumps(profile, indent=2))
     return 0
 
 
@@ -57,7 +57,7 @@ def cmd_cache(args) -> int:
         return 0
     entries = jitcache.entries()
     if args.json:
-        print(jsonout.dumps({"root": str(root), "target": jitcache.target(), "entries": entries}, indent=2))
+        jsonout.emit(jsonout.dumps({"root": str(root), "target": jitcache.target(), "entries": entries}, indent=2))
         return 0
     size = sum(e["bytes"] for e in entries)
     print(f"JIT cache  {root / 'jit'}  (${jitcache.ENV} moves it)")

@@ -37,7 +37,7 @@ def cmd_run(args) -> int:
         with solver_output_to_stderr(args.json):
             record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
     if args.json:  # the record as a store holds it: the whole scene, so the run can be made again from it
-        print(jsonout.dumps(to_row(record)))  # strict JSON: null, never NaN
+        jsonout.emit(jsonout.dumps(to_row(record)))  # strict JSON: null, never NaN
     else:
         print(record.text(scene))
     return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED

@@ -28,7 +28,7 @@ from pathlib import Path
 from pcabench import store
 from pcabench.execute.sweep import Executor, failed_record, run_child, run_specs
 from pcabench.machine.profiles import machine_id
-from pcabench.spec import OptionError, RunSpec, identity
+from pcabench.spec import OptionError, RunSpec, identity, row_code
 from pcabench.store.provenance import git_commit, host_id
 from solvers import solver_class
 
@@ -45,9 +45,12 @@ def dask_distributed():
     return dask.distributed
 
 
-def connect(address: str, stack: ExitStack):
+def connect(address: str, stack: ExitStack, stream=sys.stderr):
     """A Client for ``address``: ``local:N`` starts a LocalCluster of N one-thread workers on loopback only
-    (closed with ``stack``)."""
+    (closed with ``stack``), over TLS with credentials made for it alone (distributed's
+    ``Security.temporary``): a scheduler on loopback is reachable by every user of the machine, and a Dask
+    client runs code on the workers as their user, so only this process may be one. A remote ``tcp://``
+    scheduler takes any client that reaches it: one line says so (use ``tls://`` with certificates)."""
     dd = dask_distributed()
     if address.startswith("local:"):
         try:
@@ -56,20 +59,32 @@ def connect(address: str, stack: ExitStack):
             n = 0
         if n < 1:
             raise OptionError(f"--cluster local:N needs N >= 1 workers (got {address!r})")
+        try:
+            security = dd.Security.temporary()  # a CA and a key for this cluster only, in memory
+        except ImportError:
+            raise OptionError('--cluster local:N needs the cryptography package: pip install -e ".[cluster]"') from None
         cluster = stack.enter_context(
             dd.LocalCluster(
                 n_workers=n,
                 threads_per_worker=1,
                 processes=True,
                 host=LOOPBACK,
+                protocol="tls://",
+                security=security,
                 dashboard_address=f"{LOOPBACK}:0",
                 resources={TIMING: 1},
             )
         )
-        return stack.enter_context(dd.Client(cluster))
+        return stack.enter_context(dd.Client(cluster, security=security))
     if "://" not in address:
         raise OptionError(
             f"--cluster must be a scheduler address such as tcp://host:8786, or local:N (got {address!r})"
+        )
+    if address.startswith("tcp://") and stream is not None:
+        print(
+            f"--cluster {address}: a tcp:// scheduler runs the code of any client that reaches it, as its workers' "
+            "user; secure it with tls:// and certificates (docs/store.md, 'Sweeps on a Dask cluster')",
+            file=stream,
         )
     try:
         return stack.enter_context(dd.Client(address, timeout="30s"))
@@ -108,8 +123,8 @@ class DaskExecutor(Executor):
         self.slots = max(len(worker_resources(client)), 1)
         self.finished = dask_distributed().as_completed()
 
-    def key(self, spec, commit):
-        return _unplaced(spec.solver, spec.threads, spec.scene, spec.preset, commit, spec.pair_loop)
+    def key(self, spec, code):
+        return _unplaced(spec.solver, spec.threads, spec.scene, spec.preset, code, spec.pair_loop)
 
     def row_key(self, row):
         return _unplaced(
@@ -117,7 +132,7 @@ class DaskExecutor(Executor):
             row.get("threads", 1),
             row.get("scene") or {},
             row.get("preset", ""),
-            row.get("commit"),
+            row_code(row),
             row.get("pair_loop", ""),
         )
 
@@ -162,7 +177,7 @@ def cluster_sweep(
         rows = store.read_rows(results)
         specs = [s.resolved() for s in specs]
         with ExitStack() as stack:
-            client = connect(address, stack)
+            client = connect(address, stack, stream)
             print(f"pcabench: Dask dashboard at {client.dashboard_link}", file=stream, flush=True)
             workers = worker_resources(client)
             for need in {tuple(sorted(task_resources(s))) for s in specs}:
@@ -183,9 +198,9 @@ def cluster_sweep(
             )
 
 
-def _unplaced(solver, threads, scene, preset, commit, pair_loop) -> str:
+def _unplaced(solver, threads, scene, preset, code, pair_loop) -> str:
     """:func:`pcabench.spec.identity` without the machine: a cluster places a run on any worker."""
-    return identity(solver, int(threads or 1), scene, preset, "", commit or "", "", pair_loop)
+    return identity(solver, int(threads or 1), scene, preset, "", code or "", "", pair_loop)
 
 
 class Stores:

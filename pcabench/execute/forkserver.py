@@ -14,6 +14,7 @@ every run with ``PCABENCH_FORKSERVER=0``.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import multiprocessing
 import os
@@ -76,10 +77,27 @@ def prepare(specs: list) -> None:
         )
     os.environ[WARM] = "[" + ",".join(s.to_json() for s in variants.values()) + "]"
     try:
-        forkserver.ensure_running()
+        with terminal_signals_ignored():
+            forkserver.ensure_running()
         _server["started"] = True
     finally:
         del os.environ[WARM]
+
+
+@contextlib.contextmanager
+def terminal_signals_ignored():
+    """Within: SIGINT ignored, so that a server started here inherits it ignored from its first instant (a
+    disposition set to ignore survives fork and exec): a terminal's Ctrl-C reaches the whole foreground group,
+    and the sweep, not its server, is the one to answer it (the server, still importing, printed a
+    traceback). Its runs' children are in sessions of their own and ended by the sweep."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 class InheritedFd:
@@ -96,6 +114,7 @@ def _detach(dup) -> int:
     return dup.detach()
 
 
+LOST = 255  # a forked run's exit code when its server ended under it (multiprocessing's popen_forkserver: EOF)
 NAME = b"pcabench-run"  # a forked run's process name (/proc/PID/comm; ps and pgrep show it)
 
 
@@ -143,7 +162,8 @@ class ForkedChild:
         main = sys.modules["__main__"]
         sys.modules["__main__"] = types.ModuleType("__main__")  # the child has no main module to import again
         try:
-            self.process.start()
+            with terminal_signals_ignored():  # the server, if this starts it
+                self.process.start()
             _server["started"] = True
         finally:
             sys.modules["__main__"] = main

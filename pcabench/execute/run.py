@@ -30,10 +30,14 @@ FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.inte
 PROBE_SAMPLES = 1000  # the most readings a run records at each probe point (every few steps, evenly)
 
 
-def fields_problem(fields, n_particles: int) -> str:
+TIME_RTOL = 1e-6  # the fields' time against steps x dt (a sum of steps rounds at 1e-16 a step)
+
+
+def fields_problem(fields, n_particles: int, t_expected: float | None = None) -> str:
     """Why ``fields`` (solvers.interface.Fields) are not a run's result for ``n_particles`` ('' if they are; a
     scene's ``n_scored``: an open edge's layers are not in them): an array of another length, or values that
-    are not finite, or a time that is not."""
+    are not finite, or a time that is not, or (``t_expected``: the steps taken x dt, s) another time than the
+    steps reach: a solver's word for its own time is checked, never taken."""
     for name in FIELD_NAMES:
         values = np.asarray(getattr(fields, name))
         if values.shape != (n_particles,):
@@ -42,6 +46,8 @@ def fields_problem(fields, n_particles: int) -> str:
             return f"its field {name} holds values that are not finite numbers"
     if not math.isfinite(float(fields.t)) or fields.t < 0:
         return f"its time t = {fields.t!r} is not a finite time >= 0"
+    if t_expected is not None and not abs(float(fields.t) - t_expected) <= TIME_RTOL * max(t_expected, 1e-300):
+        return f"its time t = {float(fields.t):.9g} s is not the {t_expected:.9g} s its steps reach (steps x dt)"
     return ""
 
 
@@ -71,15 +77,34 @@ def reflected(scene, fields) -> dict:
 def score(record: RunRecord, scene, fields) -> RunRecord:
     """Score a run that finished its steps (``record``, status not ``unstable``) by its final ``fields``
     against the scene's exact solution: MSE, ME, the scene's other measures and the isothermal MSE, and the
-    status ``ok``; ``error`` naming the field if the fields are not one finite value per particle. The
+    status ``ok``. ``error`` with one line saying why where the fields are not one finite value per particle at
+    the time the record's steps reach, where scoring them raises, or where the error is not finite. The
     harness does this, never the solver: a run's errors are computed, not reported."""
-    why = fields_problem(fields, scene.n_scored)
+    why = fields_problem(fields, scene.n_scored, t_expected=record.steps * scene.dt)
+    bound = scene.blowup_factor * scene.mach * scene.c0  # what the run checks at every step (run)
+    speed = max(float(np.abs(fields.u).max(initial=0.0)), float(np.abs(fields.v).max(initial=0.0))) if not why else 0
+    if not why and speed > bound:
+        why = f"its velocity reaches {speed:.3g} m/s, past the bound the run checks at every step ({bound:.3g} m/s)"
+    if not why:
+        try:
+            _measure(record, scene, fields)
+        except Exception as exc:  # noqa: BLE001 - whatever the fields make the scorer do: this run's error
+            why = f"scoring its fields raised {type(exc).__name__}: {' '.join(str(exc).split())[:200]}"
+    if not why and (math.isinf(record.mse) or not math.isfinite(record.me)):  # (NaN: the exact field is 0 there)
+        why = f"its error is not a finite number (relative RMS {record.mse!r}, max {record.me!r})"
     if why:
         record.status, record.failed_step = "error", record.steps or None
+        record.mse = record.me = float("nan")
+        record.errors, record.probes, record.mse_isothermal = {}, {}, None
         record.message = (record.message + "\n" if record.message else "") + f"the run's result is not usable: {why}"
         return record
-    record.t_end = float(fields.t)
     record.status = "ok"
+    return record
+
+
+def _measure(record: RunRecord, scene, fields) -> None:
+    """The errors of fields that passed :func:`fields_problem`, into ``record``."""
+    record.t_end = float(fields.t)
     measures = dict(scene.kind.errors(scene, fields))  # against the scene's exact linear solution
     record.mse, record.me = measures.pop("mse"), measures.pop("me")
     record.errors = {**measures, **reflected(scene, fields)}  # open edges: what they sent back (linear runs)
@@ -87,7 +112,6 @@ def score(record: RunRecord, scene, fields) -> RunRecord:
         record.probes = {k: [float(f"{v:.6g}") for v in np.asarray(vals, float)] for k, vals in fields.probes.items()}
     if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
         record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
-    return record
 
 
 def save_fields(fields, path) -> None:

@@ -31,13 +31,13 @@ import time
 from pathlib import Path
 
 from pcabench import store
-from pcabench.execute import forkserver
+from pcabench.execute import containment, forkserver
 from pcabench.machine.memory import cgroup_memory_folders
 from pcabench.machine.profiles import MACHINE_ID_ENV, machine_id
 from pcabench.predict import predicted_seconds, row_variant, spec_variant
 from pcabench.spec import RunSpec, row_identity
 from pcabench.store import schema
-from pcabench.store.provenance import git_commit, host_id
+from pcabench.store.provenance import code_key, git_commit, host_id
 from pcabench.store.record import RunRecord, step_seconds
 
 RETRIED = ("timeout", "skipped", "error")  # statuses --retry-failed runs again
@@ -80,6 +80,7 @@ def exit_status(returncode: int, oom_before: int | None, oom_after: int | None) 
 
 RECORD_LIMIT = 1 << 20  # the most bytes a child's record may take on its channel
 OUTPUT_KEPT = 2000  # characters of a solver's stdout and stderr kept in its record's message
+DRAIN_S = 5.0  # after a run ends, how long its pipes may still be read (a process holding them past it is left)
 PROGRESS = re.compile(r"\r[^\r\n]*: step \d+/\d+ [^\r\n]*\n?")  # pcabench.execute.progress's lines
 
 
@@ -229,7 +230,9 @@ def end_group(proc) -> None:
     proc.kill()
 
 
-def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr, fields_to=None) -> dict:
+def run_child(
+    spec: RunSpec, timeout: float, commit: str, machine: str, stream=sys.stderr, fields_to=None, env=None
+) -> dict:
     """Run ``spec`` in a child process, relaying its progress to ``stream``; its record as a row.
 
     The child sends its record on a pipe of its own (``--record-fd``), never on stdout: whatever the solver
@@ -237,18 +240,21 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
     here (:func:`accept`): identity from ``spec``, ``commit`` and ``machine`` (the parent's
     :func:`~pcabench.machine.profiles.machine_id`), the child's measurements checked, the errors computed from its
     fields. The child's process group is ended when it does, and at once past ``timeout``. With ``fields_to``
-    the run's fields are kept there (an .npz, written as :mod:`pcabench.store.safeio` writes).
+    the run's fields are kept there (an .npz, written as :mod:`pcabench.store.safeio` writes). ``env``: variables
+    the child's environment adds. A run whose forkserver ended under it is run again in a fresh interpreter.
 
     Raises subprocess.TimeoutExpired (the child's group is killed first) past ``timeout`` seconds.
     """
     import tempfile
 
-    env = {**os.environ, "PCABENCH_COMMIT": commit, MACHINE_ID_ENV: machine}  # every run carries the sweep's
+    env = {**os.environ, **(env or {}), "PCABENCH_COMMIT": commit, MACHINE_ID_ENV: machine}  # the sweep's
     oom_before = oom_kills()
+    containment.become_subreaper()  # what the run starts and orphans is adopted here, and ended with the run
     with tempfile.TemporaryDirectory(prefix="pcabench-run-") as scratch:
         fields_path = Path(scratch) / "fields.npz"
         started = time.perf_counter()
         proc, stdout, stderr, read_end = start_child(spec, env, fields_path)
+        known = containment.children() | {proc.pid}  # this process's own (the forkserver's started by now)
         out, err, record = [], [], []
 
         def relay(text):  # the child's progress lines go on to the user
@@ -279,11 +285,15 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
             raise
         finally:
             end_group(proc)  # what the run left running (a plug-in's own processes) ends with it
+            containment.end_adopted(known)  # and what left its group (setsid): adopted here, ended
+            containment.stop_subreaper()
+            until = time.monotonic() + DRAIN_S
             for reader in readers:
-                if reader.is_alive() or reader.ident is not None:
-                    reader.join(timeout=5)
-            for f in (stdout, stderr):
-                f.close()
+                if reader.ident is not None:
+                    reader.join(timeout=max(until - time.monotonic(), 0.0))
+            for f, reader in zip((stdout, stderr), readers):
+                if not reader.is_alive():  # one still reading (a pipe held past the deadline) is left to end
+                    f.close()
             if stream is not None and err and not err[-1].endswith("\n"):
                 stream.write("\n")  # end the child's last progress line
         said = PROGRESS.sub("", "".join(err)).strip()  # stderr less the child's own progress lines
@@ -315,6 +325,14 @@ def run_child(spec: RunSpec, timeout: float, commit: str, machine: str, stream=s
                 return store.to_row(accepted)
             what = what or "its record is not a JSON object"
         else:
+            if isinstance(proc, forkserver.ForkedChild) and proc.returncode == forkserver.LOST and not data:
+                # the server it was forked from ended under it (killed): not the run's doing, so run it again in
+                # a fresh interpreter with what is left of its budget (the next runs start a new server)
+                if stream is not None:
+                    print(f"{spec.label}: its forkserver ended under it; run again in a fresh interpreter", file=stream)
+                left = timeout - (time.perf_counter() - started)
+                env_fresh = {forkserver.ENV: "0"}
+                return run_child(spec, left, commit, machine, stream, fields_to, env=env_fresh)
             status, what = exit_status(proc.returncode, oom_before, oom_kills())
             if proc.returncode == 0:
                 what = "it sent no record"
@@ -371,8 +389,8 @@ class Executor(abc.ABC):
     whose = "this host's"  # whose timings the predictions come from, for the progress line
 
     @abc.abstractmethod
-    def key(self, spec: RunSpec, commit: str) -> str:
-        """The spec's store key (:func:`~pcabench.spec.identity`) as this executor places runs."""
+    def key(self, spec: RunSpec, code: str) -> str:
+        """The spec's store key (:func:`~pcabench.spec.identity`) by ``code`` as this executor places runs."""
 
     @abc.abstractmethod
     def row_key(self, row: dict) -> str:
@@ -399,8 +417,8 @@ class LocalExecutor(Executor):
         self.machine, self.host, self.commit, self.stream = machine, host, commit, stream
         self.runner, self.pending = runner or run_child, []
 
-    def key(self, spec, commit):
-        return spec.key(self.machine, commit, self.host)
+    def key(self, spec, code):
+        return spec.key(self.machine, code, self.host)
 
     def row_key(self, row):
         return row_identity(row)
@@ -454,14 +472,14 @@ def run_specs(
     (``predict.py``, updated as runs finish); one predicted past ``run_budget`` is stored as ``skipped``.
     No run starts after ``sweep_budget`` seconds; one the budget cuts short is not stored.
     """
-    commit, machine = git_commit(), machine_id()
+    code, machine = code_key(), machine_id()  # the code this sweep's runs are made by: another's are not done
     done = {executor.row_key(r) for r in rows if not (retry_failed and r.get("status") in RETRIED)}
     known = [r for r in rows if executor.informs(r)]
     specs = list(dict.fromkeys(s.resolved() for s in specs))
     labels = {s: f"[{i}/{len(specs)}] {s.label}" for i, s in enumerate(specs, 1)}
     queue = []
     for spec in specs:
-        if executor.key(spec, commit) in done:
+        if executor.key(spec, code) in done:
             print(f"{labels[spec]}: already stored", file=stream, flush=True)
         else:
             queue.append(spec)

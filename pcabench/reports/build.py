@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pandas as pd
+
 from pcabench import store
 from pcabench.errors import NoResults
 from pcabench.machine import profiles
@@ -52,14 +54,21 @@ def report_for(ctx: Context) -> Path:
     for stale in set(out.glob("*.png")) - set(figs):  # a figure whose data is gone is not left behind
         stale.unlink()
     counts = df.status.value_counts().to_dict()
-    commits = sorted({c[:12] + ("+dirty" if c.endswith("+dirty") else "") for c in df.commit.astype(str)})
+    codes = df.code.fillna("").astype(str) if "code" in df else pd.Series("", index=df.index)
+    commits = sorted(
+        {
+            c[:12] + ("+dirty" if c.endswith("+dirty") else "") + (f" (code {k[:8]})" if k else "")
+            for c, k in zip(df.commit.astype(str), codes)
+        }
+    )
     hosts = sorted({str(h) for h in df.host.fillna("") if h}) or ["not recorded"]
     lines = [
         f"# pcabench report: {ctx.name}",
         "",
         f"Machine: {_machine(ctx.pid)}; host {', '.join(hosts)}.",
         "",
-        f"Runs: {len(df)} ({', '.join(f'{v} {k}' for k, v in sorted(counts.items()))}); commits: "
+        f"Runs: {len(df)} ({', '.join(f'{v} {k}' for k, v in sorted(counts.items()))}); commits (with the code "
+        "key that made their runs, where recorded): "
         f'{", ".join(commits)}. Every row below is from this machine (a table headed "across machines" names '
         "the other one) and names its protocol; Table 4 names the commit of each row. Regenerate with "
         "`pcabench report`.",

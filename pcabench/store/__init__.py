@@ -29,9 +29,9 @@ writer at a time.
   is skipped with one warning.
 - Stores taken on different machines merge by concatenation: a record keeps
   its ``run_id`` wherever it is copied, and copies are one run on load. Two
-  different records under one ``run_id``: the later write wins (the later
-  timestamp; at equal ones the one read later), with one warning naming both
-  files and lines (:func:`read_records`).
+  different records under one ``run_id``: the later write in the store's order
+  wins (the one read later, never by the rows' own timestamps), with one
+  warning naming both files and lines (:func:`read_records`).
 - Readers take the typed record (:meth:`pcabench.store.record.RunRecord.from_row`):
   the schema's fields only, so a key the schema does not know never reaches
   a table.
@@ -39,7 +39,6 @@ writer at a time.
 
 from __future__ import annotations
 
-import datetime as _dt
 import errno
 import fcntl
 import hashlib
@@ -53,7 +52,7 @@ import time
 import warnings
 from pathlib import Path
 
-from pcabench.errors import StoreError  # noqa: F401 - raised here, re-exported for callers
+from pcabench.errors import StoreError, StoreFull  # noqa: F401 - raised here, re-exported for callers
 from pcabench.store import schema
 from pcabench.store.schema import SCHEMA
 from solvers import Scene, SceneError
@@ -160,7 +159,7 @@ def check_writable(path) -> Path:
         raise StoreError(f"results store {path} is not writable: {exc.strerror or exc}") from None
     free = shutil.disk_usage(path.parent).free
     if free < MIN_FREE_BYTES:
-        raise StoreError(
+        raise StoreFull(
             f"results store {path}: only {free} bytes free on its file system (need at least {MIN_FREE_BYTES})"
         )
     return path
@@ -313,10 +312,10 @@ def append(record, path, held: int | None = None) -> dict:
         raise
     except OSError as exc:
         if exc.errno in FULL:
-            raise StoreError(f"results store {path}: the disk is full; the record was not stored") from None
+            raise StoreFull(f"results store {path}: the disk is full; the record was not stored") from None
         raise StoreError(f"results store {path} is not writable: {exc.strerror or exc}") from None
     if freed:
-        raise StoreError(
+        raise StoreFull(
             f"results store {path}: the disk is full; this run's record was stored in the space "
             "kept for it, and the sweep stops: free some space and rerun to resume"
         )
@@ -423,12 +422,35 @@ def validate(row) -> str:
         return why
     fields = Scene.__dataclass_fields__
     try:
-        Scene(
+        scene = Scene(
             **{k: v for k, v in row["scene"].items() if k in fields and fields[k].compare},
             memory_limit_bytes=sys.maxsize,
         )
     except (SceneError, TypeError, ValueError, OverflowError) as exc:
         return f"'scene' is not a valid scene ({exc})"
+    return derived_problem(row, scene)
+
+
+def derived_problem(row: dict, scene: Scene) -> str:
+    """Why a row's derived fields do not follow from its scene ('' if they do): the particle count, the steps
+    asked and taken, the precision, model, integrator and dx, each against the scene the row stores (its own
+    derived keys, and the scene rebuilt: a row's particle count is the scene's, never its own word)."""
+    stored = row["scene"]
+    n = stored.get("n_particles", scene.n_particles)
+    if row["n_particles"] != n:
+        return f"'n_particles' {row['n_particles']} is not its scene's {n}"
+    # open edges whose layer width was left to the absorber's default: that default changed (issue 41), so such
+    # a row's count is its scene's stored one, not today's rebuild
+    if not (scene.open and stored.get("layer_width") is None) and scene.n_particles != n:
+        return f"'n_particles' {n} is not the {scene.n_particles} particles its scene's lattice holds"
+    n_steps = stored.get("n_steps", scene.n_steps)
+    if row.get("steps_requested") not in (None, 0, n_steps):
+        return f"'steps_requested' {row['steps_requested']} is not its scene's {n_steps} steps"
+    if not row["steps"] <= n_steps:
+        return f"'steps' {row['steps']} is more than its scene's {n_steps}"
+    for key in ("precision", "model", "integrator", "dx"):
+        if key in row and row[key] != getattr(scene, key):
+            return f"{key!r} {row[key]!r:.40} is not its scene's {getattr(scene, key)!r:.40}"
     return ""
 
 
@@ -462,15 +484,6 @@ def read_regular(path, limit: int = MAX_STORE_BYTES, follow: bool = False) -> by
         os.close(fd)
 
 
-def _when(timestamp: str) -> _dt.datetime:
-    """A record's timestamp as a time to compare (one without a zone is UTC; none at all, the earliest)."""
-    try:
-        when = _dt.datetime.fromisoformat(timestamp.replace("Z", "+00:00"))
-    except ValueError:
-        return _dt.datetime.min.replace(tzinfo=_dt.timezone.utc)
-    return when if when.tzinfo else when.replace(tzinfo=_dt.timezone.utc)
-
-
 def _canonical(record) -> str:
     return json.dumps(_clean(record.as_dict()), sort_keys=True, default=str)
 
@@ -481,9 +494,10 @@ def read_records(paths) -> list:
 
     A line that is not valid UTF-8, not JSON, not a record, or fails :func:`validate` is skipped with one
     StoreWarning naming its file and line. One ``run_id`` read twice with the same record (a store copied
-    into another) is one run. Read twice with different records, the later write wins: the later
-    ``timestamp``, and at equal timestamps the one read later (files in the order given, a folder's by name;
-    lines in their order, which is the order they were appended in); one StoreWarning names both places.
+    into another) is one run. Read twice with different records, the later write in the store's order wins:
+    the one read later (files in the order given, a folder's by name; lines in their order, which is the
+    order they were appended in), never by the rows' own ``timestamp`` (a row's word for itself: a copy
+    with a later one must not win); one StoreWarning names both places.
     """
     from pcabench.store.record import RunRecord
 
@@ -533,15 +547,13 @@ def read_records(paths) -> list:
                 first, first_where, first_form = kept[record.run_id]
                 if form == first_form:
                     continue  # the same record, copied
-                later = _when(record.timestamp) >= _when(first.timestamp)
-                warnings.warn(
+                warnings.warn(  # the store's order decides, never a row's word for its own time
                     f"run_id {record.run_id} is stored twice with different records, at {first_where} and "
-                    f"{where}; the later write ({where if later else first_where}) is kept",
+                    f"{where}; the later write in the store's order ({where}) is kept",
                     StoreWarning,
                     stacklevel=2,
                 )
-                if later:
-                    kept[record.run_id] = (record, where, form)
+                kept[record.run_id] = (record, where, form)
     return [record for record, _, _ in kept.values()]
 
 

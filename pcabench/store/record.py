@@ -46,6 +46,7 @@ class RunRecord:
     message: str = ""
     profile_id: str = ""
     commit: str = ""
+    code: str = ""  # provenance.code_key(): the code that made the run, by content ("" in older rows)
     versions: dict = field(default_factory=dict)
     preset: str = ""  # the study preset that asked for the run (quick, paper, stability, matrix), if any
     host: str = ""  # provenance.host_id(): which computer of this hardware profile made the run
@@ -77,7 +78,7 @@ class RunRecord:
     def from_spec(cls, spec, machine: str = "", status: str = "error", message: str = "") -> "RunRecord":
         """The record of the resolved RunSpec ``spec`` on machine ``machine`` before any step: no times, no
         errors, provenance filled."""
-        from pcabench.store.provenance import git_commit, host_id, package_versions
+        from pcabench.store.provenance import code_key, git_commit, host_id, package_versions
         from solvers import solver_class
 
         nan, scene = float("nan"), spec.scene
@@ -105,6 +106,7 @@ class RunRecord:
             message=message,
             profile_id=machine,
             commit=git_commit(),
+            code=code_key(),
             versions=package_versions(),
             preset=spec.preset,
             host=host_id(),
@@ -162,16 +164,20 @@ class RunRecord:
         (in the scene's primary field: u in m/s, drho in kg/m^3) and its status."""
         primary = scene.kind.primary
         unit = {"u": "m/s", "drho": "kg/m^3"}.get(primary, "")
+
+        def number(value, form: str) -> str:  # a measure a failed run never took: "-"
+            return "-" if value is None else format(value, form)
+
         lines = [
             self.stage_table(),
             f"particles        {self.n_particles:,}",
-            f"steps            {self.steps} (t = {self.t_end:.6g} s)",
+            f"steps            {self.steps} (t = {number(self.t_end, '.6g')} s)",
             f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
-            f"mean neighbours  {self.mean_neighbours:.2f}",
-            f"MSE (rel. RMS)   {self.mse:.6g}"
+            f"mean neighbours  {number(self.mean_neighbours, '.2f')}",
+            f"MSE (rel. RMS)   {number(self.mse, '.6g')}"
             + ("" if primary == "u" else f" of {primary}")
             + (" (against the pulse; once it has left, read the left measures below)" if scene.open else ""),
-            f"ME (max)         {self.me:.6g} {unit}",
+            f"ME (max)         {number(self.me, '.6g')} {unit}",
         ]
         lines += [f"{name.replace('_', ' '):<17}{value:.6g}" for name, value in self.errors.items()]
         if self.mse_isothermal is not None:

@@ -1,4 +1,5 @@
-"""Stored runs as tables (pandas): list and filter them, and compare two machines or two commits.
+"""Stored runs as tables (pandas): list and filter them, and compare two machines or two commits (a commit, or
+a code key: the code that made the runs, which tells apart two runs of one commit with edits between).
 
 pcabench runs --solver linkedlist-cpu --status ok
 pcabench runs --compare amd-epyc h100-80gb-hbm3__intel-xeon      # two machines
@@ -12,6 +13,7 @@ import pandas as pd
 COLUMNS = [
     "machine",
     "commit",
+    "code",
     "solver",
     "threads",
     "pair_loop",
@@ -51,6 +53,12 @@ def note(message: str, width: int = NOTE_WIDTH) -> str:
     return text if len(text) <= width else text[:width].rsplit(" ", 1)[0] + " ..."
 
 
+def _code(df: pd.DataFrame) -> pd.Series:
+    """Each run's code key (provenance.code_key: two runs of one commit made by different code differ here;
+    "" in rows older than it)."""
+    return (df.code if "code" in df else pd.Series("", index=df.index)).fillna("").astype(str)
+
+
 def table(df: pd.DataFrame, **filters) -> pd.DataFrame:
     """The runs of ``df`` (from :func:`pcabench.reports.frame.load`) as a readable table, filtered by column
     prefix matches (a machine by :func:`machines`). A run that made no step (skipped on its prediction, timed
@@ -63,6 +71,7 @@ def table(df: pd.DataFrame, **filters) -> pd.DataFrame:
         steps=df.steps.astype("Int64").where(stepped),
         mse=df.mse.where(stepped),
         commit=df.commit.astype(str).str[:7],
+        code=_code(df).str[:8].replace("", "-"),  # "-": a row older than the code key
         note=(df.message if "message" in df else pd.Series("", index=df.index))
         .fillna("")
         .astype(str)
@@ -95,7 +104,7 @@ def side(df: pd.DataFrame, key: str) -> tuple[str, pd.DataFrame]:
         raise KeyError(f"--compare: {key!r} is a prefix of several machines ({', '.join(hit)}): give more of one")
     if hit:
         return "machine", df[df.machine == hit[0]]
-    hit = df[df.commit.astype(str).str.startswith(key)]
+    hit = df[df.commit.astype(str).str.startswith(key) | (_code(df).str.startswith(key) & (len(key) >= 4))]
     return ("commit", hit) if not hit.empty else ("", hit)
 
 

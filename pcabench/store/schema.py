@@ -36,6 +36,7 @@ MAX_NAME = 100  # the longest name that becomes part of a file name (profile--ho
 MAX_TEXT = 200  # the longest short text (a version string, a named scene's string parameter)
 MAX_MESSAGE = 20_000  # a record's message (an error's traceback, a solver's output), cut to this
 NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*", re.ASCII)  # safe as a file name
+CODE_KEY = re.compile(r"[0-9a-f]{16}", re.ASCII)  # provenance.code_key
 COMMIT = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+-]*", re.ASCII)  # a sha, with +dirty; or a tag
 TIMESTAMP = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d+)?([+-]\d\d:\d\d|Z)?", re.ASCII)
 CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f]")
@@ -109,6 +110,7 @@ FIELDS: dict[str, Field] = {
     "profile_id": _name(required=True, empty=False, path=True),
     "host": _name(max_len=64, path=True),
     "commit": Field(("str",), pattern=COMMIT, max_len=64, form="letters, digits, '.', '_', '+', '-'"),
+    "code": Field(("str",), pattern=CODE_KEY, max_len=16, form="16 hexadecimal digits (provenance.code_key)"),
     "versions": Field(("dict",)),
     "preset": _name(max_len=32),
     "timestamp": Field(("str",), pattern=TIMESTAMP, max_len=40, form="of the form YYYY-MM-DDTHH:MM:SS+00:00"),
