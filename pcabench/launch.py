@@ -13,25 +13,43 @@ class _Terminated(BaseException):
     """SIGTERM while the harness is being imported (cli's own handler is not installed yet)."""
 
 
+_got = {"signal": None}  # the signal that arrived during the import (a C extension's import turns the
+# exception its handler raises into an ImportError: the flag says what it was)
+
+
 def _terminated(signum, frame):
+    _got["signal"] = signal.SIGTERM
     raise _Terminated
+
+
+def _interrupted(signum, frame):
+    _got["signal"] = signal.SIGINT
+    raise KeyboardInterrupt
+
+
+def _said(signum) -> int:
+    if signum == signal.SIGTERM:
+        sys.stderr.write("pcabench: terminated\n")
+        return 143  # cli.exits.EXIT_TERMINATED: a SIGTERM is not a Ctrl-C, from the first instant
+    sys.stderr.write("pcabench: interrupted\n")
+    return 130  # cli.exits.EXIT_INTERRUPTED (not imported: the import is what was interrupted)
 
 
 def main() -> int:
     before = signal.signal(signal.SIGTERM, _terminated)  # kept until cli.main installs its own
+    before_int = signal.signal(signal.SIGINT, _interrupted)
     try:
         from pcabench.cli import main as cli_main
-    except KeyboardInterrupt:
-        sys.stderr.write("pcabench: interrupted\n")
-        return 130  # cli.exits.EXIT_INTERRUPTED (not imported: the import is what was interrupted)
-    except _Terminated:
-        sys.stderr.write("pcabench: terminated\n")
-        return 143  # cli.exits.EXIT_TERMINATED: a SIGTERM is not a Ctrl-C, from the first instant
+    except BaseException:  # noqa: BLE001 - a signal during the import, whatever the import made of it
+        if _got["signal"] is None:
+            raise
+        return _said(_got["signal"])
+    finally:
+        signal.signal(signal.SIGINT, before_int)
     try:
         return cli_main()
     except _Terminated:  # in the instant before cli.main's handler
-        sys.stderr.write("pcabench: terminated\n")
-        return 143
+        return _said(signal.SIGTERM)
     finally:
         signal.signal(signal.SIGTERM, before)
 

@@ -261,9 +261,15 @@ class Scene:
                 f"{'x-periodic' if self.periodic_x else 'walled'} {self.name} scene (got {self.width:.6g} m)",
             )
         breaking = self.kind.breaking_time(self)
+        # the end time the user set: --t-end, or --steps of dt = --cfl x --dx / c0 (the options it comes from)
+        ends = (
+            f"--t-end {self.t_end:g}"
+            if self.t_end is not None
+            else f"--steps {self.n_steps} x dt (--cfl {self.cfl:g} x --dx {self.dx:g} / c0) = {self.t_final:g} s"
+        )
         need(
             self.model == "linear" or self.t_final < breaking,
-            f"--t-end: t = {self.t_final:g} s passes the pulse's nonlinear breaking time {breaking:.3g} s at "
+            f"{ends}: the run passes the pulse's nonlinear breaking time {breaking:.3g} s at "
             f"--mach {self.mach:g}, --pulse-width {self.pulse_width:g} m (the isothermal solution has a shock "
             f"there): end earlier, lower --mach, or use the linear model",
         )

@@ -103,6 +103,21 @@ def test_predictor_fits_the_power_law_and_extrapolates():
     assert predicted_seconds(ll, [dict(one[0], status="error")]) == (None, "")
 
 
+def test_the_eta_counts_only_the_runs_that_will_run():
+    """A run predicted past the run budget will be skipped: the ETA counts nothing for it and says so (it said
+    12.9 minutes with one left, counting a run the sweep then skipped)."""
+    from pcabench.execute.sweep import eta_text
+
+    rows = [_ok_row("allpair-cpu", dx, 1e-3 * (1.0 / dx) ** 4) for dx in (1.0, 0.5, 0.25)]  # t ~ N^2
+    small = RunSpec("allpair-cpu", Scene(dx=1.0, steps=10))
+    huge = RunSpec("allpair-cpu", Scene(dx=0.0625, steps=10))  # predicted 655 s
+    quick = predicted_seconds(small, rows)[0]
+    text = eta_text([small, huge], rows, None, run_budget=60.0)
+    said = f"eta {quick / 60:.1f} min (1 of 1 runs predicted from this host's timings; 1 to be skipped past the "
+    assert text == said + "run budget)", text
+    assert f"{(quick + predicted_seconds(huge, rows)[0]) / 60:.1f} min" in eta_text([small, huge], rows, None)
+
+
 # ---------------------------------------------------------------- the clock and step time
 def test_host_clock_books_each_operation_to_its_stage():
     clock = HostClock()

@@ -38,6 +38,7 @@ from pcabench.cli.options import (
 from pcabench.cli.parsers import build_parser
 from pcabench.cli.study import study_specs  # noqa: F401 - the package's face
 from pcabench.errors import NoResults, StoreFull
+from pcabench.execute.progress import end_line
 from pcabench.parser import EXIT_BAD_INPUT, Parser
 from pcabench.spec import OptionError
 from pcabench.store import StoreError
@@ -87,8 +88,10 @@ def main(argv=None) -> int:
     except NoResults as exc:
         parser.exit(EXIT_NO_RESULTS, f"{prog}: {exc}\n")
     except KeyboardInterrupt:
+        end_line()  # not on the progress line
         parser.exit(EXIT_INTERRUPTED, f"{prog}: interrupted\n")
     except Terminated:
+        end_line()
         parser.exit(EXIT_TERMINATED, f"{prog}: terminated\n")
     finally:
         warnings.formatwarning = shown

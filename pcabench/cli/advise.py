@@ -23,9 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from pcabench import jsonout, paths
+from pcabench import jsonout
 from pcabench.cli.accuracy import ROUNDED_AS_PRINTED
 from pcabench.cli.exits import EXIT_OK, EXIT_RUN_FAILED
+from pcabench.cli.options import results_of
 from pcabench.errors import NoResults
 from pcabench.predict.methods import HIGH_ORDER_SHARES, high_order_methods, step_weight
 from pcabench.predict.stability import assess, e_foldings, scene_limit
@@ -474,7 +475,7 @@ def cmd_advise(args) -> int:
         raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
     if not args.t_end > 0:
         raise OptionError(f"--t-end is a physical time in s, > 0 (got {args.t_end:g})")
-    results = paths.reference_results() if args.reference else Path(args.results or paths.user_results())
+    results = results_of(args)
     df = load_frame(results) if results is not None and Path(results).exists() else None
     if df is not None and not df.empty:
         import numpy as np

@@ -328,3 +328,15 @@ def option_words(message: str) -> str:
     for name, option in OPTION_NAMES.items():
         message = re.sub(rf"(?<![\w-]){name}\b", option, message)
     return re.sub(rf"^({'|'.join(LEADING_OPTIONS)})\b", r"--\1", message)
+
+
+def results_of(args):
+    """The results folder ``--results`` or ``--reference`` names (else the user's); both: one line (which one
+    was meant is not for the command to guess)."""
+    from pcabench import paths
+
+    if getattr(args, "reference", False) and getattr(args, "results", None):
+        raise OptionError("--reference and --results each name a results folder: give one of them")
+    if getattr(args, "reference", False):
+        return paths.reference_results()
+    return Path(args.results) if args.results else paths.user_results()

@@ -57,7 +57,16 @@ def build_parser() -> argparse.ArgumentParser:
         type=number("--strip-height"),
         help="replace the 20 m height by a y-periodic strip of this height, m",
     )
-    p.add_argument("--fields", help="write the final fields (x, y, u, v, drho, t) to this .npz")
+    p.add_argument(
+        "--fields",
+        help="write the final fields (x, y, u, v, drho, t) to this .npz (a folder: a file named by the run in it)",
+    )
+    p.add_argument(
+        "--store",
+        action="store_true",
+        help="keep the run's record in the results store (as a study does), so `runs` and `advise` see it",
+    )
+    p.add_argument("--results", type=folder("--results"), help=f"with --store: {results_help}")
     p.add_argument("--json", action="store_true", help="print exactly one JSON object on stdout")
     p.add_argument("--quiet", action="store_true", help="no progress on stderr")
     p.add_argument(
@@ -248,4 +257,5 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--clear", action="store_true", help="remove every compiled loop (all targets)")
     p.add_argument("--json", action="store_true", help="one JSON object: root, target, entries")
     p.set_defaults(func=cmd_cache)
+    parser.subcommands = dict(sub.choices)  # an unknown option is its subcommand's error
     return parser

@@ -7,7 +7,7 @@ import warnings
 from pathlib import Path
 
 from pcabench import paths
-from pcabench.cli.options import check_folder, home_option
+from pcabench.cli.options import check_folder, home_option, results_of
 from pcabench.errors import NoResults
 from pcabench.spec import OptionError
 
@@ -27,6 +27,34 @@ def cmd_report(args) -> int:
     return 0
 
 
+def check_filters(args, df, results) -> None:
+    """Each filter of ``runs`` names something the store can hold: a status a run ends in, a scene, solver and
+    model this installation knows, a machine or commit (or code key) prefix of the store's; else one line
+    naming the option and what it may be (a filter that matches nothing by a typo is not "no runs")."""
+    from pcabench.store import runs
+    from pcabench.store.schema import STATUSES
+    from solvers import MODELS, scene_names, solver_names
+
+    for option, value, allowed in (
+        ("--status", args.status, STATUSES),
+        ("--scene", args.scene, scene_names()),
+        ("--solver", args.solver, solver_names()),
+        ("--model", args.model, MODELS),
+    ):
+        if value and not any(str(a).startswith(value) for a in allowed):
+            raise OptionError(f"{option} {value!r} is none of {', '.join(map(str, allowed))}")
+    if args.machine and not runs.machines(df.machine, args.machine):
+        raise OptionError(
+            f"--machine {args.machine!r} is no machine of {results} (its machines: "
+            f"{', '.join(sorted(set(df.machine)))})"
+        )
+    codes = df.code.fillna("").astype(str) if "code" in df else df.commit.astype(str)
+    if args.commit and not (
+        df.commit.astype(str).str.startswith(args.commit).any() or codes.str.startswith(args.commit).any()
+    ):
+        raise OptionError(f"--commit {args.commit!r} is the prefix of no commit or code key of {results}")
+
+
 def cmd_runs(args) -> int:
 
     import pandas as pd
@@ -34,12 +62,13 @@ def cmd_runs(args) -> int:
     from pcabench.reports.frame import load
     from pcabench.store import runs
 
-    results = args.results or (paths.reference_results() if args.reference else paths.user_results())
+    results = results_of(args)
     with warnings.catch_warnings():
         warnings.simplefilter("default")
         df = load(results)
     if df.empty:
         raise NoResults(f"no stored runs in {results}: run `pcabench study` first, or use --reference")
+    check_filters(args, df, results)
     if args.scene:
         df = df[df.scene == args.scene]
     with pd.option_context("display.max_columns", None, "display.width", 200):

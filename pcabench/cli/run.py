@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 from pcabench import jsonout
 from pcabench.cli.exits import EXIT_OK, EXIT_RUN_FAILED
@@ -23,11 +24,21 @@ def cmd_run(args) -> int:
     # resolved once, and checked: the solver can run here (a GPU for a GPU solver), before anything is printed
     (spec,) = check_specs([RunSpec(args.solver, scene, args.threads or SERIAL, pair_loop=args.pair_loop or "auto")])
     if args.fields is not None:
-        if args.fields.strip() and not args.fields.endswith((".npz", "/")):
+        if args.fields.strip() and (args.fields.endswith("/") or Path(args.fields).is_dir()):
+            args.fields = str(Path(args.fields) / fields_name(spec))  # a folder: a file named by the run in it
+        elif args.fields.strip() and not args.fields.endswith(".npz"):
             args.fields += ".npz"  # as numpy.savez names it
         check_output_path(args.fields, "--fields")
     if args.run_budget is not None and not args.run_budget > 0:
         raise OptionError(f"--run-budget must be > 0 seconds (got {args.run_budget})")
+    if args.results is not None and not args.store:
+        raise OptionError("--results names where --store keeps the run: give --store too")
+    store_path = None
+    if args.store:  # checked before the run: a record with nowhere to go is found out first
+        from pcabench import paths
+        from pcabench.store import check_writable, store_name
+
+        store_path = check_writable(Path(args.results or paths.user_results()) / store_name(machine_id()))
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
     if args.run_budget is not None:  # in a child, as a sweep runs it: the budget holds whatever the solver does
@@ -36,11 +47,25 @@ def cmd_run(args) -> int:
         progress = None if args.quiet else Progress(args.solver)
         with solver_output_to_stderr(args.json):
             record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
+    if store_path is not None:
+        from pcabench.store import append
+
+        append(record, store_path)
     if args.json:  # the record as a store holds it: the whole scene, so the run can be made again from it
         jsonout.emit(jsonout.dumps(to_row(record)))  # strict JSON: null, never NaN
     else:
         print(record.text(scene))
+    went = [("fields", args.fields)] if args.fields and Path(args.fields).is_file() else []
+    went += [("record", store_path)] if store_path is not None else []
+    for what, path in went:  # where they went (on stderr beside --json's one object)
+        print(f"{what:<17}{path}", file=sys.stderr if args.json else sys.stdout)
     return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
+
+
+def fields_name(spec: RunSpec) -> str:
+    """The file a run's fields take in a folder given to --fields: solver, scene, dx, model, steps."""
+    s = spec.scene
+    return f"{spec.solver}_{s.name}_dx{s.dx:g}_{s.model}_{s.n_steps}steps.npz"
 
 
 def run_in_child(spec: RunSpec, args):

@@ -61,7 +61,9 @@ def run_study(
     from pcabench.store import check_writable, store_name
 
     if cluster:
-        from pcabench.execute.cluster import cluster_sweep, dask_distributed
+        from pcabench.execute.cluster import check_address, cluster_sweep, dask_distributed
+
+        check_address(cluster)  # before the header: a bad address is one line, nothing printed first
 
         dask_distributed()  # one line naming the extra, before anything else
         print(

@@ -45,13 +45,9 @@ def dask_distributed():
     return dask.distributed
 
 
-def connect(address: str, stack: ExitStack, stream=sys.stderr):
-    """A Client for ``address``: ``local:N`` starts a LocalCluster of N one-thread workers on loopback only
-    (closed with ``stack``), over TLS with credentials made for it alone (distributed's
-    ``Security.temporary``): a scheduler on loopback is reachable by every user of the machine, and a Dask
-    client runs code on the workers as their user, so only this process may be one. A remote ``tcp://``
-    scheduler takes any client that reaches it: one line says so (use ``tls://`` with certificates)."""
-    dd = dask_distributed()
+def check_address(address: str) -> None:
+    """One line (OptionError) unless ``address`` is ``local:N`` (N >= 1) or a scheduler's ``proto://host:port``:
+    checked before anything is printed or started."""
     if address.startswith("local:"):
         try:
             n = int(address.split(":", 1)[1])
@@ -59,6 +55,22 @@ def connect(address: str, stack: ExitStack, stream=sys.stderr):
             n = 0
         if n < 1:
             raise OptionError(f"--cluster local:N needs N >= 1 workers (got {address!r})")
+    elif "://" not in address:
+        raise OptionError(
+            f"--cluster must be a scheduler address such as tcp://host:8786, or local:N (got {address!r})"
+        )
+
+
+def connect(address: str, stack: ExitStack, stream=sys.stderr):
+    """A Client for ``address``: ``local:N`` starts a LocalCluster of N one-thread workers on loopback only
+    (closed with ``stack``), over TLS with credentials made for it alone (distributed's
+    ``Security.temporary``): a scheduler on loopback is reachable by every user of the machine, and a Dask
+    client runs code on the workers as their user, so only this process may be one. A remote ``tcp://``
+    scheduler takes any client that reaches it: one line says so (use ``tls://`` with certificates)."""
+    dd = dask_distributed()
+    check_address(address)
+    if address.startswith("local:"):
+        n = int(address.split(":", 1)[1])
         try:
             security = dd.Security.temporary()  # a CA and a key for this cluster only, in memory
         except ImportError:
@@ -76,10 +88,6 @@ def connect(address: str, stack: ExitStack, stream=sys.stderr):
             )
         )
         return stack.enter_context(dd.Client(cluster, security=security))
-    if "://" not in address:
-        raise OptionError(
-            f"--cluster must be a scheduler address such as tcp://host:8786, or local:N (got {address!r})"
-        )
     if address.startswith("tcp://") and stream is not None:
         print(
             f"--cluster {address}: a tcp:// scheduler runs the code of any client that reaches it, as its workers' "

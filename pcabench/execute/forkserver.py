@@ -14,7 +14,6 @@ every run with ``PCABENCH_FORKSERVER=0``.
 
 from __future__ import annotations
 
-import contextlib
 import ctypes
 import multiprocessing
 import os
@@ -65,7 +64,6 @@ def usable(env: dict) -> bool:
 def prepare(specs: list) -> None:
     """Start the server for a sweep of ``specs``, warmed with their compiled loops where the disk cache has
     them (:func:`pcabench.execute.preload.warm`); a server this process started before stays as it is."""
-    from multiprocessing import forkserver
 
     if not usable(dict(os.environ)) or _server.get("started"):
         return
@@ -77,25 +75,26 @@ def prepare(specs: list) -> None:
         )
     os.environ[WARM] = "[" + ",".join(s.to_json() for s in variants.values()) + "]"
     try:
-        with terminal_signals_ignored():
-            forkserver.ensure_running()
+        start_server()
         _server["started"] = True
     finally:
         del os.environ[WARM]
 
 
-@contextlib.contextmanager
-def terminal_signals_ignored():
-    """Within: SIGINT ignored, so that a server started here inherits it ignored from its first instant (a
-    disposition set to ignore survives fork and exec): a terminal's Ctrl-C reaches the whole foreground group,
-    and the sweep, not its server, is the one to answer it (the server, still importing, printed a
-    traceback). Its runs' children are in sessions of their own and ended by the sweep."""
+def start_server() -> None:
+    """multiprocessing's forkserver started if it is not running, with SIGINT ignored from its first instant:
+    ignored only while it is spawned (a disposition set to ignore survives fork and exec, a blocked mask does
+    not survive multiprocessing's spawn), a few milliseconds, not while it imports (its start does not wait for
+    that). A terminal's Ctrl-C reaches the whole foreground group: the sweep, not its server, answers it (the
+    server, still importing, printed a traceback). The runs' children are in sessions of their own."""
+    from multiprocessing import forkserver
+
     if threading.current_thread() is not threading.main_thread():
-        yield
+        forkserver.ensure_running()
         return
     before = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        yield
+        forkserver.ensure_running()
     finally:
         signal.signal(signal.SIGINT, before)
 
@@ -162,8 +161,8 @@ class ForkedChild:
         main = sys.modules["__main__"]
         sys.modules["__main__"] = types.ModuleType("__main__")  # the child has no main module to import again
         try:
-            with terminal_signals_ignored():  # the server, if this starts it
-                self.process.start()
+            start_server()  # if not running: SIGINT ignored from its start (the start below would spawn it plain)
+            self.process.start()
             _server["started"] = True
         finally:
             sys.modules["__main__"] = main

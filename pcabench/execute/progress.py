@@ -5,6 +5,16 @@ from __future__ import annotations
 import sys
 import time
 
+OPEN = {"line": False}  # whether a progress line is on the terminal without its newline yet
+
+
+def end_line(stream=sys.stderr) -> None:
+    """End a progress line left open (a Ctrl-C mid-run): what is printed next starts on a line of its own."""
+    if OPEN["line"]:
+        stream.write("\n")
+        stream.flush()
+        OPEN["line"] = False
+
 
 class Progress:
     """Step progress on stderr, at most every ``every`` seconds, with an ETA."""
@@ -23,6 +33,8 @@ class Progress:
         self.last = now
         eta = (now - self.t0) / max(done, 1) * (total - done)
         self.stream.write(f"\r{self.label}: step {done}/{total} ({100 * done / total:5.1f} %), eta {eta:6.1f} s ")
+        OPEN["line"] = self.stream is sys.stderr
         if done == total:
             self.stream.write("\n")
+            OPEN["line"] = False
         self.stream.flush()

@@ -359,9 +359,14 @@ def error_words(row: dict) -> str:
 
 
 def eta_text(
-    remaining: list[RunSpec], mine: list[dict], seconds_per_run: float | None, whose: str = "this host's"
+    remaining: list[RunSpec],
+    mine: list[dict],
+    seconds_per_run: float | None,
+    whose: str = "this host's",
+    run_budget: float = math.inf,
 ) -> str:
-    """The sweep's ETA and how sure it is: runs predicted from ``whose`` timings, the rest at the mean so far."""
+    """The sweep's ETA and how sure it is: runs predicted from ``whose`` timings, the rest at the mean so far;
+    a run predicted past ``run_budget`` counts nothing (the sweep will skip it, as it skips it then)."""
     if not remaining:
         return "done"
     compiled = {row_variant(r) for r in mine}  # configurations whose loops the cache holds by then
@@ -369,14 +374,17 @@ def eta_text(
     for s in remaining:
         predicted.append(predicted_seconds(s, mine, cached=spec_variant(s) in compiled)[0])
         compiled.add(spec_variant(s))
-    known = [p for p in predicted if p is not None]
-    unknown = len(predicted) - len(known)
+    skipped = sum(1 for p in predicted if p is not None and p > run_budget)
+    known = [p for p in predicted if p is not None and p <= run_budget]
+    unknown = len(predicted) - len(known) - skipped
+    to_run = len(remaining) - skipped
     if unknown and seconds_per_run is None:
-        return f"eta unknown ({len(remaining)} runs left, {len(known)} predicted)"
-    total = sum(known) + unknown * (seconds_per_run or 0.0)
-    how = f"{len(known)} of {len(remaining)} runs predicted from {whose} timings" + (
+        return f"eta unknown ({to_run} runs left, {len(known)} predicted)"
+    total = sum(known) + unknown * min(seconds_per_run or 0.0, run_budget)
+    how = f"{len(known)} of {to_run} runs predicted from {whose} timings" + (
         f", {unknown} at the mean so far" if unknown else ""
     )
+    how += f"; {skipped} to be skipped past the run budget" if skipped else ""
     return f"eta {total / 60:.1f} min ({how})"
 
 
@@ -533,7 +541,7 @@ def run_specs(
         print(
             f"{labels[spec]}{where}: {row['status']}, step {1e3 * step_seconds(row['stages'], row['steps']):.2f} "
             f"ms, {error_words(row)} | sweep: {len(stored)}/{n_todo} done, "
-            f"{running} running, {failed} not ok, {eta_text(queue, known, per_run, executor.whose)}",
+            f"{running} running, {failed} not ok, {eta_text(queue, known, per_run, executor.whose, run_budget)}",
             file=stream,
             flush=True,
         )

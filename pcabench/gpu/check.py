@@ -72,6 +72,7 @@ from pcabench.gpu.plan import FULL, REHEARSAL, Budget, Plan
 from pcabench.gpu.sweeps import cpu_peer_specs, gpu_specs, run_and_release
 from pcabench.gpu.tables import markdown
 from pcabench.gpu.tools import ncu_command, run_logged
+from pcabench.spec import OptionError
 from pcabench.store import store_name
 from pcabench.store.safeio import fresh, own_folder, write_file
 from solvers import PRECISIONS
@@ -273,6 +274,21 @@ def run_stage(stage: Stage, c: Check) -> None:
 
 
 # ---------------------------------------------------------------- the check
+TOOLS = {"asv": "asv", "pytest": "pytest-gpu", "pytest_benchmark": "bench"}  # module -> the stage that runs it
+
+
+def missing_tools() -> list[str]:
+    """The Python tools a stage needs that this environment lacks (each with the extra that installs it)."""
+    import importlib.util
+
+    extra = {"asv": "bench", "pytest": "test", "pytest_benchmark": "bench"}
+    return [
+        f"{module} (its {stage!r} stage; pip install -e '.[{extra[module]}]')"
+        for module, stage in TOOLS.items()
+        if importlib.util.find_spec(module) is None
+    ]
+
+
 def gpu_check(
     out: Path, results: Path, reports: Path, budget_s: float = 480.0, rehearse: bool = False, plan: Plan | None = None
 ) -> int:
@@ -280,6 +296,9 @@ def gpu_check(
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
+    missing = missing_tools()  # before any stage: a tool found missing 290 s in is minutes of a loan lost
+    if missing:
+        raise OptionError(f"gpu-check needs {', '.join(missing)}: none of its stages was run")
     out = own_folder(out, "--out")  # never a link: the check writes and bundles everything in it
     if rehearse:
         from numba.core import config

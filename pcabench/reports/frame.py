@@ -58,6 +58,13 @@ def _flat(row: dict) -> dict:
     # how the run ends: the paper's fixed step count, or a fixed physical time
     r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
     r["domain"] = "strip" if scene.get("strip_height") else "full"
+    layer = scene.get("layer")
+    r["edges"] = (  # one word (a table column): open edges/absorber/layer, e.g. x/sponge/4.5m
+        f"{scene['open']}/{scene.get('absorber') or 'default'}"
+        + (f"/{layer:g}m" if isinstance(layer, (int, float)) else "")
+        if scene.get("open")
+        else "-"
+    )
     # the configuration: the scene's parameters alone, as the resume key has them (pcabench.spec.identity), so that
     # a derived key a newer row stores (its layer's width) does not split one configuration in two
     r["scene_key"] = json.dumps(parameters, sort_keys=True)

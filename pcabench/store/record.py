@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import datetime as _dt
+import math
 import uuid
 from dataclasses import MISSING, asdict, dataclass, field, fields
 
@@ -174,12 +175,17 @@ class RunRecord:
             f"steps            {self.steps} (t = {number(self.t_end, '.6g')} s)",
             f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
             f"mean neighbours  {number(self.mean_neighbours, '.2f')}",
-            f"MSE (rel. RMS)   {number(self.mse, '.6g')}"
-            + ("" if primary == "u" else f" of {primary}")
-            + (" (against the pulse; once it has left, read the left measures below)" if scene.open else ""),
+            (
+                f"MSE (rel. RMS)   {number(self.mse, '.6g')}"
+                + ("" if primary == "u" else f" of {primary}")
+                + (" (against the pulse; once it has left, read the left measures below)" if scene.open else "")
+            )
+            if self.mse is None or math.isfinite(self.mse)
+            else f"MSE (rel. RMS)   - (undefined: the exact {primary} holds no pulse in the scored domain"
+            + ("; the pulse has left: read the left measures below)" if scene.open else ")"),
             f"ME (max)         {number(self.me, '.6g')} {unit}",
         ]
-        lines += [f"{name.replace('_', ' '):<17}{value:.6g}" for name, value in self.errors.items()]
+        lines += [f"{name.replace('_', ' '):<16} {value:.6g}" for name, value in self.errors.items()]
         if self.mse_isothermal is not None:
             lines.append(
                 f"MSE against the isothermal solution (the equations lagrangian solves) {self.mse_isothermal:.6g}"

@@ -26,6 +26,7 @@ COLUMNS = [
     "cfl",
     "integrator",
     "domain",
+    "edges",
     "protocol",
     "dx",
     "n_particles",

@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from solvers.reference.analytic import QUIET
 from solvers.scenes.base import SceneKind, left_behind, scored_axes
 
 LN2 = math.log(2.0)
@@ -34,9 +35,11 @@ def centre(scene) -> tuple[float, float]:
     return scene.pulse_center, 0.5 * (scene.y_min + scene.y_max)
 
 
-def _relative(diff, ref) -> float:
+def _relative(diff, ref, amplitude: float = 0.0) -> float:
+    """The relative RMS of ``diff`` against ``ref``; NaN where ``ref`` holds no pulse (its RMS below QUIET of
+    ``amplitude``: solvers/reference/analytic.py)."""
     den = float(np.mean(np.abs(ref) ** 2))
-    return float(np.sqrt(np.mean(np.abs(diff) ** 2) / den)) if den > 0 else float("nan")
+    return float(np.sqrt(np.mean(np.abs(diff) ** 2) / den)) if den > (QUIET * amplitude) ** 2 else float("nan")
 
 
 def measures(scene, x, y, drho, u, v, ref) -> dict:
@@ -54,13 +57,14 @@ def measures(scene, x, y, drho, u, v, ref) -> dict:
     t = scene.t_final
     ray_axis = (py > 0) & (py < scene.dx) & (px > 0)  # the row just above the centre, to the right
     ray_diagonal = (np.abs(px - py) < 0.5 * scene.dx) & (px > 0)
+    rho, speed = scene.rho0 * scene.mach, scene.mach * scene.c0  # the pulse's amplitudes: drho, velocity
     return {
-        "mse": _relative(d, r_drho),
+        "mse": _relative(d, r_drho, rho),
         "me": float(np.max(np.abs(d))),
-        "velocity_rms": _relative(speed_err, np.hypot(r_u, r_v)),
+        "velocity_rms": _relative(speed_err, np.hypot(r_u, r_v), speed),
         "velocity_max": float(speed_err.max()),
-        "axis_rms": _relative(d[axis], r_drho[axis]),
-        "diagonal_rms": _relative(d[diagonal], r_drho[diagonal]),
+        "axis_rms": _relative(d[axis], r_drho[axis], rho),
+        "diagonal_rms": _relative(d[diagonal], r_drho[diagonal], rho),
         "front_axis": front_shift(
             px[ray_axis], py[ray_axis], np.asarray(drho, float)[ray_axis], r_drho[ray_axis], scene.c0 * t
         ),
@@ -224,7 +228,7 @@ class AcousticPulse(SceneKind):
         )
         ref = np.interp(r, rr, drho)
         d = np.asarray(fields.drho, float) - ref
-        return _relative(d, ref) if np.all(np.isfinite(d)) else float("nan")
+        return _relative(d, ref, scene.rho0 * scene.mach) if np.all(np.isfinite(d)) else float("nan")
 
     def predict(self, scene):
         from solvers.reference.dispersion import predict_2d

@@ -101,12 +101,16 @@ class Cylinder(SceneKind):
         if not (isinstance(a, (int, float)) and math.isfinite(a) and a > 0):
             out.append(f"--cylinder-radius must be > 0 m (got {a!r})")
             return out
-        reach = a + scene.cutoff
-        if not (scene.x_min + reach <= 0 <= scene.x_max - reach and scene.y_min + reach <= 0 <= scene.y_max - reach):
+        room = min(-scene.x_min, scene.x_max, -scene.y_min, scene.y_max)  # from the axis to the nearest edge, m
+        domain = f"[{scene.x_min:g}, {scene.x_max:g}] x [{scene.y_min:g}, {scene.y_max:g}] m"
+        if a >= room:
+            out.append(f"--cylinder-radius {a:g}: the cylinder (at the origin) must lie inside the domain {domain}")
+        elif a + scene.cutoff > room:  # the body fits; the kernel's cutoff about it, set by --dx, does not
+            per_dx = scene.cutoff / scene.dx
             out.append(
-                f"--cylinder-radius: the cylinder (radius {a:g} m at the origin) must lie inside the domain "
-                f"[{scene.x_min:g}, {scene.x_max:g}] x [{scene.y_min:g}, {scene.y_max:g}] m, a cutoff "
-                f"({scene.cutoff:.3g} m) from its edges"
+                f"--dx {scene.dx:g} with --cylinder-radius {a:g}: the cutoff ({scene.cutoff:.3g} m = {per_dx:.3g} dx: "
+                f"--h-factor, --cutoff) about the cylinder reaches past the domain {domain}: --dx at most "
+                f"{(room - a) / per_dx:.3g} m here, or a smaller radius"
             )
         gap = abs(scene.pulse_center) - a
         if gap < CLEAR_WIDTHS * b:

@@ -94,7 +94,7 @@ class PlaneWall(PlanePulse):
 
     def errors(self, scene, fields) -> dict:
         ref = self.exact_velocity(scene, fields.x, fields.t)
-        err = relative_errors(fields.u, ref)
+        err = relative_errors(fields.u, ref, amplitude=scene.mach * scene.c0)
         return {"mse": err.mse, "me": err.me, **wall_measures(scene, fields.x, fields.u - ref, ref)}
 
     def isothermal_errors(self, scene, fields) -> float | None:
