@@ -5,27 +5,52 @@ from __future__ import annotations
 
 import os
 import subprocess
+import sys
+import textwrap
 import time
+from pathlib import Path
 
 import pytest
 
-from pcabench.execute import forkserver
 from pcabench.execute.sweep import run_child
 from pcabench.spec import RunSpec
 from solvers import Scene
 from tests.conftest import run_children
 
+ROOT = Path(__file__).resolve().parents[1]
 
-def test_a_forked_run_makes_the_record_a_fresh_interpreter_makes(monkeypatch):
-    spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=6)).resolved()
-    assert forkserver.usable(dict(os.environ))
-    forked = run_child(spec, 300, "abc", "m", stream=None)
-    monkeypatch.setenv(forkserver.ENV, "0")
-    fresh = run_child(spec, 300, "abc", "m", stream=None)
-    assert forked["status"] == fresh["status"] == "ok", (forked["message"], fresh["message"])
-    for key in ("mse", "me", "mean_neighbours", "n_particles", "steps", "profile_id", "commit", "errors"):
-        assert forked[key] == fresh[key], key  # bit for bit, and the sweep's machine and commit
-    assert forked["jit_cached"] is True  # the fresh one filled the cache or found it filled
+
+def in_a_process_of_its_own(body: str) -> None:
+    """``body`` (asserts) in a fresh interpreter: the forkserver is one per process, and an earlier test in this
+    worker may have started it in an environment of its own (a variable it set), which a run in today's
+    environment rightly does not share (it starts a fresh interpreter instead)."""
+    prelude = (
+        "import os\n"
+        "from pcabench.execute import forkserver\n"
+        "from pcabench.execute.sweep import run_child\n"
+        "from pcabench.spec import RunSpec\n"
+        "from solvers import Scene\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", prelude + textwrap.dedent(body)], capture_output=True, text=True, cwd=ROOT, timeout=600
+    )
+    assert out.returncode == 0, out.stderr[-3000:]
+
+
+def test_a_forked_run_makes_the_record_a_fresh_interpreter_makes():
+    in_a_process_of_its_own(
+        """
+        spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=6)).resolved()
+        assert forkserver.usable(dict(os.environ))
+        forked = run_child(spec, 300, "abc", "m", stream=None)
+        os.environ[forkserver.ENV] = "0"
+        fresh = run_child(spec, 300, "abc", "m", stream=None)
+        assert forked["status"] == fresh["status"] == "ok", (forked["message"], fresh["message"])
+        for key in ("mse", "me", "mean_neighbours", "n_particles", "steps", "profile_id", "commit", "errors"):
+            assert forked[key] == fresh[key], key  # bit for bit, and the sweep's machine and commit
+        assert forked["jit_cached"] is True  # the fresh one filled the cache or found it filled
+        """
+    )
 
 
 def test_a_forked_run_past_its_budget_is_killed():
@@ -41,12 +66,16 @@ def test_a_forked_run_past_its_budget_is_killed():
 
 
 def test_only_the_run_time_variables_may_differ_from_the_servers():
-    env = dict(os.environ)
-    assert forkserver.usable(env)
-    assert forkserver.usable({**env, "PCABENCH_HOME": "/elsewhere", "PCABENCH_CACHE": "/other"})
-    assert not forkserver.usable({**env, "NUMBA_OPT": "0"})  # read by numba at import: a fresh interpreter
-    assert not forkserver.usable({**env, "PYTHONPATH": "/a/plugin"})
-    assert not forkserver.usable({**env, forkserver.ENV: "0"})
+    in_a_process_of_its_own(
+        """
+        env = dict(os.environ)
+        assert forkserver.usable(env)
+        assert forkserver.usable({**env, "PCABENCH_HOME": "/elsewhere", "PCABENCH_CACHE": "/other"})
+        assert not forkserver.usable({**env, "NUMBA_OPT": "0"})  # read by numba at import: a fresh interpreter
+        assert not forkserver.usable({**env, "PYTHONPATH": "/a/plugin"})
+        assert not forkserver.usable({**env, forkserver.ENV: "0"})
+        """
+    )
 
 
 def test_a_run_killed_with_its_forkserver_is_run_again_in_a_fresh_interpreter(tmp_path):
