@@ -73,6 +73,18 @@ def run_children(pid: int) -> list[int]:
     return found
 
 
+def study_process(results, *args) -> subprocess.Popen:
+    """``pcabench study ARGS --no-report --results RESULTS`` in a process group of its own (its stderr piped, as
+    text): a test may signal the whole group as a terminal would."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "pcabench.cli", "study", *args, "--no-report", "--results", str(results)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+
+
 def cli_main(*args, capsys):
     """``pcabench ARGS`` in this process: (exit code, stdout, stderr)."""
     try:

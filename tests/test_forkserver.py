@@ -15,7 +15,7 @@ import pytest
 from pcabench.execute.sweep import run_child
 from pcabench.spec import RunSpec
 from solvers import Scene
-from tests.conftest import run_children
+from tests.conftest import run_children, study_process
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -82,25 +82,18 @@ def test_a_run_killed_with_its_forkserver_is_run_again_in_a_fresh_interpreter(tm
     """The server killed while it holds a run (its child dies with it): the run is made again in a fresh
     interpreter, not stored as an `error` (exit 255), and the sweep's next runs start a new server."""
     import signal
-    import sys
 
     from pcabench import store
+    from pcabench.execute import containment
 
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "pcabench.cli", "study", "--dx", "0.5", "0.25", "--steps", "400", "--model", "linear"]
-        + ["--solver", "linkedlist-cpu", "--no-report", "--results", str(tmp_path)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
+    proc = study_process(
+        tmp_path, "--dx", "0.5", "0.25", "--steps", "400", "--model", "linear", "--solver", "linkedlist-cpu"
     )
     try:
         killed, deadline = False, time.time() + 180
         while not killed and time.time() < deadline and proc.poll() is None:
-            for child in run_children(proc.pid):
-                with open(f"/proc/{child}/stat") as f:
-                    server = int(f.read().rsplit(")", 1)[1].split()[1])  # a forked run's parent: the server
-                if server != proc.pid:
+            for server in containment.children(proc.pid):  # the sweep's children: the forkserver among them
+                if run_children(server):  # the one holding a forked run
                     os.kill(server, signal.SIGKILL)
                     killed = True
                     break

@@ -25,7 +25,7 @@ from pcabench.store import provenance, schema
 from pcabench.store.record import RunRecord
 from solvers import Scene
 
-from .conftest import cli_main
+from .conftest import cli_main, study_process
 
 
 def record(**kw):
@@ -550,27 +550,19 @@ def test_a_sweeps_forkserver_ignores_the_terminals_ctrl_c_from_its_start(tmp_pat
     import signal
     import time
 
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "pcabench.cli", "study", "--dx", "1", "0.5", "0.25", "--steps", "50"]
-        + ["--no-report", "--results", str(tmp_path)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
+    from pcabench.execute import containment
+
+    proc = study_process(tmp_path, "--dx", "1", "0.5", "0.25", "--steps", "50")
     try:
         server, deadline = None, time.time() + 120
         while server is None and time.time() < deadline and proc.poll() is None:
-            for pid in os.listdir("/proc"):
+            for pid in containment.children(proc.pid):
                 try:
                     with open(f"/proc/{pid}/cmdline", "rb") as f:
-                        words = f.read().split(b"\0")
-                    with open(f"/proc/{pid}/stat") as f:
-                        parent = int(f.read().rsplit(")", 1)[1].split()[1])
-                except (OSError, ValueError, IndexError):
+                        if b"forkserver" in f.read():
+                            server = pid
+                except OSError:
                     continue
-                if parent == proc.pid and any(b"forkserver" in w for w in words):
-                    server = int(pid)
             time.sleep(0.02)
         assert server is not None, "no forkserver seen"
         with open(f"/proc/{server}/status") as f:

@@ -48,9 +48,8 @@ def check_filters(args, df, results) -> None:
             f"--machine {args.machine!r} is no machine of {results} (its machines: "
             f"{', '.join(sorted(set(df.machine)))})"
         )
-    codes = df.code.fillna("").astype(str) if "code" in df else df.commit.astype(str)
     if args.commit and not (
-        df.commit.astype(str).str.startswith(args.commit).any() or codes.str.startswith(args.commit).any()
+        df.commit.astype(str).str.startswith(args.commit).any() or runs.codes(df).str.startswith(args.commit).any()
     ):
         raise OptionError(f"--commit {args.commit!r} is the prefix of no commit or code key of {results}")
 

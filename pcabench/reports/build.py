@@ -9,8 +9,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pandas as pd
-
 from pcabench import store
 from pcabench.errors import NoResults
 from pcabench.machine import profiles
@@ -20,6 +18,7 @@ from pcabench.reports import paper as P
 from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.sections import Context, table6_md
+from pcabench.store import runs
 from pcabench.store.safeio import own_folder, write_file
 from solvers import DEFAULT_SCENE
 
@@ -54,11 +53,11 @@ def report_for(ctx: Context) -> Path:
     for stale in set(out.glob("*.png")) - set(figs):  # a figure whose data is gone is not left behind
         stale.unlink()
     counts = df.status.value_counts().to_dict()
-    codes = df.code.fillna("").astype(str) if "code" in df else pd.Series("", index=df.index)
+    keys = runs.codes(df)
     commits = sorted(
         {
             c[:12] + ("+dirty" if c.endswith("+dirty") else "") + (f" (code {k[:8]})" if k else "")
-            for c, k in zip(df.commit.astype(str), codes)
+            for c, k in zip(df.commit.astype(str), keys)
         }
     )
     hosts = sorted({str(h) for h in df.host.fillna("") if h}) or ["not recorded"]

@@ -54,7 +54,7 @@ def note(message: str, width: int = NOTE_WIDTH) -> str:
     return text if len(text) <= width else text[:width].rsplit(" ", 1)[0] + " ..."
 
 
-def _code(df: pd.DataFrame) -> pd.Series:
+def codes(df: pd.DataFrame) -> pd.Series:
     """Each run's code key (provenance.code_key: two runs of one commit made by different code differ here;
     "" in rows older than it)."""
     return (df.code if "code" in df else pd.Series("", index=df.index)).fillna("").astype(str)
@@ -72,7 +72,7 @@ def table(df: pd.DataFrame, **filters) -> pd.DataFrame:
         steps=df.steps.astype("Int64").where(stepped),
         mse=df.mse.where(stepped),
         commit=df.commit.astype(str).str[:7],
-        code=_code(df).str[:8].replace("", "-"),  # "-": a row older than the code key
+        code=codes(df).str[:8].replace("", "-"),  # "-": a row older than the code key
         note=(df.message if "message" in df else pd.Series("", index=df.index))
         .fillna("")
         .astype(str)
@@ -105,7 +105,7 @@ def side(df: pd.DataFrame, key: str) -> tuple[str, pd.DataFrame]:
         raise KeyError(f"--compare: {key!r} is a prefix of several machines ({', '.join(hit)}): give more of one")
     if hit:
         return "machine", df[df.machine == hit[0]]
-    hit = df[df.commit.astype(str).str.startswith(key) | (_code(df).str.startswith(key) & (len(key) >= 4))]
+    hit = df[df.commit.astype(str).str.startswith(key) | (codes(df).str.startswith(key) & (len(key) >= 4))]
     return ("commit", hit) if not hit.empty else ("", hit)
 
 
