@@ -296,10 +296,10 @@ def gpu_check(
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
+    out = own_folder(out, "--out")  # never a link: the check writes and bundles everything in it
     missing = missing_tools()  # before any stage: a tool found missing 290 s in is minutes of a loan lost
     if missing:
         raise OptionError(f"gpu-check needs {', '.join(missing)}: none of its stages was run")
-    out = own_folder(out, "--out")  # never a link: the check writes and bundles everything in it
     if rehearse:
         from numba.core import config
 
