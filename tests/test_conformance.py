@@ -57,6 +57,7 @@ def test_the_checks_are_the_suites_in_its_order():
     assert [f"{s}-{n}" for s in ("x",) for n in CHECK_NAMES] == [p.id for p in parametrize_with_checks(["x"]).args[1]]
 
 
+@pytest.mark.tier2  # the whole conformance suite in numba-cuda's simulator: two minutes
 @pytest.mark.parametrize("name", GPU_SOLVERS)
 def test_the_gpu_solver_conforms_in_the_simulator(name):
     env = dict(

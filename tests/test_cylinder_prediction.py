@@ -99,7 +99,7 @@ def test_advise_names_the_cheapest_method_predicted_to_reach_the_probes_target(m
 
     from .test_study import row
 
-    monkeypatch.setattr(A, "search_grid", lambda kind: ((0.04, 0.02), (1.0,), (0.8,)))
+    monkeypatch.setattr(A, "search_grid", lambda kind, model="linear": ((0.04, 0.02), (1.0,), (0.8,)))
     monkeypatch.setattr(A, "high_order_methods", lambda: ())  # the standard kernels alone (tests/test_high_order.py)
     path = tmp_path / "results" / "m.jsonl"
     store.append(row(name="cylinder", dx=0.04, t_end=10.0, model="linear", mse=9.0, open="xy"), path)

@@ -154,6 +154,7 @@ def test_every_figure_of_a_quick_study_reads_right(quick_report):
     assert {name: p for name, p in found.items() if p} == {}
 
 
+@pytest.mark.tier2  # draws every reference figure again: minutes
 def test_every_committed_reference_figure_reads_right(tmp_path):
     if paths.checkout() is None:
         pytest.skip("needs a source checkout")

@@ -552,7 +552,8 @@ def test_a_sweeps_forkserver_ignores_the_terminals_ctrl_c_from_its_start(tmp_pat
 
     from pcabench.execute import containment
 
-    proc = study_process(tmp_path, "--dx", "1", "0.5", "0.25", "--steps", "50")
+    # runs of seconds each (2.5 to 30 s), so that one is surely under way when the Ctrl-C comes
+    proc = study_process(tmp_path, "--dx", "1", "0.5", "0.25", "--steps", "3000", "--model", "linear")
     try:
         server, deadline = None, time.time() + 120
         while server is None and time.time() < deadline and proc.poll() is None:

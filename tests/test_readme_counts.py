@@ -26,3 +26,8 @@ def test_each_run_count_the_readme_states_is_its_plans(args, runs, capsys):
     listed = re.findall(r"^\[(\d+)/(\d+)\]", out + err, re.M)
     assert code == 0 and listed, (out + err)[-500:]
     assert int(listed[-1][1]) == runs, f"`pcabench study {args}` lists {listed[-1][1]} runs; the README says {runs}"
+
+
+def test_the_readme_is_a_front_door():
+    """At most 300 lines (issue 58): the rest is in docs/, linked from its "More"."""
+    assert len((ROOT / "README.md").read_text(encoding="utf-8").splitlines()) <= 300

@@ -177,7 +177,7 @@ def test_runs_shows_a_skipped_run_as_skipped_with_its_reason_and_no_numbers(tmp_
     assert code == 0 and len(lines) == 1, out + err
     cells = dict(zip(header.split(), lines[0].split(maxsplit=len(header.split()) - 1)))
     assert cells["status"] == "skipped" and cells["note"] == "predicted 999 s > run budget", cells
-    assert cells["steps"] == cells["step_ms"] == cells["mse"] == "-", cells  # not 0 steps, 0.00 ms
+    assert cells["steps"] == cells["step_ms"] == cells["error"] == cells["measure"] == "-", cells  # not 0 steps
     code, out, _ = cli_main("runs", "--results", str(results), "--status", "ok", capsys=capsys)
     assert code == 0 and "-  ok" not in out and "<NA>" not in out
 

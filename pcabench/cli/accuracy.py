@@ -65,5 +65,5 @@ ROUNDED_AS_PRINTED = (
     "paper_seconds",
     "paper_error",
     "speedup_over_paper",
-    "unstable_by_prediction",
+    "not_advised",
 )

@@ -28,8 +28,8 @@ from pcabench.cli.accuracy import ROUNDED_AS_PRINTED
 from pcabench.cli.exits import EXIT_OK, EXIT_RUN_FAILED
 from pcabench.cli.options import results_of
 from pcabench.errors import NoResults
-from pcabench.predict.methods import HIGH_ORDER_SHARES, high_order_methods, step_weight
-from pcabench.predict.stability import assess, e_foldings, scene_limit
+from pcabench.predict.methods import high_order_methods, step_weight
+from pcabench.predict.stability import assess, e_foldings, margin, margin_rule, scene_limit
 from pcabench.reports.tables import comparable, default_numerics, error_column, latest, numerics_label
 from pcabench.spec import OptionError, scene_from_row
 from solvers import (
@@ -48,12 +48,14 @@ from solvers.method import Method
 # every registered kernel.
 SEARCH_H = (1.3, 1.6, 2.13)
 SEARCH_DX = (1.0, 0.5, 0.4, 0.25, 0.2, 0.125, 0.1, 0.05, 0.025)
-SEARCH_CFL_SHARE = (0.25, 0.5, 0.8)  # of the predicted stable CFL
-# A 2D scene's prediction evolves every mode of its lattice (seconds at dx = 0.125): a coarser grid, and the
-# longest step only (the leapfrog's phase lead offsets the lattice's lag: the longest stable step is the most
-# accurate and the cheapest).
+# The steps searched, as shares of the stable CFL: the longest the margin allows (stability.MARGIN, the one rule:
+# 0.9 for linear), and on a strip and for the high-order methods also shorter ones (a fourth-order operator is
+# most accurate at a short step: Verlet's phase lead no longer offsets a second-order lag). A 2D scene's
+# prediction evolves every mode of its lattice (seconds at dx = 0.125): a coarser grid, and a standard method at
+# the longest step only (the leapfrog's phase lead offsets the lattice's lag: the longest stable step is the
+# most accurate and the cheapest).
+SHORT_SHARES = (0.25, 0.5)
 SEARCH_DX_2D = (0.5, 0.25, 0.2, 0.125)
-SEARCH_CFL_SHARE_2D = (0.8,)
 # A scene with a body predicts its probes alone (about a second at any dx: solvers/reference/dispersive_cylinder.py):
 # down to 80 particles per pulse width, and wider kernels (each kernel's long-wave phase-speed deficit at fixed
 # h / dx, which no refinement removes, is smallest at h of 2.5 to 3 dx: docs/accuracy.md).
@@ -68,13 +70,15 @@ HIGH_ORDER_DX_BODY = (0.04, 0.03, 0.025, 0.0225, 0.02, 0.01)
 BODY_MARGIN = 0.5
 
 
-def search_grid(kind) -> tuple:
-    """(dxs, h factors, CFL shares of the predicted stable CFL) :func:`suggest` searches on a scene of ``kind``."""
+def search_grid(kind, model: str = "linear") -> tuple:
+    """(dxs, h factors, CFL shares of the stable CFL) :func:`suggest` searches on a scene of ``kind`` for
+    ``model``: the shares end at its margin (:func:`pcabench.predict.stability.margin`)."""
+    longest = (margin(model),)
     if kind.body:
-        return SEARCH_DX_BODY, SEARCH_H_BODY, SEARCH_CFL_SHARE_2D
+        return SEARCH_DX_BODY, SEARCH_H_BODY, longest
     if kind.strip:
-        return SEARCH_DX, SEARCH_H, SEARCH_CFL_SHARE
-    return SEARCH_DX_2D, SEARCH_H, SEARCH_CFL_SHARE_2D
+        return SEARCH_DX, SEARCH_H, SHORT_SHARES + longest
+    return SEARCH_DX_2D, SEARCH_H, longest
 
 
 def scene_of(r) -> dict:
@@ -121,6 +125,8 @@ def _unstable_row(r, column: str) -> dict:
         "method": numerics_label(r),
         "dx": float(r.dx),
         "cfl": float(r.cfl),
+        "fraction": a["fraction"],
+        "past_limit": bool(a["past_limit"]),
         "stable_cfl": a["stable_cfl"],
         "limit_from": a["limit_from"],
         "error": float(r[column]),
@@ -142,27 +148,37 @@ def _unstable_rows(runs, column: str, most: int = 3) -> list[dict]:
 
 
 def advise(
-    df, error: float, t_end: float, model: str = "linear", domain: str | None = None, scene: str = Scene.default("name")
+    df,
+    error: float,
+    t_end: float,
+    model: str = "linear",
+    domain: str | None = None,
+    scene: str = Scene.default("name"),
+    problem: tuple[str, ...] = (),
 ) -> dict:
     """The fastest stored run of ``scene`` reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``,
-    if given) below its predicted stable CFL, the fastest run of the paper's configuration reaching it that compares
-    with it, and the ratio. Like is compared with like (``tables.comparable``): the same kind of domain (a
+    if given) within the margin of its stable CFL, the fastest run of the paper's configuration reaching it that
+    compares with it, and the ratio. Like is compared with like (``tables.comparable``): the same kind of domain (a
     strip holds fewer particles than the full domain; on a strip each method runs on the thinnest strip its
-    support allows), the same threads and the same commit. A run at or past its method's predicted stable
-    CFL (pcabench/predict/stability.py) is never advised, whatever its error: ``unstable_by_prediction`` lists those
-    faster than the advice (or all of them, fastest first, where none below the limit reaches the error)."""
+    support allows), the same threads and the same commit. A run past the margin of its method's stable CFL
+    (pcabench/predict/stability.py ``MARGIN``, the one rule: at or past the limit it is unstable by prediction) is
+    never advised, whatever its error: ``not_advised`` lists those faster than the advice (or all of them,
+    fastest first, where none within the margin reaches the error). ``problem``: the study options of the problem
+    asked about (``--open x``), for the study command :func:`suggest` names."""
     runs = reaching(df, t_end, model)
     if domain is not None and not runs.empty:
         runs = runs[runs.domain == domain]
     column = error_column(model)
     hits = runs[runs[column] <= error] if not runs.empty else runs
-    past = np.array([assess(r)["past_limit"] for _, r in hits.iterrows()], bool)
+    past = np.array([assess(r)["past_margin"] for _, r in hits.iterrows()], bool)  # the one margin rule
     unstable, hits = hits[past], hits[~past]
     out = {
         "error_target": error,
         "t_end": t_end,
         "model": model,
         "runs_considered": int(len(runs)),
+        "margin": margin(model),
+        "problem": list(problem),
         "error_against": "the isothermal solution"
         if column == "mse_isothermal"
         else "the linear pulse"
@@ -171,8 +187,8 @@ def advise(
     }
     if hits.empty:
         out["found"] = False
-        out["unstable_by_prediction"] = _unstable_rows(unstable, column)
-        out["suggestion"] = suggest(error, t_end, model, scene)
+        out["not_advised"] = _unstable_rows(unstable, column)
+        out["suggestion"] = suggest(error, t_end, model, scene, problem, domain)
         return out
     best = hits.iloc[0]
     faster = unstable[unstable.t_solution < best.t_solution]
@@ -200,7 +216,7 @@ def advise(
         paper_seconds=None if paper_best is None else float(paper_best.t_solution),
         paper_error=None if paper_best is None else float(paper_best[column]),
         paper_command=None if paper_best is None else command(paper_best, t_end),
-        unstable_by_prediction=_unstable_rows(faster, column),
+        not_advised=_unstable_rows(faster, column),
     )
     out["is_paper_configuration"] = paper_best is not None and out["paper_command"] == out["command"]
     out["speedup_over_paper"] = out["paper_seconds"] / out["seconds"] if out["paper_seconds"] else None
@@ -219,19 +235,28 @@ def candidates(kind, dxs, hs, shares) -> list[tuple[dict, tuple, tuple]]:
         if not (kind.body and kernel_named(kern).negative_lobe)
     ]
     fine = HIGH_ORDER_DX_BODY if kind.body else dxs
-    return standard + [(m, HIGH_ORDER_SHARES, fine) for m in high_order_methods()]
+    return standard + [(m, SHORT_SHARES + shares[-1:], fine) for m in high_order_methods()]
 
 
-def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFAULT_SCENE) -> dict:
+def suggest(
+    error: float,
+    t_end: float,
+    model: str = "linear",
+    scene: str = DEFAULT_SCENE,
+    problem: tuple[str, ...] = (),
+    domain: str | None = None,
+) -> dict:
     """From the prediction: the cheapest configuration of a small grid (:func:`search_grid`, and the high-order
     methods: :func:`candidates`) predicted to reach ``error`` at ``t_end`` on ``scene`` (cost ~ particles x steps
     x neighbours x the step's sweeps: on the thinnest strip where a strip serves the scene, else on its own
     domain), the one predicted closest to it, and the paper configuration's dx. A scene with a body is predicted
     with its wall exact (the bulk's dispersion alone: a lower bound of a run's error), a corrected method with
     the weak wall (solvers/bodies/weak.py: the ghosts' walls grow with a corrected negative-lobe kernel); its
-    search takes a minute or two and says so on stderr."""
+    search takes a minute or two and says so on stderr. The study command it names makes runs that advise, asked
+    again, reads: ``problem`` (the study options of the problem asked about: ``--open x``, ``--mach 0.1``) goes into
+    it, and a strip only where ``domain`` is not ``full``."""
     kind = scene_kind(scene)
-    dxs, hs, shares = search_grid(kind)
+    dxs, hs, shares = search_grid(kind, model)
     asked = error * (BODY_MARGIN if kind.body else 1.0)  # the prediction's target (a body's: with its margin)
     best, paper, closest = None, None, None
     for method, method_shares, method_dxs in candidates(kind, dxs, hs, shares):
@@ -286,6 +311,7 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
             **method_fields(s),
             dx=s.dx,
             predicted_error=p.predicted_error,
+            stable_cfl=scene_limit(s),
             **({} if kind.strip else {"n_particles": s.n_particles, "steps": s.n_steps}),
             study=shlex.join(
                 [
@@ -298,7 +324,8 @@ def suggest(error: float, t_end: float, model: str = "linear", scene: str = DEFA
                     "--t-end",
                     f"{t_end:g}",
                     *([] if scene == DEFAULT_SCENE else ["--scene", scene]),
-                    *(["--strip"] if kind.strip else []),
+                    *problem,
+                    *(["--strip"] if kind.strip and domain != "full" else []),
                     *method_words(s),
                     "--dx",
                     f"{s.dx:g}",
@@ -367,9 +394,10 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
     if not out["found"]:
         s = out["suggestion"]
         lines.append(
-            f"{head}: none of the {out['runs_considered']} stored runs reaches it below its predicted stable CFL."
+            f"{head}: none of the {out['runs_considered']} stored runs reaches it within the margin of its stable "
+            f"CFL ({margin_rule(model)})."
         )
-        lines += unstable_lines(out["unstable_by_prediction"], "runs that reach it")
+        lines += unstable_lines(out["not_advised"], "runs that reach it", model)
         if no_reference:
             lines.append(
                 f"no {model} run of {scene} can be scored (no isothermal solution is known there); the "
@@ -391,7 +419,8 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
                 + (f", {s['boundary_method']} wall" if "boundary_method" in s else "")
                 + f", dx {s['dx']:g} (predicted {s['predicted_error']:.3g}"
                 + (f"; {s['n_particles']:,} particles, {s['steps']:,} steps" if "steps" in s else "")
-                + "); "
+                + f"; CFL {s['cfl']:g} = {s['cfl'] / s['stable_cfl']:.2f} of its stable {s['stable_cfl']:.3g}, "
+                + f"{margin_rule(model)}); "
                 f"run:\n  {s['study']}"
             )
         lines.append(
@@ -411,7 +440,7 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
         + f", dx {out['dx']:g}, "
         f"{out['precision']}, {out['threads']} thread{'s' if out['threads'] > 1 else ''}, "
         f"{out['domain']} domain, {out['n_particles']:,} particles, {out['steps']} steps, "
-        f"commit {out['commit'][:7]})\n  {out['command']}"
+        f"commit {out['commit'][:7]}; {margin_rule(model)})\n  {out['command']}"
     )
     if out["is_paper_configuration"]:
         lines.append(
@@ -419,7 +448,7 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
             f"{t_end:g} s is faster"
             + (
                 ""
-                if scene == DEFAULT_SCENE
+                if scene == DEFAULT_SCENE or out.get("problem")  # the front takes no problem options
                 else f" (`{shlex.join(['pcabench', 'study', '--front', '--scene', scene])}` runs other methods)"
             )
         )
@@ -437,19 +466,27 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
             f"threads and commit reaches it; `pcabench advise --domain {other}` looks at the {other} "
             "domain's runs"
         )
-    lines += unstable_lines(out["unstable_by_prediction"], "faster runs")
+    lines += unstable_lines(out["not_advised"], "faster runs", model)
     return "\n".join(lines), True
 
 
-def unstable_lines(rows, what: str) -> list[str]:
-    """The lines naming advise's runs past their predicted stable CFL that reached the error: never advised."""
+def unstable_lines(rows, what: str, model: str) -> list[str]:
+    """The lines naming advise's runs past the margin of their stable CFL that reached the error: never advised
+    (at or past the limit itself: unstable by prediction)."""
     lines = []
     if rows:
         lines.append(
-            f"  not advised: {what} at or past their predicted stable CFL (unstable by prediction: a "
-            "longer run or a finer dx grows them without bound)"
+            f"  not advised: {what} past the margin ({margin_rule(model)}; at or past the limit a run is "
+            "unstable by prediction: a longer run or a finer dx grows it without bound)"
         )
     for r in rows:
+        if not r["past_limit"]:  # stable, but closer to its limit than the margin allows
+            lines.append(
+                f"    {r['method']}, dx {r['dx']:g}: {r['seconds']:.3g} s, error {r['error']:.3g}; CFL {r['cfl']:g} = "
+                f"{r['fraction']:.2f} of the {'predicted ' if r['limit_from'] == 'prediction' else ''}stable "
+                f"{r['stable_cfl']:.3g}, past the margin of {margin(model):g}"
+            )
+            continue
         which = (
             f"predicted stable {r['stable_cfl']:.3g}"
             if r["limit_from"] == "prediction"
@@ -466,6 +503,17 @@ def unstable_lines(rows, what: str) -> list[str]:
     return lines
 
 
+def problem_words(args) -> tuple[str, ...]:
+    """The study options of the problem advise was asked about where they are not the scene's own: ``--open``
+    and ``--mach``, so that a study advise names makes the runs it reads."""
+    words: list[str] = []
+    if args.open and args.open != scene_kind(args.scene).defaults.get("open", ""):
+        words += ["--open", args.open]
+    if args.mach is not None and args.mach != Scene.default("mach"):
+        words += ["--mach", f"{args.mach:g}"]
+    return tuple(words)
+
+
 def cmd_advise(args) -> int:
     from pcabench.machine.profiles import machine_id
     from pcabench.reports.frame import load as load_frame
@@ -477,19 +525,21 @@ def cmd_advise(args) -> int:
         raise OptionError(f"--t-end is a physical time in s, > 0 (got {args.t_end:g})")
     results = results_of(args)
     df = load_frame(results) if results is not None and Path(results).exists() else None
+    mach = Scene.default("mach") if args.mach is None else args.mach
+    edges = args.open or scene_kind(args.scene).defaults.get("open", "")  # an open problem's edges by default
+    problem = problem_words(args)
     if df is not None and not df.empty:
-        import numpy as np
-
-        mach = Scene.default("mach") if args.mach is None else args.mach
-        edges = args.open or scene_kind(args.scene).defaults.get("open", "")  # an open problem's edges by default
         df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach) & (df.open == edges)]
-    if df is None or df.empty:
-        study = ["pcabench", "study", "--front", *([] if args.scene == DEFAULT_SCENE else ["--scene", args.scene])]
+    if df is None or df.empty:  # what makes the runs asked about: the prediction's study, with their problem
+        s = suggest(args.error, args.t_end, args.model, args.scene, problem, args.domain)
+        make = (
+            f"run `{s['study']}` first (the method predicted cheapest to --error {args.error:g})"
+            if "study" in s
+            else f"no method of the searched grid is predicted to reach --error {args.error:g}"
+        )
         raise NoResults(
-            f"no stored runs of the {args.scene} scene at --mach "
-            f"{Scene.default('mach') if args.mach is None else args.mach:g}"
-            f"{f' with --open {args.open}' if args.open else ''} in {results}: run "
-            f"`{shlex.join(study)}` first, or use --reference"
+            f"no stored runs of the {args.scene} scene at --mach {mach:g}"
+            f"{f' with --open {args.open}' if args.open else ''} in {results}: {make}, or use --reference"
         )
     machines = df.machine.value_counts()
     if args.machine:
@@ -503,7 +553,7 @@ def cmd_advise(args) -> int:
     out = {
         "machine": machine,
         "scene": args.scene,
-        **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain, args.scene),
+        **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain, args.scene, problem),
     }
     if args.json:  # the numbers the text prints, rounded as it prints them
         shown = {key: jsonout.significant(out[key]) for key in ROUNDED_AS_PRINTED if out.get(key) is not None}

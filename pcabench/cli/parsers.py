@@ -174,7 +174,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="relative RMS error of the scene's primary field (u; drho in 2D), e.g. 0.01",
     )
     p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical time, s (default 10)")
-    p.add_argument("--model", choices=MODELS, default="linear", help="default linear")
+    p.add_argument(
+        "--model",
+        choices=MODELS,
+        default="linear",
+        help=f"default linear, whose prediction is exact (run's and study's default is {Scene.default('model')}: "
+        "name it to be advised on it)",
+    )
     p.add_argument("--scene", choices=scene_names(), default=DEFAULT_SCENE, help=f"default {DEFAULT_SCENE}")
     p.add_argument(
         "--mach",

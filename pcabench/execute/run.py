@@ -96,6 +96,7 @@ def score(record: RunRecord, scene, fields) -> RunRecord:
         record.status, record.failed_step = "error", record.steps or None
         record.mse = record.me = float("nan")
         record.errors, record.probes, record.mse_isothermal = {}, {}, None
+        record.measure, record.headline = "", None
         record.message = (record.message + "\n" if record.message else "") + f"the run's result is not usable: {why}"
         return record
     record.status = "ok"
@@ -112,6 +113,8 @@ def _measure(record: RunRecord, scene, fields) -> None:
         record.probes = {k: [float(f"{v:.6g}") for v in np.asarray(vals, float)] for k, vals in fields.probes.items()}
     if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
         record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
+    record.measure = scene.kind.measure(scene, record.t_end)  # the one error that means something at its end
+    record.headline = scene.kind.measure_value(record.measure, record.mse, record.errors)
 
 
 def save_fields(fields, path) -> None:

@@ -16,6 +16,7 @@ import itertools
 import math
 from functools import lru_cache
 
+from pcabench.predict.stability import MARGIN
 from solvers import DEFAULT_SCENE, Scene, kernel_names
 from solvers.kernels import truncated
 from solvers.method import Method
@@ -30,12 +31,8 @@ H_FACTORS = (1.0, 1.1, 1.2, 1.3, 1.4, 1.6, 2.0, 2.13)
 HIGH_ORDER_H = (1.5,)
 HIGH_ORDER_CUTOFF = 4.0
 HIGH_ORDER_INTEGRATORS = ("verlet", "rk4")
-HIGH_ORDER_SHARES = (0.25, 0.5, 0.8)
 DXS = (0.4, 0.3, 0.25, 0.2, 0.15, 0.125, 0.1, 0.075, 0.05)
 CFL_SHARES = (0.5, 0.7, 0.9)  # of the predicted stable CFL
-# The largest share of the predicted stable CFL a model may use: the prediction is exact for `linear`; for the
-# moving models it is the linear part only, and their measured limit lies lower.
-MARGIN = {"linear": 0.9, "fixed": 0.7, "lagrangian": 0.7}
 
 
 def cost(scene: Scene) -> float:

@@ -22,6 +22,10 @@ from pathlib import Path
 import numpy as np
 
 ROUND_OFF_E_FOLDINGS = math.log(1e16)  # ~37: from float64 round-off to the pulse's size
+# The one margin rule: the largest share of a method's stable CFL (:func:`stable_limit`) at which advise names a
+# stored run or suggests one, and the front picks its methods. The prediction is exact for `linear`; for the
+# moving models it is their linear part's, and their measured limits lie lower.
+MARGIN = {"linear": 0.9, "fixed": 0.7, "lagrangian": 0.7}
 UNSTABLE_BY_PREDICTION = "unstable by prediction"
 
 MEASURED_LIMITS_FILE = Path(__file__).with_name("measured_limits.csv")  # data, with where each was measured
@@ -88,21 +92,40 @@ def method_of(r) -> tuple[str, float, float, str, str]:
     return m.kernel, m.h_factor, cut, m.integrator, m.correction
 
 
+FREE_END_SCENE = "plane-pulse"  # where the free end's limits are measured (the high-order study's long runs)
+
+
+def free_ended(name: str, edges: str) -> bool:
+    """Whether a closed run of scene ``name`` (no ``edges`` opened) has a free edge: a lattice edge with no wall,
+    seam or layer beyond it, where a particle has half its neighbours (solvers.scenes.base.SceneKind.boundaries)."""
+    from solvers import scene_kind
+
+    try:
+        kind = scene_kind(name)
+    except (KeyError, ValueError):  # a scene whose plug-in is not installed: no claim about its edges
+        return False
+    closed = not edges and not kind.defaults.get("open")
+    return closed and bool({"free-x", "free-y"} & kind.boundaries())
+
+
 def measured_limit(r) -> float | None:
     """The smallest CFL at which long runs of ``r``'s scene, model and method blew up (:func:`measured_limits`),
-    or None (a run without a scene is of the paper's)."""
+    or None (a run without a scene is of the paper's). A closed scene with a free edge and no row of its own
+    takes the free end's limit measured on :data:`FREE_END_SCENE` (the same edge: half the neighbours)."""
     from solvers import DEFAULT_SCENE
     from solvers.kernels import truncated
 
     kernel, h, cut, integrator, correction = method_of(r)
-    mine = (str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", ""), kernel, integrator, correction)
-    for (scene, model, k, hh, cc, integ, corr), (limit, _bounded) in measured_limits().items():
-        if (
-            (scene, model, k, integ, corr) == mine
-            and math.isclose(h, hh)
-            and (not truncated(k) or math.isclose(cut, cc))
-        ):
-            return limit
+    name, model_r = str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", "")
+    names = [name] + ([FREE_END_SCENE] if free_ended(name, str(_value(r, "open", "") or "")) else [])
+    for want in names:
+        for (scene, model, k, hh, cc, integ, corr), (limit, _bounded) in measured_limits().items():
+            if (
+                (scene, model, k, integ, corr) == (want, model_r, kernel, integrator, correction)
+                and math.isclose(h, hh)
+                and (not truncated(k) or math.isclose(cut, cc))
+            ):
+                return limit
     return None
 
 
@@ -120,13 +143,24 @@ def scene_limit(scene) -> float:
     runs, docs/accuracy.md "Open edges")."""
     from solvers.method import Method
 
-    row = {"scene": scene.name, "model": scene.model, **Method.of(scene).scene_fields()}
+    row = {"scene": scene.name, "model": scene.model, "open": scene.open, **Method.of(scene).scene_fields()}
     return stable_limit(row)
 
 
 def past_limit(cfl: float, limit: float) -> bool:
     """Whether ``cfl`` is at or past the stable ``limit``: the scan's limit is the first unstable step."""
     return float(cfl) >= float(limit)
+
+
+def margin(model: str) -> float:
+    """The largest share of the stable CFL a run of ``model`` is advised at (:data:`MARGIN`)."""
+    return MARGIN[model]
+
+
+def margin_rule(model: str) -> str:
+    """:data:`MARGIN` for ``model`` in words, as advise states it."""
+    why = "whose prediction is exact" if model == "linear" else "whose prediction is of its linear part"
+    return f"advised at most {margin(model):g} of the stable CFL for {model}, {why}"
 
 
 def e_foldings(r, steps: int) -> float:
@@ -142,13 +176,18 @@ def e_foldings(r, steps: int) -> float:
 
 def assess(r) -> dict:
     """``stable_cfl``, ``fraction`` (the run's CFL over it, inf for a limit of 0), ``past_limit``,
-    ``limit_from`` ("prediction", or "long runs" where the limit long runs of its scene measured is the lower)
-    and ``predicted`` (the periodic lattice's predicted limit)."""
+    ``past_margin`` (past :func:`margin` of the limit for its model, to the CFL's two decimals: never advised),
+    ``limit_from``
+    ("prediction", or "long runs" where the limit long runs of its scene measured is the lower) and
+    ``predicted`` (the periodic lattice's predicted limit)."""
     limit, cfl, predicted = stable_limit(r), float(r["cfl"]), _limits(*method_of(r))[0]
+    fraction = cfl / limit if limit > 0 else math.inf
     return {
         "stable_cfl": limit,
-        "fraction": cfl / limit if limit > 0 else math.inf,
+        "fraction": fraction,
         "past_limit": past_limit(cfl, limit),
+        # a CFL is written to two decimals (round(share x limit, 2)): half of the last one is within the margin
+        "past_margin": cfl > margin(str(_value(r, "model", "linear"))) * limit + 0.005,
         "predicted": predicted,
         "limit_from": "prediction" if limit == predicted else "long runs",
     }

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from pcabench.presets.base import Preset, spec_of
 from solvers import Scene
+from solvers.kernels import truncated
 
 HIGH_ORDER = "high-order"
 HIGH_ORDER_T_END = 10.0
@@ -29,16 +30,31 @@ RK4 = {"integrator": "rk4", "cfl": 1.0}
 # high-order kernel corrected with Verlet at CFL 0.5 and with RK4 at CFL 1.
 PULSE_DX = (0.5, 0.25)
 # 3. The stable step over long runs (plane pulse, dx 0.25, t = 100 s, Mach 0.01), linear and lagrangian (whether
-# the kernel's negative lobe or the correction breaks moving particles). The free ends lower it below the
-# periodic lattice's prediction (2.04 for Verlet, 2.88 for RK4): there a particle has half its neighbours, its L is
-# about twice the interior's, and so is its highest frequency. Measured here first (2026-12-06, one run each):
-# Verlet bounded at 0.5, 0.75, 1.0, 1.25, 1.3, 1.4 and blew up at 1.5 (step 20), RK4 bounded to 1.8 and blew up
-# at 2.1 (step 39) and 2.4, the same for the lagrangian model; 0.95 and 1.02 of the prediction blew up within 9
-# steps. The study brackets those limits.
+# the kernel's negative lobe or the correction breaks moving particles), of every corrected method advise's search
+# names (pcabench/predict/methods.py high_order_methods: each kernel at h = 1.5 dx, Verlet and RK4). The free ends
+# lower it below the periodic lattice's prediction: there a particle has half its neighbours, its L is about
+# twice the interior's, and so is its highest frequency. Measured here first (2026-12-06, intel-xeon, one linear
+# run at each CFL, `pcabench study --strip --dx 0.25 --t-end 100 --mach 0.01 --h-factor 1.5 --correction gradient
+# --kernel K --integrator I --cfl ...`): Laguerre-Gauss Verlet bounded at 0.5 to 1.4 and blew up at 1.5 (step 20),
+# RK4 bounded to 1.8, blew up at 2.1 (step 39) and 2.4 (prediction 2.04 and 2.88); Gaussian (cut at 4 h) Verlet
+# bounded to 2.2, blew up at 2.4 (step 19; prediction 3.50), RK4 3.0 and 3.3 (step 41; 4.95); Wendland C2 Verlet
+# 1.6 and 1.8 (step 22; 2.66), RK4 2.4 and 2.6 (step 26; 3.76); Wendland C4 Verlet 1.4 and 1.6 (step 19; 2.31),
+# RK4 2.0 and 2.2 (step 44; 3.26): 0.6 to 0.7 of the prediction each. The study brackets those limits.
 LONG_DX = 0.25
 LONG_T_END = 100.0
 LONG_MACH = 0.01  # the pulse must not break before LONG_T_END (at Mach 0.05 it does at 70 s)
-LONG_CFLS = {"verlet": (1.4, 1.5), "rk4": (1.8, 2.1)}
+LONG_CFLS = {  # (kernel, integrator): (the largest bounded CFL, the smallest that blew up)
+    ("laguerre-gauss", "verlet"): (1.4, 1.5),
+    ("laguerre-gauss", "rk4"): (1.8, 2.1),
+    ("gaussian", "verlet"): (2.2, 2.4),
+    ("gaussian", "rk4"): (3.0, 3.3),
+    ("wendland-c2", "verlet"): (1.6, 1.8),
+    ("wendland-c2", "rk4"): (2.4, 2.6),
+    ("wendland-c4", "verlet"): (1.4, 1.6),
+    ("wendland-c4", "rk4"): (2.0, 2.2),
+}
+LONG_H = 1.5
+LONG_CUTOFF = 4.0  # a truncated kernel's (the Gaussian's and Laguerre-Gauss's), as the search has it
 
 
 def plane(dx: float, **method) -> object:
@@ -63,8 +79,9 @@ def high_order() -> list:
         runs.append(spec_of(dx=dx, **pulse))
         runs.append(spec_of(dx=dx, **pulse, **METHOD, correction="gradient", cfl=0.5))
         runs.append(spec_of(dx=dx, **pulse, **METHOD, correction="gradient", **RK4))
-    for integrator, cfls in LONG_CFLS.items():
-        base = {**METHOD, "correction": "gradient", "integrator": integrator}
+    for (kernel, integrator), cfls in LONG_CFLS.items():
+        cut = {"cutoff_factor": LONG_CUTOFF} if truncated(kernel) else {}
+        base = {"kernel": kernel, "h_factor": LONG_H, **cut, "correction": "gradient", "integrator": integrator}
         for model in ("linear", "lagrangian"):
             runs += [
                 spec_of(dx=LONG_DX, model=model, mach=LONG_MACH, t_end=LONG_T_END, cfl=cfl, strip=True, **base)

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from pcabench import store
-from pcabench.spec import stored_parameters
+from pcabench.spec import scene_from_row, stored_parameters
 from pcabench.store.record import STEP_STAGES
 from solvers import registry
 
@@ -34,12 +34,28 @@ SCENE_COLUMNS = (
     "pulse_width",
     "open",
 )
-NUMERIC = ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal")
+NUMERIC = ("mse", "me", "mean_neighbours", "jit_seconds", "dx", "t_end", "mse_isothermal", "headline")
 
 
 def load(paths) -> pd.DataFrame:
     """The stores ``paths`` (files or folders of *.jsonl) as one DataFrame, one row per run."""
     return frame(store.read_rows(paths))
+
+
+def headline_of(row: dict) -> tuple[str, float | None]:
+    """(name, value) of a stored row's headline measure (solvers.scenes.base.SceneKind.measure): as the row
+    stores it; in a row older than it, as its scene kind names it for the time the run reached ("" and None for a
+    run that was not scored, or whose scene kind is not installed)."""
+    if row.get("measure"):
+        return str(row["measure"]), row.get("headline")
+    if row.get("status") != "ok" or not isinstance(row.get("t_end"), (int, float)):
+        return "", None
+    try:
+        scene = scene_from_row(row)
+    except (ValueError, TypeError, KeyError):  # a scene this checkout no longer builds: no name to give it
+        return "", None
+    name = scene.kind.measure(scene, float(row["t_end"]))
+    return name, scene.kind.measure_value(name, row.get("mse"), row.get("errors") or {})
 
 
 def _flat(row: dict) -> dict:
@@ -55,6 +71,7 @@ def _flat(row: dict) -> dict:
     for key in SCENE_COLUMNS:
         r[key] = scene.get(key)
     r["scene"] = scene["name"]  # rows from before the scene registry: the paper's (stored_parameters)
+    r["measure"], r["headline"] = headline_of(row)  # the one error that means something at the run's end
     # how the run ends: the paper's fixed step count, or a fixed physical time
     r["protocol"] = f"t = {scene['t_end']:g} s" if scene.get("t_end") else f"{scene.get('steps')} steps"
     r["domain"] = "strip" if scene.get("strip_height") else "full"

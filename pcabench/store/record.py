@@ -41,6 +41,8 @@ class RunRecord:
     steps_requested: int = 0
     mse_isothermal: float | None = None  # relative RMS error of the primary field against the isothermal solution
     # (every model since the scene registry; lagrangian only before)
+    measure: str = ""  # the headline measure's name (SceneKind.measure: rms_u, probes_p, left_energy); "" unscored
+    headline: float | None = None  # its value (mse, or the error measure of that name): the run's one error
     errors: dict = field(default_factory=dict)  # the scene's other error measures (solvers/scenes/), by name
     probes: dict = field(default_factory=dict)  # {"t": [s], name: [drho, kg/m^3]} at the scene's probe points
     scene: dict = field(default_factory=dict)
@@ -185,7 +187,16 @@ class RunRecord:
             + ("; the pulse has left: read the left measures below)" if scene.open else ")"),
             f"ME (max)         {number(self.me, '.6g')} {unit}",
         ]
-        lines += [f"{name.replace('_', ' '):<16} {value:.6g}" for name, value in self.errors.items()]
+        if self.measure:  # the one error that means something at the run's end, by its name
+            lines.insert(
+                len(lines) - 2,
+                f"headline         {self.measure} {number(self.headline, '.6g')}: "
+                f"{scene.kind.measure_words(self.measure, self.t_end)}",
+            )
+        lines += [  # a measure whose reference holds no pulse is undefined (NaN): "-"
+            f"{name.replace('_', ' '):<16} {value:.6g}" if math.isfinite(value) else f"{name.replace('_', ' '):<16} -"
+            for name, value in self.errors.items()
+        ]
         if self.mse_isothermal is not None:
             lines.append(
                 f"MSE against the isothermal solution (the equations lagrangian solves) {self.mse_isothermal:.6g}"

@@ -33,7 +33,8 @@ COLUMNS = [
     "steps",
     "status",
     "step_ms",
-    "mse",
+    "measure",
+    "error",
     "timestamp",
     "note",
 ]
@@ -62,15 +63,18 @@ def codes(df: pd.DataFrame) -> pd.Series:
 
 def table(df: pd.DataFrame, **filters) -> pd.DataFrame:
     """The runs of ``df`` (from :func:`pcabench.reports.frame.load`) as a readable table, filtered by column
-    prefix matches (a machine by :func:`machines`). A run that made no step (skipped on its prediction, timed
-    out, crashed before a step) has no step time, steps or error (NA, shown as "-"), and its note says why."""
+    prefix matches (a machine by :func:`machines`). Its error is the run's headline measure, named in the
+    ``measure`` column (SceneKind.measure: ``rms_u``, ``probes_p``, ``left_energy`` once an open scene's pulse has
+    left). A run that made no step (skipped on its prediction, timed out, crashed before a step) has no step
+    time, steps or error (NA, shown as "-"), and its note says why."""
     if df.empty:
         return pd.DataFrame(columns=COLUMNS)
     stepped = df.steps > 0
     out = df.assign(
         step_ms=(1e3 * df.t_step).where(stepped),
         steps=df.steps.astype("Int64").where(stepped),
-        mse=df.mse.where(stepped),
+        measure=(df.measure if "measure" in df else pd.Series("", index=df.index)).fillna("").replace("", "-"),
+        error=(df.headline if "headline" in df else df.mse).where(stepped),  # the headline measure's value
         commit=df.commit.astype(str).str[:7],
         code=codes(df).str[:8].replace("", "-"),  # "-": a row older than the code key
         note=(df.message if "message" in df else pd.Series("", index=df.index))

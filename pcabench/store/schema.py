@@ -103,6 +103,8 @@ FIELDS: dict[str, Field] = {
     "device": _name(max_len=32),
     "steps_requested": Field(("int",), low=0, high=MAX_STEPS),
     "mse_isothermal": _ERROR,
+    "measure": _name(max_len=32),  # the headline measure's name (SceneKind.measure): rms_u, probes_p, left_energy
+    "headline": _MEASURE,  # its value: the one error that means something at the run's end
     "errors": Field(("dict",)),  # the scene's other error measures, by name: numbers or null
     "probes": Field(("dict",)),  # readings at the scene's probe points, by name: lists of numbers
     "scene": Field(("dict",), True),

@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from solvers.reference.analytic import QUIET
-from solvers.scenes.base import SceneKind, left_behind, scored_axes
+from solvers.scenes.base import PULSE_REACH, SceneKind, left_behind, scored_axes
 
 LN2 = math.log(2.0)
 
@@ -197,6 +197,13 @@ class AcousticPulse(SceneKind):
         ref = self.reference(scene, t)
         x, y = np.meshgrid(ref.x, ref.y)
         return Fields(x=x.ravel(), y=y.ravel(), u=ref.u.ravel(), v=ref.v.ravel(), drho=ref.drho.ravel(), t=t)
+
+    def pulse_inside(self, scene, t: float) -> bool:
+        """The ring (its radius c0 t and :data:`PULSE_REACH` half-widths) has not reached an open edge."""
+        xc, yc = centre(scene)
+        gaps = {"x": (xc - scene.x_min, scene.x_max - xc), "y": (yc - scene.y_min, scene.y_max - yc)}
+        nearest = min((gap for axis in scene.open for gap in gaps[axis]), default=math.inf)
+        return scene.c0 * t + PULSE_REACH * scene.pulse_width <= nearest
 
     def errors(self, scene, fields) -> dict:
         ref = self.reference(scene, fields.t)

@@ -63,6 +63,10 @@ class Cylinder(SceneKind):
             return super().headline(t_end)
         return f"relative RMS error of p at the probes over {start:g} <= t <= {min(t_end, end):g} s"
 
+    def measure(self, scene, t: float) -> str:
+        """The workshop's measure, p at the probes over the window (``probes_p``), once the run reaches it."""
+        return "probes_p" if t >= self.window[0] else super().measure(scene, t)
+
     def probe_points(self, scene) -> dict:
         return probe_points(scene)
 

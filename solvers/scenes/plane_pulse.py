@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from solvers.reference.analytic import errors as analytic_errors
-from solvers.scenes.base import SceneKind, left_behind
+from solvers.scenes.base import PULSE_REACH, SceneKind, left_behind
 
 
 class PlanePulse(SceneKind):
@@ -44,10 +44,15 @@ class PlanePulse(SceneKind):
         """The simple wave's characteristics (speed u + c0) cross at t_b = 1 / max du/dx."""
         return scene.pulse_width / (scene.c0 * scene.mach * math.sqrt(2.0 / math.e))
 
+    def pulse_inside(self, scene, t: float) -> bool:
+        """The right-going pulse's front (its peak and :data:`PULSE_REACH` widths) has not reached x_max (an open
+        edge, or the free end it leaves by)."""
+        return scene.pulse_center + scene.c0 * t + PULSE_REACH * scene.pulse_width <= scene.x_max
+
     def errors(self, scene, fields) -> dict:
         err = analytic_errors(scene, fields.x, fields.u, fields.t)
         out = {"mse": err.mse, "me": err.me}
-        if scene.open:  # what the open ends leave behind, against the open line's pulse
+        if scene.open or not self.pulse_inside(scene, fields.t):  # what the ends leave behind, against the line's
             import numpy as np
 
             from solvers.reference.analytic import pulse_velocity

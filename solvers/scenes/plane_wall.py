@@ -24,7 +24,7 @@ simple waves crossing are not one.
 from __future__ import annotations
 
 from solvers.reference.analytic import pulse_velocity, relative_errors
-from solvers.scenes.base import wall_measures
+from solvers.scenes.base import PULSE_REACH, left_behind, wall_measures
 from solvers.scenes.plane_pulse import PlanePulse
 
 DEFAULT_WALL = 6.0  # m: the wall of plane-wall and pulse-wall by default, two pulse widths right of the pulse
@@ -92,10 +92,27 @@ class PlaneWall(PlanePulse):
         a, b = pulse_velocity(scene, x, t), pulse_velocity(scene, image_x(scene, x), t)
         return Fields(x=x, y=np.zeros_like(x), u=a - b, v=np.zeros_like(x), drho=scene.rho0 * (a + b) / scene.c0, t=t)
 
+    def pulse_inside(self, scene, t: float) -> bool:
+        """The reflected pulse's front (its peak, from the image's place 2 x_wall - x_c, and :data:`PULSE_REACH`
+        widths) has not reached the free left end."""
+        image = 2.0 * scene.walls["x_max"] - scene.pulse_center
+        return image - scene.c0 * t - PULSE_REACH * scene.pulse_width >= scene.x_min
+
     def errors(self, scene, fields) -> dict:
         ref = self.exact_velocity(scene, fields.x, fields.t)
         err = relative_errors(fields.u, ref, amplitude=scene.mach * scene.c0)
-        return {"mse": err.mse, "me": err.me, **wall_measures(scene, fields.x, fields.u - ref, ref)}
+        out = {
+            "mse": err.mse,
+            "me": err.me,
+            **wall_measures(scene, fields.x, fields.u - ref, ref, scene.mach * scene.c0),
+        }
+        if not self.pulse_inside(scene, fields.t):  # what the free end leaves behind, against the reflection
+            import numpy as np
+
+            x = np.asarray(fields.x, dtype=np.float64)
+            a, b = pulse_velocity(scene, x, fields.t), pulse_velocity(scene, image_x(scene, x), fields.t)
+            out.update(left_behind(scene, fields, (scene.rho0 * (a + b) / scene.c0, a - b, np.zeros_like(x))))
+        return out
 
     def isothermal_errors(self, scene, fields) -> float | None:
         return None

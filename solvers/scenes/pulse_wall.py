@@ -80,7 +80,12 @@ class PulseWall(AcousticPulse):
         out = measures(scene, fields.x, fields.y, fields.drho, fields.u, fields.v, values)
         for ray in ("front_axis", "front_diagonal"):  # the outgoing peak along a ray: the reflections cross it here
             out.pop(ray)
-        return {**out, **wall_measures(scene, fields.x, np.asarray(fields.drho, float) - values[0], values[0])}
+        return {
+            **out,
+            **wall_measures(
+                scene, fields.x, np.asarray(fields.drho, float) - values[0], values[0], scene.rho0 * scene.mach
+            ),
+        }
 
     def isothermal_errors(self, scene, fields) -> float | None:
         return None
