@@ -187,9 +187,12 @@ class RunRecord:
             + ("; the pulse has left: read the left measures below)" if scene.open else ")"),
             f"ME (max)         {number(self.me, '.6g')} {unit}",
         ]
+        if self.measure.startswith("probes_"):  # mse is the probes' measure, not the field's: the headline says so
+            lines[-1] = f"ME (max)         {number(self.me, '.6g')} {unit} (of {primary} at the probes)"
+            del lines[-2]
         if self.measure:  # the one error that means something at the run's end, by its name
             lines.insert(
-                len(lines) - 2,
+                len(lines) - (1 if self.measure.startswith("probes_") else 2),
                 f"headline         {self.measure} {number(self.headline, '.6g')}: "
                 f"{scene.kind.measure_words(self.measure, self.t_end)}",
             )
