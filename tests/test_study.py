@@ -299,6 +299,32 @@ def test_every_figure_is_drawn_and_both_machines_are_reported(results, tmp_path)
     cards = (out / "cards.md").read_text()
     assert "machine-b" in cards and "Tesla K20c" in cards and "Quadro M4000" in cards
     assert "machine-b" in (out / "README.md").read_text()
+    _figures_sit_in_their_sections_with_their_data(out / "machine-a")
+
+
+def _figures_sit_in_their_sections_with_their_data(folder):
+    """Issue 58: a contents list of the sections, each figure under the section that drew it (no pile at the
+    end), and each figure's data beside it as a CSV whose points are the ones drawn."""
+    import re
+
+    import pandas as pd
+
+    from pcabench.reports.build import anchor
+
+    text = (folder / "report.md").read_text()
+    headings = re.findall(r"^## (.+)$", text, flags=re.M)
+    assert "Figures" not in headings and len(headings) > 3
+    for title in headings:
+        assert f"- [{title}](#{anchor(title)})" in text  # the contents list links every section
+    sections = re.split(r"^## ", text, flags=re.M)
+    for png in folder.glob("*.png"):
+        (home,) = [s for s in sections if f"]({png.name})" in s]  # in exactly one section
+        assert home.split("\n", 1)[0] in headings
+        data = pd.read_csv(png.with_suffix(".csv"))
+        assert f"[{png.stem}.csv]({png.stem}.csv)" in home and len(data) > 0, png.name
+        assert data[["x", "y"]].notna().all(axis=1).any() and set(data.kind) <= {"line", "points", "bar"}
+    fig8 = pd.read_csv(folder / "fig8_error_vs_dx.csv")  # its measured points: the runs' dx and errors
+    assert {0.2, 0.1}.issubset(set(fig8.x.round(6)))
 
 
 def test_a_run_predicted_past_the_budget_is_skipped_not_run(tmp_path):

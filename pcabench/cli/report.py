@@ -12,6 +12,16 @@ from pcabench.errors import NoResults
 from pcabench.spec import OptionError
 
 
+def report_progress(line: str) -> None:
+    """A report's progress on stderr: one line rewritten in place on a terminal, a line each elsewhere (a log);
+    an empty ``line`` clears it."""
+    if sys.stderr.isatty():
+        sys.stderr.write("\r\x1b[K" + line)
+        sys.stderr.flush()
+    elif line:
+        print(line, file=sys.stderr, flush=True)
+
+
 def cmd_report(args) -> int:
     from pcabench.reports import write_reports
 
@@ -22,7 +32,9 @@ def cmd_report(args) -> int:
         results, reports = results or paths.reference_results(), reports or paths.reference_reports()
     results, reports = results or paths.user_results(), reports or paths.user_reports()
     check_folder(reports, "--out" if args.out else "--reference" if args.reference else home_option())
-    for p in write_reports(Path(results), Path(reports), scene=args.scene):
+    written = write_reports(Path(results), Path(reports), scene=args.scene, progress=report_progress)
+    report_progress("")
+    for p in written:
         print(f"wrote {p}", file=sys.stderr)
     return 0
 

@@ -87,7 +87,10 @@ def run_study(
         sweep(specs, store_path, run_budget, sweep_budget, retry_failed=retry_failed)
     if reports is None:
         return 0
-    written = write_reports(results, reports)
+    from pcabench.cli.report import report_progress
+
+    written = write_reports(results, reports, progress=report_progress)
+    report_progress("")
     for p in written:
         print(f"wrote {p}", file=sys.stderr)
     if not cluster:

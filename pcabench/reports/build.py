@@ -7,7 +7,9 @@ reports/README.md             the index
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
+from typing import Callable
 
 from pcabench import store
 from pcabench.errors import NoResults
@@ -38,19 +40,44 @@ def _machine(pid: str) -> str:
     return text
 
 
-def report_for(ctx: Context) -> Path:
+def anchor(title: str) -> str:
+    """The link anchor GitHub gives a Markdown heading ``title``: lower case, punctuation dropped, spaces -> "-"."""
+    return re.sub(r"[^\w\- ]", "", title.strip().lower()).replace(" ", "-")
+
+
+def contents(body: list[str]) -> list[str]:
+    """A contents list of the report's sections (its "## " headings), each a link to its place."""
+    titles = [line[3:].strip() for line in body if line.startswith("## ")]
+    return ["Contents:", "", *(f"- [{t}](#{anchor(t)})" for t in titles), ""] if titles else []
+
+
+def figure_lines(paths: list[Path]) -> list[str]:
+    """Each figure inline, under the section that drew it, with a link to its data (the CSV beside it)."""
+    lines = []
+    for p in paths:
+        lines += [f"![{p.stem}]({p.name})", ""]
+        if p.with_suffix(".csv").exists():
+            lines += [f"Data: [{p.stem}.csv]({p.stem}.csv) (one row per plotted point: replot it)", ""]
+    return lines
+
+
+def report_for(ctx: Context, progress: Callable[[str], None] | None = None) -> Path:
     """The report of one machine's runs (``ctx.name``: its profile id, with its host where a profile has
-    several): each section's rows computed once, then its Markdown and its figures from them."""
+    several): each section's rows computed once, then its Markdown and its figures from them, the figures inline
+    under their section with their data beside them; ``progress`` is told each section as it starts."""
     out, df = ctx.out, ctx.df_scenes if ctx.df_scenes is not None else ctx.df
     own_folder(out, "report folder", within=out.parent)  # a link is refused: nothing written or deleted there
     body, figs = [], []
-    for section in sections.in_order():  # read at each report: a section registered since is in it
-        if ctx.df.empty and not section.all_scenes:
-            continue  # this machine ran other scenes only
+    chosen = [s for s in sections.in_order() if not ctx.df.empty or s.all_scenes]  # else: other scenes only
+    for i, section in enumerate(chosen, 1):  # read at each report: a section registered since is in it
+        if progress:
+            progress(f"report {ctx.name}: section {i} of {len(chosen)}, {section.name}")
         rows = section.rows(ctx)
-        body += section.text(rows, ctx)
-        figs += [p for p in (draw(rows, ctx) for draw in section.figures) if p is not None]
-    for stale in set(out.glob("*.png")) - set(figs):  # a figure whose data is gone is not left behind
+        drawn = [p for p in (draw(rows, ctx) for draw in section.figures) if p is not None]
+        body += section.text(rows, ctx) + figure_lines(drawn)
+        figs += drawn
+    kept = set(figs) | {p.with_suffix(".csv") for p in figs}
+    for stale in (set(out.glob("*.png")) | set(out.glob("*.csv"))) - kept:  # a figure whose data is gone: gone
         stale.unlink()
     counts = df.status.value_counts().to_dict()
     keys = runs.codes(df)
@@ -72,12 +99,9 @@ def report_for(ctx: Context) -> Path:
         "the other one) and names its protocol; Table 4 names the commit of each row. Regenerate with "
         "`pcabench report`.",
         "",
+        *contents(body),
         *body,
-        "## Figures",
-        "",
     ]
-    for p in figs:
-        lines += [f"![{p.stem}]({p.name})", ""]
     return write_file(out / "report.md", "\n".join(lines) + "\n")
 
 
@@ -253,8 +277,11 @@ def open_study(df):
     return edges | (df.preset == OPEN) | df.preset.map(lambda p: open_cost_round(p) is not None)
 
 
-def write_reports(results_dir: Path, reports_dir: Path, scene: str | None = None) -> list[Path]:
-    """Every report from the stores in ``results_dir`` (only ``scene``'s runs, if given) into ``reports_dir``."""
+def write_reports(
+    results_dir: Path, reports_dir: Path, scene: str | None = None, progress: Callable[[str], None] | None = None
+) -> list[Path]:
+    """Every report from the stores in ``results_dir`` (only ``scene``'s runs, if given) into ``reports_dir``;
+    ``progress`` (a callable taking one line) is told each machine's sections as they start."""
     df_all = frame.load(results_dir)
     if scene is not None and not df_all.empty:
         df_all = df_all[df_all.scene == scene]
@@ -279,7 +306,8 @@ def write_reports(results_dir: Path, reports_dir: Path, scene: str | None = None
                 shared,
                 df_scenes=g,
                 df_open=everything[everything.machine == name],
-            )
+            ),
+            progress,
         )
         for name, g in everything[~open_study(everything)].groupby("machine")
     ]

@@ -22,6 +22,7 @@ from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 from pcabench.predict.stability import UNSTABLE_BY_PREDICTION
 from pcabench.reports import paper as P
 from pcabench.reports import tables as T
+from pcabench.reports.figdata import save_figure_data
 from pcabench.store.safeio import save_figure
 from solvers import kernel_names, scene_kind
 
@@ -123,6 +124,7 @@ def figure(
         fig.legend([handles[lab] for lab in labels], labels, loc="outside right center", fontsize=7, frameon=False)
     _suptitle(fig, title)
     save_figure(fig, path, dpi=110)  # whole or not at all; a link at its name is replaced, not followed
+    save_figure_data(fig, path)  # its data beside it, as a CSV a reader replots
     plt.close(fig)
 
 
@@ -439,7 +441,7 @@ def _shares(path, title, xlabel, rows, published, stages):
                 hatch=hatch,
                 edgecolor="white" if hatch is None else "0.25",
                 lw=0.4,
-                label=s.upper() if ax is axes[0] else None,
+                label=s.upper() if ax is axes[0] else f"_{s.upper()}",  # "_": out of the legend, in the data
             )
             left += vals
         ax.set_yticks(range(len(items)))
@@ -452,6 +454,7 @@ def _shares(path, title, xlabel, rows, published, stages):
     fig.legend(loc="outside lower center", ncols=len(stages), fontsize=8, frameon=False)
     _suptitle(fig, title)
     save_figure(fig, path, dpi=110)  # whole or not at all; a link at its name is replaced, not followed
+    save_figure_data(fig, path)  # its data beside it, as a CSV a reader replots
     plt.close(fig)
     return path
 
