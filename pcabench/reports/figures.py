@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+from matplotlib.ticker import FixedLocator, LogFormatterSciNotation, NullFormatter, NullLocator
 
 from pcabench.predict.stability import UNSTABLE_BY_PREDICTION
 from pcabench.reports import paper as P
@@ -293,13 +293,23 @@ def fig9(rows, out: Path, pid: str):
                 zorder=4,
                 ls="none",  # the paper gives two sizes 2.4 decades apart: a line would invent the ones between
             )
-        skipped = [r["N"] for r in rows if r["allpair_status"] == "skipped"]
-        for n in skipped:
-            a.axvline(n, color="tab:gray", ls=":", lw=1)
+        skipped = sorted(r["N"] for r in rows if r["allpair_status"] == "skipped")
+        measured = sorted((r["N"], r["allpair_ms"]) for r in rows if r["allpair_ms"])
+        if skipped and len(measured) >= 2:  # where it would be: the measured a N^b, as the sweep predicted it
+            b_exp, log_a = np.polyfit(np.log([n for n, _ in measured]), np.log([ms for _, ms in measured]), 1)
+            n_pred = [measured[-1][0], *skipped]
+            a.plot(
+                n_pred,
+                np.exp(log_a) * np.asarray(n_pred, float) ** b_exp,
+                color=SEARCH_COLOUR["all-pair"],
+                ls=":",
+                marker="o",
+                mfc="none",
+                markevery=list(range(1, len(n_pred))),
+                label=f"all-pair, predicted (N^{b_exp:.2f} fit; skipped: past the run budget)",
+            )
         a.set_ylabel("one step (ms)")
-        a.set_title(
-            "runtime" + (" (dotted: all-pair predicted past the budget, skipped)" if skipped else ""), fontsize=9
-        )
+        a.set_title("runtime", fontsize=9)
         pts = [(r["N"], r["eta"]) for r in rows if r["eta"]]
         if pts:
             b.plot(*zip(*pts), marker="o", color="tab:purple", label="speedup eta (measured)")
@@ -373,8 +383,9 @@ def fig10(series, out: Path, pid: str):
                 )
             ax.set_title(f"runs to t = {run[4:]}" if run.startswith("t =") else f"runs of {run}", fontsize=9)
             sizes = [n for s in series if s["run"] == run for n in s["N"]]
-            if max(sizes) / min(sizes) < 100:  # under two decades: ticks at the sizes run, never 2x10^5
-                plain_log_ticks(ax, sizes, axis="x", spread=3.0)
+            if max(sizes) / min(sizes) < 100:  # under two decades: ticks at the sizes run, written as the
+                plain_log_ticks(ax, sizes, axis="x", spread=3.0)  # other panels write theirs (2.5 x 10^4)
+                ax.xaxis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False))
                 ax.xaxis.set_minor_locator(NullLocator())
             if run != paper_panel:
                 continue
@@ -527,7 +538,10 @@ def fig13(rows, out: Path, pid: str):
 
 
 def fig14(rows, out: Path, title: str):
-    """Speedup per step of each GPU over its own host's CPU, beside the paper's three systems (Table 6)."""
+    """Speedup per step of each GPU over its own host's CPU, beside the paper's three systems (Table 6); a GPU
+    measured only against another machine's CPU is drawn apart (dash-dotted, hollow, "across machines", with
+    its commit): a measured card, not one machine's speedup."""
+    across = [r for r in rows if not r["same_machine"]]
     rows = [r for r in rows if r["same_machine"]]
     path = out / "fig14_speedup_vs_N.png"
     pub = P.table6()
@@ -535,12 +549,14 @@ def fig14(rows, out: Path, title: str):
     colours = palette(len(keys))
     values = (
         [r["speedup"] for r in pub]
-        + [r["speedup"] for r in rows]
+        + [r["speedup"] for r in rows + across]
         + [r["speedup_all_cores"] for r in rows if r["speedup_all_cores"]]
     )
     with figure(
         path,
-        f"Fig. 14: GPU speedup per step over its own host's CPU ({title})",
+        "Fig. 14: GPU speedup per step over one CPU core, its own host's"
+        + (" or, dash-dotted, another machine's" if across else "")
+        + f" ({title})",
         "particles N",
         "speedup per step",
         logx=True,
@@ -576,12 +592,29 @@ def fig14(rows, out: Path, title: str):
                     mfc="none",
                     label=f"{gp} {prec} vs all cores of its host, {how}",
                 )
+        others = sorted({(r["gpu_profile"], r["precision"], r["protocol"], r["cpu_profile"]) for r in across})
+        for colour, (gp, prec, how, cp) in zip(palette(len(keys) + len(others))[len(keys) :], others):
+            pts = [
+                r
+                for r in across
+                if (r["gpu_profile"], r["precision"], r["protocol"], r["cpu_profile"]) == (gp, prec, how, cp)
+            ]
+            commits = ", ".join(sorted({r["gpu_commit"] for r in pts}))
+            ax.plot(
+                [r["N"] for r in pts],
+                [r["speedup"] for r in pts],
+                marker=PRECISION_MARKER[prec],
+                color=colour,
+                ls="-.",
+                mfc="none",
+                label=f"{gp.split('__')[0]} {prec} vs one core of {cp}\n(across machines; GPU at {commits}; {how})",
+            )
         nice_log_ticks(ax, values)
-        if not rows:
+        if not rows and not across:
             ax.text(
                 0.02,
                 0.95,
-                "no GPU measured with its own host's CPU yet: only the paper's lines",
+                "no GPU measured yet: only the paper's lines",
                 transform=ax.transAxes,
                 fontsize=8,
                 color="0.3",

@@ -199,6 +199,7 @@ def table6(df_all) -> list[dict]:
         rows.append(
             {
                 "gpu_profile": g.profile_id,
+                "gpu_commit": str(g.commit)[:7],
                 "cpu_profile": c.profile_id,
                 "same_machine": c.profile_id == g.profile_id,
                 "N": int(g.n_particles),
