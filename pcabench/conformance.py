@@ -39,7 +39,17 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError, SolverUnavailable, kernel_names, solver_class
+from solvers import (
+    INTEGRATORS,
+    MODELS,
+    PRECISIONS,
+    Scene,
+    SceneError,
+    SolverUnavailable,
+    kernel_names,
+    scenes,
+    solver_class,
+)
 from solvers.corrections import correction_names
 from solvers.interface import STAGES, Solver
 from solvers.physics.integrators import advance_steps, evolve
@@ -47,52 +57,27 @@ from solvers.registry import SOLVERS
 
 REFERENCE = "allpair-cpu"  # the all-pair search: every pair tested, no cell list to get wrong
 TOLERANCE = {"float64": 1e-12, "float32": 2e-5}  # relative to the field's max: round-off of a few steps
-# a walled scene at its smallest (182 particles): the narrow kernel (h 1.3 dx) lets a 14 x 13 m box hold the
-# 3 cells of a cutoff across; the pulse is narrow and 4 m from the right wall (clear of its support, 3.9 m), so
-# that its tail is at the wall and every mirror pair counts from the first step
-TINY_WALLED = dict(
-    dx=1.0, x_min=-8.0, x_max=6.0, y_min=-6.5, y_max=6.5, h_factor=1.3, pulse_width=1.5, pulse_center=2.0
-)
-SCENES = {  # the scene kinds at their smallest: free-x, x-periodic, walled at one and at both x ends, open
-    "plane-pulse": dict(dx=1.0, x_min=-8.0, x_max=8.0),
-    "acoustic-pulse": dict(dx=1.0, name="acoustic-pulse", x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0),
-    "plane-wall": dict(name="plane-wall", **TINY_WALLED),
-    "pulse-wall": dict(name="pulse-wall", **TINY_WALLED),
-    # open x edges: an absorbing layer beyond the domain, the pulse's flank in it from the start (a solver that
-    # skips the layer's damping, Solver.absorb around each kick and advance, or scores the layer's particles
-    # fails agreement here)
-    "plane-pulse-open": dict(dx=1.0, x_min=-8.0, x_max=8.0, open="x", layer_width=3.0, pulse_center=5.0),
-    # all four edges open (free y edges) with the split-field PML (the x part of the continuity rate): the pulse
-    # off-centre, its flank in the right and the corner layers from the start
-    "acoustic-pulse-open": dict(
-        dx=1.0,
-        name="acoustic-pulse",
-        x_min=-6.0,
-        x_max=6.0,
-        y_min=-6.0,
-        y_max=6.0,
-        pulse_width=1.5,
-        pulse_center=3.0,
-        open="xy",
-        layer_width=3.0,
-    ),
-    # a rigid cylinder with its ghost particles (solvers/bodies/: the default boundary method), the pulse's flank
-    # at its wall from the first step (a solver that skips the ghosts' values, Solver.fill_body, fails agreement)
-    "cylinder": dict(
-        dx=0.125,
-        name="cylinder",
-        x_min=-1.375,  # the body and the pulse with 3 widths about it (1,376 particles with the layer)
-        x_max=2.75,
-        y_min=-1.375,
-        y_max=1.375,
-        pulse_width=0.3,
-        pulse_center=1.85,
-    ),
-}
 # the paper's scene at 3,200 particles, checked once with the defaults: a solver wrong only past the tiny lattices'
 # few hundred particles (its cells, blocks or threads laid out otherwise) fails here
 LARGER = "plane-pulse-3200"
-SCENES[LARGER] = dict(dx=0.5, x_min=-20.0, x_max=20.0)
+LARGER_SCENE = dict(dx=0.5, x_min=-20.0, x_max=20.0)
+
+
+def scene_cases() -> dict[str, dict]:
+    """The conformance scenes (Scene fields, name included): every registered scene kind at its smallest
+    (SceneKind.smallest: free-x, x-periodic, walled at one and at both x ends, a body), with open edges where the
+    kind has such a case (``<name>-open``, SceneKind.smallest_open), and :data:`LARGER`. Read at each check: a
+    scene kind registered since (a plug-in) is checked too, with no list to edit."""
+    out = {}
+    for name, kind in scenes().items():
+        out[name] = {"name": name, **kind.smallest}
+        if kind.smallest_open is not None:
+            out[f"{name}-open"] = {"name": name, **kind.smallest_open}
+    out[LARGER] = dict(LARGER_SCENE)
+    return out
+
+
+SCENES = scene_cases()  # the built-in kinds' (the GPU check's rehearsal plan reads them at import)
 AXES = ("precision", "model", "integrator", "kernel", "correction")  # Scene fields a class claims values of
 ALL_VALUES = {"precision": PRECISIONS, "model": MODELS, "integrator": INTEGRATORS}  # kernels, corrections: all_values
 CLAIMS = {
@@ -158,6 +143,7 @@ class Subject:
         # numba-cuda's simulator runs a GPU class's threads in Python: the larger lattice is checked on a card only
         self.simulated = cls.device == "gpu" and os.environ.get("NUMBA_ENABLE_CUDASIM") == "1"
         self.runs: dict = {}
+        self.cases = scene_cases()  # every scene kind registered now, at its smallest
 
     def default(self, axis: str) -> str:
         """The Scene's default value of ``axis`` if the class claims it, else its first claimed value."""
@@ -167,14 +153,14 @@ class Subject:
     def claimed_scenes(self) -> list[str]:
         return [
             name
-            for name in SCENES
+            for name in self.cases
             if name != LARGER and set(self.scene(name=name).boundaries) <= set(self.cls.boundaries)
         ]
 
     def scene(self, name: str = "plane-pulse", steps: int | None = None, **method) -> Scene:
         """A conformance scene: ``name``'s tiny lattice with the class's defaults and ``method`` on top."""
         base = {axis: self.default(axis) for axis in AXES if getattr(self.cls, CLAIMS[axis], None)}
-        return Scene(**{**SCENES[name], "steps": steps or self.steps, **base, **method})
+        return Scene(**{**self.cases[name], "steps": steps or self.steps, **base, **method})
 
     def configurations(self) -> list[dict]:
         """(scene name, method, pair loop) to check: the full product, or (quick) the defaults and each
@@ -190,7 +176,7 @@ class Subject:
         out = [base, *larger]
         for axis, values in axes.items():
             out += [{**base, axis: value} for value in values if value != base[axis]]
-        walled = [name for name in axes["scene"] if Scene(**SCENES[name]).walls]
+        walled = [name for name in axes["scene"] if Scene(**self.cases[name]).walls]
         out += [
             {**base, "scene": name, "model": model}
             for name in walled
@@ -568,7 +554,9 @@ def claims(subject: Subject) -> str:
             problems.append(f"{CLAIMS[axis]} {tuple(claimed)}: {what}")
         probes += [(f"{axis} {value}", subject.scene(**{axis: value}), value in claimed) for value in all_values(axis)]
     probes += [
-        (f"scene {name}", subject.scene(name), name in subject.claimed_scenes()) for name in SCENES if name != LARGER
+        (f"scene {name}", subject.scene(name), name in subject.claimed_scenes())
+        for name in subject.cases
+        if name != LARGER
     ]
     ran = 0
     for what, scene, claimed in probes:

@@ -187,10 +187,10 @@ def test_a_solver_without_walls_is_refused_a_walled_scene_in_one_line_and_confor
         assert len(message.splitlines()) == 1 and "wall-x" in message and scene in message, message
     (claims,) = check_solver(NoWalls, quick=True, only=("claims",))
     assert claims.status == "ok", claims.line()
-    assert Subject(NoWalls, quick=True).claimed_scenes() == [
+    assert Subject(NoWalls, quick=True).claimed_scenes() == [  # the scene registry's order, each kind's open case next
         "plane-pulse",
-        "acoustic-pulse",
         "plane-pulse-open",
+        "acoustic-pulse",
         "acoustic-pulse-open",
         "cylinder",
     ]
@@ -285,3 +285,34 @@ def test_a_solver_that_skips_the_pmls_split_fails_agreement_on_the_open_square_o
     (result,) = check_solver(IgnoresTheSplit, quick=True, only=("agreement",))
     assert result.failed and "acoustic-pulse-open" in result.message, result.message
     assert "plane-pulse-open" not in result.message and "acoustic-pulse/" not in result.message, result.message
+
+
+def test_a_new_scene_kind_is_checked_everywhere_with_no_list_to_edit():
+    """Issue 58: the conformance suite and the GPU check read their cases from the scene kinds
+    (SceneKind.smallest, smallest_open, card, card_open): a kind registered now is in both."""
+    from pcabench.conformance import Subject, scene_cases
+    from pcabench.gpu.plan import Plan
+    from solvers.scenes import SCENES
+    from solvers.scenes.plane_pulse import PlanePulse
+    from solvers.scenes.plane_wall import PlaneWall
+
+    class ShortDuct(PlaneWall):
+        name = "short-duct"
+        summary = "a walled duct (a test's plug-in)"
+
+    class OpenLine(PlanePulse):
+        name = "open-line"
+        summary = "the plane pulse again (a test's plug-in)"
+        card_open = {"dx": 0.5, "open": "x"}
+
+    with SCENES.registered(ShortDuct), SCENES.registered(OpenLine):
+        cases = scene_cases()
+        assert cases["short-duct"]["name"] == "short-duct" and "short-duct-open" not in cases  # a wall: no open case
+        assert cases["open-line-open"]["open"] == "x"
+        claimed = Subject(LinkedListCPU, quick=True).claimed_scenes()
+        assert {"short-duct", "open-line", "open-line-open"} <= set(claimed)
+        Scene(**cases["short-duct"], steps=1)  # a case the Scene takes
+        plan = Plan()
+        assert {"name": "short-duct", "dx": 0.5} in plan.wall_scenes
+        assert {"name": "open-line", "dx": 0.5, "open": "x"} in plan.open_scenes
+    assert "short-duct" not in scene_cases() and "short-duct" not in str(Plan().wall_scenes)

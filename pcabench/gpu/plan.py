@@ -20,6 +20,18 @@ HIGH_ORDER = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0,
 RESERVE_S = 25.0  # kept back from every stage for the reports and the tarball
 
 
+def card_cases(which, open_edges: bool = False) -> tuple:
+    """The GPU check's cases on a card (Scene fields, name included): each registered scene kind ``which``
+    selects, at its card size (SceneKind.card, or with open edges SceneKind.card_open)."""
+    from solvers import scenes
+
+    return tuple(
+        {"name": name, **(kind.card_open if open_edges else kind.card)}
+        for name, kind in scenes().items()
+        if which(kind)
+    )
+
+
 @dataclass(frozen=True)
 class Plan:
     """What the check runs and at what size."""
@@ -30,19 +42,16 @@ class Plan:
     max_steps: int = 100
     compare_dx: float = 0.5
     compare_steps: int = 20
-    # the walled scenes (Scene fields, name included), run compare_steps steps; their default domains here
-    wall_scenes: tuple = ({"name": "plane-wall", "dx": 0.5}, {"name": "pulse-wall", "dx": 0.5})
+    # the walled scenes (Scene fields, name included), run compare_steps steps: every scene kind with walls at
+    # its card size (SceneKind.card: a new walled kind is checked with no list to edit)
+    wall_scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: bool(kind.walls)))
     wall_models: tuple = ("linear", "lagrangian")  # mirrors set once; mirrors following the particles
     # open edges (issue 41): the 2D pulse in a 24 m open square (free y edges, the PML) and the paper's pulse with
     # open x edges (the sponge), against the CPU solver; then the time per step closed and open, alternating
-    open_scenes: tuple = (
-        {"name": "acoustic-pulse", "dx": 0.25, "x_min": -12.0, "x_max": 12.0, "y_min": -12.0, "y_max": 12.0,
-         "open": "xy"},
-        {"dx": 0.25, "open": "x"},
-    )  # fmt: skip
+    open_scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: kind.card_open is not None, True))
     # a body (issue 42): the workshop's cylinder at 5 particles a pulse width (102,400 particles), each boundary
     # method (its ghosts filled from the fluid on the host), linear and lagrangian, against the CPU solver
-    body_scenes: tuple = ({"name": "cylinder", "dx": 0.04},)
+    body_scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: kind.body))
     body_methods: tuple = ("lattice", "rings")
     body_models: tuple = ("linear", "lagrangian")
     body_precisions: tuple = ("float64", "float32")

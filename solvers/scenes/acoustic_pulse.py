@@ -198,6 +198,23 @@ class AcousticPulse(SceneKind):
         x, y = np.meshgrid(ref.x, ref.y)
         return Fields(x=x.ravel(), y=y.ravel(), u=ref.u.ravel(), v=ref.v.ravel(), drho=ref.drho.ravel(), t=t)
 
+    smallest = {"dx": 1.0, "x_min": -10.0, "x_max": 10.0, "y_min": -10.0, "y_max": 10.0}
+    # all four edges open (free y edges) with the split-field PML (the x part of the continuity rate): the pulse
+    # off-centre, its flank in the right and the corner layers from the start
+    smallest_open = {
+        "dx": 1.0,
+        "x_min": -6.0,
+        "x_max": 6.0,
+        "y_min": -6.0,
+        "y_max": 6.0,
+        "pulse_width": 1.5,
+        "pulse_center": 3.0,
+        "open": "xy",
+        "layer_width": 3.0,
+    }
+    # a 24 m open square (free y edges, the PML)
+    card_open = {"dx": 0.25, "x_min": -12.0, "x_max": 12.0, "y_min": -12.0, "y_max": 12.0, "open": "xy"}
+
     def pulse_inside(self, scene, t: float) -> bool:
         """The ring (its radius c0 t and :data:`PULSE_REACH` half-widths) has not reached an open edge."""
         xc, yc = centre(scene)

@@ -123,6 +123,16 @@ class SceneKind:
     # edge there gives the open problem itself; a strip's y is a slice of a plane wave and stays periodic
     images: tuple = ()
 
+    # Where every solver is checked on this kind (Scene fields over the kind's defaults), so that a new kind is
+    # checked everywhere without a list to edit: ``smallest``, a few hundred particles with its boundaries acting
+    # from the first step, for the conformance suite (pcabench/conformance.py) and the GPU check's rehearsal;
+    # ``smallest_open`` the same with open edges (None: none to open); ``card`` and ``card_open`` the GPU check's
+    # comparison of the GPU solver with the CPU one on a card (pcabench/gpu/plan.py: walls, bodies, open edges).
+    smallest: dict = {"dx": 1.0}
+    smallest_open: dict | None = None
+    card: dict = {"dx": 0.5}
+    card_open: dict | None = None
+
     def boundaries(self, scene=None) -> frozenset:
         """The boundary kinds this scene needs of a solver (with ``scene``'s open edges, which are free edges
         of the lattice beyond the layer)."""

@@ -53,6 +53,19 @@ class Cylinder(SceneKind):
     primary = "drho"
     body = True
     window = WINDOW  # s: where the probes are scored
+    # a rigid cylinder with its ghost particles (solvers/bodies/: the default boundary method), the pulse's flank
+    # at its wall from the first step (a solver that skips the ghosts' values, Solver.fill_body, fails agreement):
+    # the body and the pulse with 3 widths about it (1,376 particles with the layer)
+    smallest = {
+        "dx": 0.125,
+        "x_min": -1.375,
+        "x_max": 2.75,
+        "y_min": -1.375,
+        "y_max": 1.375,
+        "pulse_width": 0.3,
+        "pulse_center": 1.85,
+    }
+    card = {"dx": 0.04}  # the workshop's cylinder at 5 particles a pulse width (102,400 particles)
 
     def body_of(self, scene) -> tuple:
         return 0.0, 0.0, float(scene.cylinder_radius)

@@ -44,6 +44,13 @@ class PlanePulse(SceneKind):
         """The simple wave's characteristics (speed u + c0) cross at t_b = 1 / max du/dx."""
         return scene.pulse_width / (scene.c0 * scene.mach * math.sqrt(2.0 / math.e))
 
+    smallest = {"dx": 1.0, "x_min": -8.0, "x_max": 8.0}
+    # open x edges: an absorbing layer beyond the domain, the pulse's flank in it from the start (a solver that
+    # skips the layer's damping, Solver.absorb around each kick and advance, or scores the layer's particles
+    # fails agreement here)
+    smallest_open = {"dx": 1.0, "x_min": -8.0, "x_max": 8.0, "open": "x", "layer_width": 3.0, "pulse_center": 5.0}
+    card_open = {"dx": 0.25, "open": "x"}  # the paper's pulse with open x edges (the sponge)
+
     def pulse_inside(self, scene, t: float) -> bool:
         """The right-going pulse's front (its peak and :data:`PULSE_REACH` widths) has not reached x_max (an open
         edge, or the free end it leaves by)."""

@@ -28,6 +28,19 @@ from solvers.scenes.base import PULSE_REACH, left_behind, wall_measures
 from solvers.scenes.plane_pulse import PlanePulse
 
 DEFAULT_WALL = 6.0  # m: the wall of plane-wall and pulse-wall by default, two pulse widths right of the pulse
+# a walled scene at its smallest (182 particles): the narrow kernel (h 1.3 dx) lets a 14 x 13 m box hold the
+# 3 cells of a cutoff across; the pulse is narrow and 4 m from the right wall (clear of its support, 3.9 m), so
+# that its tail is at the wall and every mirror pair counts from the first step
+SMALLEST_WALLED = {
+    "dx": 1.0,
+    "x_min": -8.0,
+    "x_max": 6.0,
+    "y_min": -6.5,
+    "y_max": 6.5,
+    "h_factor": 1.3,
+    "pulse_width": 1.5,
+    "pulse_center": 2.0,
+}
 
 
 def image_x(scene, x):
@@ -69,6 +82,9 @@ class PlaneWall(PlanePulse):
     primary = "u"
     has_isothermal = False
     strip = True
+    smallest = SMALLEST_WALLED
+    smallest_open = None  # its x edge is a wall, its y a plane wave's: nothing to open
+    card_open = None
 
     def initial_fields(self, scene, x, y, xp):
         incident, image = (

@@ -27,7 +27,7 @@ import numpy as np
 
 from solvers.scenes.acoustic_pulse import LN2, AcousticPulse, centre, measures
 from solvers.scenes.base import wall_measures
-from solvers.scenes.plane_wall import DEFAULT_WALL, wall_check
+from solvers.scenes.plane_wall import DEFAULT_WALL, SMALLEST_WALLED, wall_check
 
 
 def _wrap(xp, d, period: float):
@@ -40,6 +40,9 @@ class PulseWall(AcousticPulse):
     summary = "the 2D acoustic pulse two widths from a rigid wall at --wall-x, in a duct walled at both x ends"
     periodic = ("y",)
     images = ()  # its reference is the walls' mirror images on a periodic lattice: no edge opens
+    smallest = SMALLEST_WALLED
+    smallest_open = None
+    card_open = None
     walls = ("x_min", "x_max")
     domain = {"x_min": -14.0, "x_max": DEFAULT_WALL, "y_min": -10.0, "y_max": 10.0}
     has_isothermal = False
