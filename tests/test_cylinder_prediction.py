@@ -93,7 +93,7 @@ def test_advise_names_the_cheapest_method_predicted_to_reach_the_probes_target(m
     h) and names the cheapest method predicted to reach it, with the study that runs it; a target none reaches
     gets the closest method, predicted, in words."""
     from pcabench import cli, store
-    from pcabench.cli import advise as A
+    from pcabench.predict import search as A
     from pcabench.predict.stability import scene_limit
     from solvers import kernel_named, kernel_names
 

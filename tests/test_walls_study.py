@@ -228,7 +228,7 @@ def test_advise_searches_the_prediction_on_a_wall_scene(tmp_path, capsys):
     def error(dx):
         return predict(Scene(dx=dx, name="plane-wall", t_end=10.0, model="linear")).predicted_error
 
-    from pcabench.cli.advise import SEARCH_DX
+    from pcabench.predict.search import SEARCH_DX
     from solvers import SceneError
 
     coarser = []
