@@ -476,8 +476,8 @@ def test_a_full_disk_during_report_names_the_path_and_leaves_no_partial_file(tmp
 
     monkeypatch.setattr(safeio, "_write_all", full_text)
     code, _, err = cli_main("report", "--results", str(results), "--out", str(out), capsys=capsys)
-    assert code == 2 and "No space left on device" in err and str(out / "m" / "report.md") in err, err
-    assert sorted({p.suffix for p in out.rglob("*") if p.is_file()}) == [".png"]  # whole figures, no page
+    assert code == 2 and "No space left on device" in err and str(out / "m") in err, err  # a figure's CSV first
+    assert sorted({p.suffix for p in out.rglob("*") if p.is_file()}) == [".png"]  # whole figures, no data, no page
 
 
 # ---------------------------------------------------------------- issue 57: answers that keep one meaning
@@ -525,7 +525,7 @@ def test_a_sigterm_from_the_first_instant_is_terminated_not_interrupted(tmp_path
     import time
 
     proc = subprocess.Popen(
-        [sys.executable, "-m", "pcabench.launch", "study", "--dx", "1", "--steps", "2", "--no-report"]
+        [sys.executable, "-m", "pcabench.console", "study", "--dx", "1", "--steps", "2", "--no-report"]
         + ["--results", str(tmp_path)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -568,8 +568,11 @@ def test_a_sweeps_forkserver_ignores_the_terminals_ctrl_c_from_its_start(tmp_pat
         assert server is not None, "no forkserver seen"
         while not run_children(server) and time.time() < deadline and proc.poll() is None:
             time.sleep(0.02)  # a run under way: the sweep ignores SIGINT only while it spawns its server
-        with open(f"/proc/{server}/status") as f:
-            ignored = int(next(line for line in f if line.startswith("SigIgn:")).split()[1], 16)
+        try:
+            with open(f"/proc/{server}/status") as f:
+                ignored = int(next(line for line in f if line.startswith("SigIgn:")).split()[1], 16)
+        except FileNotFoundError:  # the sweep ended first (a loaded machine): nothing of the server to read
+            pytest.skip("the sweep's server had exited before the test read its signal mask")
         assert ignored & (1 << (signal.SIGINT - 1)), f"the server takes SIGINT (SigIgn {ignored:x})"
         os.killpg(proc.pid, signal.SIGINT)  # the terminal's Ctrl-C: the whole group
         _, err = proc.communicate(timeout=120)
@@ -586,7 +589,7 @@ def test_ctrl_c_during_a_run_ends_its_progress_line_first():
     import time
 
     proc = subprocess.Popen(
-        [sys.executable, "-m", "pcabench.launch", "run", "--solver", "linkedlist-cpu", "--dx", "0.25"]
+        [sys.executable, "-m", "pcabench.console", "run", "--solver", "linkedlist-cpu", "--dx", "0.25"]
         + ["--steps", "1000000", "--model", "linear"],  # steps of milliseconds: the interrupt is seen at once
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,

@@ -170,7 +170,7 @@ LAYERS = (
     ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops
     ("solvers.allpair_cpu", "solvers.linkedlist_cpu", "solvers.linkedlist_gpu", "solvers.registry"),  # solvers
     ("solvers",),  # the package's face
-    ("pcabench", "pcabench.errors", "pcabench.paths", "pcabench.jsonout", "pcabench.parameters", "pcabench.parser"),
+    ("pcabench", "pcabench.errors", "pcabench.paths", "pcabench.jsonout", "pcabench.parameters", "pcabench.usage"),
     ("pcabench.spec", "pcabench.commands"),  # what one run is, and the command that makes it again
     ("pcabench.store",),  # the run record, its schema and the results store
     ("pcabench.machine",),  # this machine's profile and memory
@@ -180,7 +180,7 @@ LAYERS = (
     ("pcabench.reports",),  # tables, sections, figures
     ("pcabench.bench",),  # asv
     ("pcabench.gpu",),  # the GPU check
-    ("pcabench.cli", "pcabench.launch"),  # the command line, and the console script that imports it
+    ("pcabench.cli", "pcabench.console"),  # the command line, and the console script that imports it
 )
 
 

@@ -675,5 +675,5 @@ def test_a_child_claiming_more_time_than_its_process_took_is_an_error(tmp_path, 
 
 def test_a_ctrl_c_while_the_plugins_load_is_one_line(tmp_path):
     site = install(tmp_path / "site", "slow", "raise KeyboardInterrupt\n", {"slow": "slow:Solver"})  # a Ctrl-C
-    out = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", module="pcabench.launch", site=site)
+    out = pcabench("run", "--solver", "linkedlist-cpu", "--dx", "1", module="pcabench.console", site=site)
     assert out.returncode == 130 and out.stderr.strip().splitlines() == ["pcabench: interrupted"], out.stderr

@@ -43,7 +43,7 @@ def scratch_config(results: Path, root: Path = ROOT, name: str = "smoke") -> Pat
 
 
 def main(argv=None) -> int:
-    from pcabench.parser import Parser  # a usage error is one line, exit code 2
+    from pcabench.usage import Parser  # a usage error is one line, exit code 2
 
     p = Parser(prog="python -m pcabench.bench.asv_smoke", description=__doc__.split("\n")[0])
     p.add_argument("--machine", help="asv's machine name (default: `pcabench profile --asv`, which writes it)")

@@ -39,9 +39,9 @@ from pcabench.cli.parsers import build_parser
 from pcabench.cli.study import study_specs  # noqa: F401 - the package's face
 from pcabench.errors import NoResults, StoreFull
 from pcabench.execute.progress import end_line
-from pcabench.parser import EXIT_BAD_INPUT, Parser
 from pcabench.spec import OptionError
 from pcabench.store import StoreError
+from pcabench.usage import EXIT_BAD_INPUT, Parser
 from solvers import SceneError, SolverUnavailable
 
 

@@ -1,7 +1,7 @@
-"""``python -m pcabench.cli``: the command line, as the console script runs it (pcabench/launch.py)."""
+"""``python -m pcabench.cli``: the command line, as the console script runs it (pcabench/console.py)."""
 
 import sys
 
-from pcabench.launch import main
+from pcabench.console import main
 
 sys.exit(main())

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pcabench.parser import EXIT_BAD_INPUT
+from pcabench.usage import EXIT_BAD_INPUT
 
 DESCRIPTION = """Benchmark SPH solvers of computational acoustics (a Gaussian sound pulse in 2D, the paper's
 scene) on CPUs and GPUs: run one scene, sweep studies into a results store, write reports with

@@ -24,7 +24,7 @@ from pcabench.cli.options import (
 from pcabench.cli.report import cmd_report, cmd_runs
 from pcabench.cli.run import cmd_run
 from pcabench.cli.study import cmd_study
-from pcabench.parser import Parser
+from pcabench.usage import Parser
 from solvers import (
     DEFAULT_SCENE,
     MODELS,
