@@ -199,7 +199,6 @@ class CylinderPulse:
     def scattered(self, x, y, t) -> np.ndarray:
         """The scattered part of drho at points ``x``, ``y`` (m, one shape) and times ``t`` (s, 1D): shape
         (len(t), *x.shape). Points inside the cylinder get NaN."""
-        sp = _special()
         t = np.atleast_1d(np.asarray(t, float))
         r, theta = self.polar(x, y)
         shape = r.shape
@@ -207,14 +206,14 @@ class CylinderPulse:
         if np.max(np.abs(t), initial=0.0) > self.t_max * (1 + 1e-12) or r.max(initial=0.0) > self.r_max:
             raise ValueError(f"the reference is built for t <= {self.t_max:g} s and r <= {self.r_max:g} m")
         k, wk, cj, cy = _spectrum(self.a, self.d, self.b, self.orders, self.k_nodes, self.r_nodes)
-        out = np.zeros((t.size, r.size))
-        ckt = self.factor(k, t) * wk  # (t, k)
         kr = np.outer(r, k)  # (points, k)
-        for n in range(self.orders):
+        angular = np.zeros_like(kr)  # sum over the orders of each radial function times cos(n theta), per k
+        for n, (j_n, y_n) in enumerate(bessel_orders(self.orders, kr)):  # every order by recurrence, not one by one
             with np.errstate(over="ignore", invalid="ignore"):
-                radial = sp.jn(n, kr) * cj[n] + sp.yn(n, kr) * cy[n]
+                radial = j_n * cj[n] + y_n * cy[n]
             radial = np.nan_to_num(radial, nan=0.0, posinf=0.0, neginf=0.0)  # Y_n overflowing where cy[n] is 0
-            out += (ckt @ radial.T) * np.cos(n * theta)[None, :]
+            angular += radial * np.cos(n * theta)[:, None]
+        out = (self.factor(k, t) * wk) @ angular.T  # (t, points): the time integral once, not once per order
         out *= self.amplitude
         out[:, r < self.a] = np.nan
         return out.reshape((t.size, *shape))

@@ -80,8 +80,13 @@ def predicted_probes(scene, method) -> dict:
     steps = np.arange(1, scene.n_steps + 1)
     times = steps[steps * scene.dt >= scene.kind.window[0] - 1e-9] * scene.dt
     probes = {"t": times}
-    for name, (px, py) in scene.probe_points().items():
-        probes[name] = method.drho(np.array([px]), np.array([py]), times)[:, 0] if times.size else times
+    points = scene.probe_points()
+    if not points:
+        return probes
+    px, py = (np.array([p[i] for p in points.values()], dtype=np.float64) for i in (0, 1))
+    values = method.drho(px, py, times) if times.size else np.zeros((0, px.size))  # every probe in one series sum
+    for i, name in enumerate(points):
+        probes[name] = values[:, i]
     return probes
 
 
