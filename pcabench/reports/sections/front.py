@@ -71,6 +71,27 @@ def unstable_front_text(rows) -> list[str]:
     ]
 
 
+def past_margin_text(front) -> list[str]:
+    """The front's runs that advise never names: stable, but past its one margin (stability.MARGIN), and why."""
+    from pcabench.predict.stability import margin_rule
+
+    past = [p for p in front if p.get("past_margin") and not p.get("past_limit")]
+    if not past:
+        return []
+    models = sorted({p["model"] for p in past})
+    return [
+        f"On the front but never named by `pcabench advise`, which keeps a margin below the stable CFL "
+        f"({'; '.join(margin_rule(m) for m in models)}): "
+        + ", ".join(
+            f"{p['model']} {p['method']}, dx {p['dx']:g} "
+            f"(CFL {p['cfl']:g} = {p['fraction']:.2f} of {p['stable_cfl']:.3g})"
+            for p in past
+        )
+        + ". Measured and bounded, they sit too close to their limit for a longer run or another dx.",
+        "",
+    ]
+
+
 def predicted_by_model(predicted) -> list[str]:
     rows = [
         [r["model"], fmt(r["dx"], "g"), pct(r["measured"]), pct(r["predicted"]), pct(r["isothermal"])]
@@ -219,6 +240,7 @@ def text(data, ctx) -> list[str]:
         "",
         md_table(["model", "t (s)", "method", "dx", "domain", "precision", "time (s)", "error", "predicted"], fronts),
         "",
+        *past_margin_text(front),
         *unstable_front_text(T.unstable_on_front(points)),
         *predicted_by_model(data["predicted"]),
         *why_the_paper_method(),
