@@ -17,7 +17,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from matplotlib.ticker import FixedLocator, LogFormatterSciNotation, NullFormatter, NullLocator
+from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
 
 from pcabench.predict.stability import UNSTABLE_BY_PREDICTION
 from pcabench.reports import paper as P
@@ -146,6 +146,14 @@ def plain_log_ticks(ax, values, axis="x", spread=1.8):
     target.set_major_locator(FixedLocator(kept))
     target.set_major_formatter(lambda v, _: f"{v:g}")
     target.set_minor_formatter(NullFormatter())
+
+
+def particle_count(value, _position=None) -> str:
+    """A particle count as a tick label: 500, 25K, 1.6M (one style on every panel of a figure)."""
+    for scale, suffix in ((1e6, "M"), (1e3, "K")):
+        if value >= scale:
+            return f"{value / scale:g}{suffix}"
+    return f"{value:g}"
 
 
 def nice_log_ticks(ax, values, axis="y"):
@@ -383,10 +391,10 @@ def fig10(series, out: Path, pid: str):
                 )
             ax.set_title(f"runs to t = {run[4:]}" if run.startswith("t =") else f"runs of {run}", fontsize=9)
             sizes = [n for s in series if s["run"] == run for n in s["N"]]
-            if max(sizes) / min(sizes) < 100:  # under two decades: ticks at the sizes run, written as the
-                plain_log_ticks(ax, sizes, axis="x", spread=3.0)  # other panels write theirs (2.5 x 10^4)
-                ax.xaxis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False))
+            if max(sizes) / min(sizes) < 100:  # under two decades: ticks at the sizes run, never 2x10^5
+                plain_log_ticks(ax, sizes, axis="x", spread=3.0)
                 ax.xaxis.set_minor_locator(NullLocator())
+            ax.xaxis.set_major_formatter(particle_count)  # every panel writes N alike: 1K, 25K, 1M
             if run != paper_panel:
                 continue
             if ("cpu", "linked list") in kinds:
