@@ -555,24 +555,20 @@ def test_a_sweeps_forkserver_ignores_the_terminals_ctrl_c_from_its_start(tmp_pat
     # runs of seconds each (2.5 to 30 s), so that one is surely under way when the Ctrl-C comes
     proc = study_process(tmp_path, "--dx", "1", "0.5", "0.25", "--steps", "3000", "--model", "linear")
     try:
-        server, deadline = None, time.time() + 120
-        while server is None and time.time() < deadline and proc.poll() is None:
-            for pid in containment.children(proc.pid):
-                try:
+        ignored, deadline = None, time.time() + 120
+        while ignored is None and time.time() < deadline and proc.poll() is None:
+            for pid in containment.children(proc.pid):  # the server with a run under way (the sweep ignores
+                try:  # SIGINT only while it spawns its server): its signal mask, read while it lives
                     with open(f"/proc/{pid}/cmdline", "rb") as f:
-                        if b"forkserver" in f.read():
-                            server = pid
-                except OSError:
+                        if b"forkserver" not in f.read() or not run_children(pid):
+                            continue
+                    with open(f"/proc/{pid}/status") as f:
+                        ignored = int(next(line for line in f if line.startswith("SigIgn:")).split()[1], 16)
+                    break
+                except OSError:  # a process that ended between the listing and the read: look again
                     continue
             time.sleep(0.02)
-        assert server is not None, "no forkserver seen"
-        while not run_children(server) and time.time() < deadline and proc.poll() is None:
-            time.sleep(0.02)  # a run under way: the sweep ignores SIGINT only while it spawns its server
-        try:
-            with open(f"/proc/{server}/status") as f:
-                ignored = int(next(line for line in f if line.startswith("SigIgn:")).split()[1], 16)
-        except FileNotFoundError:  # the sweep ended first (a loaded machine): nothing of the server to read
-            pytest.skip("the sweep's server had exited before the test read its signal mask")
+        assert ignored is not None, f"no forkserver with a run under way seen (sweep exit {proc.poll()})"
         assert ignored & (1 << (signal.SIGINT - 1)), f"the server takes SIGINT (SigIgn {ignored:x})"
         os.killpg(proc.pid, signal.SIGINT)  # the terminal's Ctrl-C: the whole group
         _, err = proc.communicate(timeout=120)
