@@ -232,3 +232,18 @@ def test_each_command_advise_names_run_gives_advise_what_it_asked_for(tmp_path, 
     rc, text, err = cli_main(*asked, capsys=capsys)
     assert rc == 0, text + err
     assert "fastest:" in text and "advised at most 0.9 of the stable CFL for linear" in text
+
+
+@pytest.mark.parametrize(
+    "args, option",
+    [
+        (("--mach", "-1"), "--mach"),
+        (("--mach", "0.5"), "--mach"),
+        (("--open", "y"), "--open y"),  # the plane pulse's y is a plane wave's period
+        (("--scene", "cylinder", "--open", "x"), "--open"),  # its four edges are always open
+    ],
+)
+def test_a_problem_the_scene_refuses_is_refused_before_any_advice(tmp_path, args, option, capsys):
+    """A study advise would name for it would be refused in turn: one line naming the option, exit 2, no search."""
+    rc, out, err = cli_main("advise", "--error", "0.05", *args, "--results", str(tmp_path), capsys=capsys)
+    assert rc == 2 and option in err and len(err.strip().splitlines()) == 1 and not out, err

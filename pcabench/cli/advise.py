@@ -314,6 +314,18 @@ def problem_words(args) -> tuple[str, ...]:
     return tuple(words)
 
 
+def check_problem(name: str, mach: float, edges: str) -> None:
+    """One line naming the option unless scene ``name`` takes ``--mach`` and ``--open`` as given (before any search:
+    a study advise names for a problem Scene refuses would be refused in turn)."""
+    from solvers import SceneError
+
+    try:
+        Scene(name=name, dx=scene_kind(name).smallest.get("dx", 1.0), steps=1, mach=mach, open=edges, model="linear")
+    except (SceneError, ValueError) as exc:
+        text = str(exc)  # Scene's own range checks name the parameter, its kinds' the option
+        raise OptionError(f"--mach: {text}" if text.startswith("mach ") else text) from None
+
+
 def cmd_advise(args) -> int:
     from pcabench.machine.profiles import machine_id
     from pcabench.reports.frame import load as load_frame
@@ -328,6 +340,7 @@ def cmd_advise(args) -> int:
     mach = Scene.default("mach") if args.mach is None else args.mach
     edges = args.open or scene_kind(args.scene).defaults.get("open", "")  # an open problem's edges by default
     problem = problem_words(args)
+    check_problem(args.scene, mach, edges)
     if df is not None and not df.empty:
         df = df[(df.scene == args.scene) & np.isclose(df.mach.astype(float), mach) & (df.open == edges)]
     if df is None or df.empty:  # what makes the runs asked about: the prediction's study, with their problem

@@ -582,41 +582,17 @@ def fig14(rows, out: Path, title: str):
             )
         for colour, (gp, prec, how) in zip(colours, keys):
             pts = [r for r in rows if (r["gpu_profile"], r["precision"], r["protocol"]) == (gp, prec, how)]
-            ax.plot(
-                [r["N"] for r in pts],
-                [r["speedup"] for r in pts],
-                marker=PRECISION_MARKER[prec],
-                color=colour,
-                label=f"{gp} {prec} vs one core of its host, {how}",
-            )
+            _speedup_line(ax, pts, "speedup", colour, f"{gp} {prec} vs one core of its host, {how}")
             multi = [r for r in pts if r["speedup_all_cores"]]
             if multi:
-                ax.plot(
-                    [r["N"] for r in multi],
-                    [r["speedup_all_cores"] for r in multi],
-                    marker=PRECISION_MARKER[prec],
-                    color=colour,
-                    ls=":",
-                    mfc="none",
-                    label=f"{gp} {prec} vs all cores of its host, {how}",
-                )
-        others = sorted({(r["gpu_profile"], r["precision"], r["protocol"], r["cpu_profile"]) for r in across})
-        for colour, (gp, prec, how, cp) in zip(palette(len(keys) + len(others))[len(keys) :], others):
-            pts = [
-                r
-                for r in across
-                if (r["gpu_profile"], r["precision"], r["protocol"], r["cpu_profile"]) == (gp, prec, how, cp)
-            ]
+                label = f"{gp} {prec} vs all cores of its host, {how}"
+                _speedup_line(ax, multi, "speedup_all_cores", colour, label, ls=":", mfc="none")
+        by = ("gpu_profile", "precision", "protocol", "cpu_profile")
+        others = _groups(sorted(across, key=lambda r: tuple(r[k] for k in by)), by)
+        for colour, ((gp, prec, how, cp), pts) in zip(palette(len(keys) + len(others))[len(keys) :], others):
             commits = ", ".join(sorted({r["gpu_commit"] for r in pts}))
-            ax.plot(
-                [r["N"] for r in pts],
-                [r["speedup"] for r in pts],
-                marker=PRECISION_MARKER[prec],
-                color=colour,
-                ls="-.",
-                mfc="none",
-                label=f"{gp.split('__')[0]} {prec} vs one core of {cp}\n(across machines; GPU at {commits}; {how})",
-            )
+            label = f"{gp.split('__')[0]} {prec} vs one core of {cp}\n(across machines; GPU at {commits}; {how})"
+            _speedup_line(ax, pts, "speedup", colour, label, ls="-.", mfc="none")
         nice_log_ticks(ax, values)
         if not rows and not across:
             ax.text(
@@ -628,6 +604,18 @@ def fig14(rows, out: Path, title: str):
                 color="0.3",
             )
     return path
+
+
+def _speedup_line(ax, pts, key: str, colour, label: str, **style) -> None:
+    """One GPU's Table 6 rows ``pts`` as a line of ``key`` (speedup) against N, marked by their precision."""
+    ax.plot(
+        [r["N"] for r in pts],
+        [r[key] for r in pts],
+        marker=PRECISION_MARKER[pts[0]["precision"]],
+        color=colour,
+        label=label,
+        **style,
+    )
 
 
 def _groups(rows, keys):

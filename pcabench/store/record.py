@@ -171,12 +171,8 @@ class RunRecord:
         def number(value, form: str) -> str:  # a measure a failed run never took: "-"
             return "-" if value is None else format(value, form)
 
-        lines = [
-            self.stage_table(),
-            f"particles        {self.n_particles:,}",
-            f"steps            {self.steps} (t = {number(self.t_end, '.6g')} s)",
-            f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
-            f"mean neighbours  {number(self.mean_neighbours, '.2f')}",
+        at_probes = self.measure.startswith("probes_")  # mse is the probes' measure: the headline names it
+        mse = (
             (
                 f"MSE (rel. RMS)   {number(self.mse, '.6g')}"
                 + ("" if primary == "u" else f" of {primary}")
@@ -184,18 +180,26 @@ class RunRecord:
             )
             if self.mse is None or math.isfinite(self.mse)
             else f"MSE (rel. RMS)   - (undefined: the exact {primary} holds no pulse in the scored domain"
-            + ("; the pulse has left: read the left measures below)" if scene.open else ")"),
-            f"ME (max)         {number(self.me, '.6g')} {unit}",
+            + ("; the pulse has left: read the left measures below)" if scene.open else ")")
+        )
+        lines = [
+            self.stage_table(),
+            f"particles        {self.n_particles:,}",
+            f"steps            {self.steps} (t = {number(self.t_end, '.6g')} s)",
+            f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
+            f"mean neighbours  {number(self.mean_neighbours, '.2f')}",
+            *(  # the one error that means something at the run's end, by its name
+                [
+                    f"headline         {self.measure} {number(self.headline, '.6g')}: "
+                    f"{scene.kind.measure_words(self.measure, self.t_end)}"
+                ]
+                if self.measure
+                else []
+            ),
+            *([] if at_probes else [mse]),
+            f"ME (max)         {number(self.me, '.6g')} {unit}"
+            + (f" (of {primary} at the probes)" if at_probes else ""),
         ]
-        if self.measure.startswith("probes_"):  # mse is the probes' measure, not the field's: the headline says so
-            lines[-1] = f"ME (max)         {number(self.me, '.6g')} {unit} (of {primary} at the probes)"
-            del lines[-2]
-        if self.measure:  # the one error that means something at the run's end, by its name
-            lines.insert(
-                len(lines) - (1 if self.measure.startswith("probes_") else 2),
-                f"headline         {self.measure} {number(self.headline, '.6g')}: "
-                f"{scene.kind.measure_words(self.measure, self.t_end)}",
-            )
         lines += [  # a measure whose reference holds no pulse is undefined (NaN): "-"
             f"{name.replace('_', ' '):<16} {value:.6g}" if math.isfinite(value) else f"{name.replace('_', ' '):<16} -"
             for name, value in self.errors.items()
