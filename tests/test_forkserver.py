@@ -106,3 +106,26 @@ def test_a_run_killed_with_its_forkserver_is_run_again_in_a_fresh_interpreter(tm
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
+
+
+def test_a_ctrl_c_while_the_server_is_spawned_is_held_back_not_lost():
+    """The sweep ignores SIGINT for the milliseconds its server is spawned (so the server inherits the ignore): a
+    Ctrl-C then reaches the sweep's handler afterwards instead of being dropped (the resource tracker's own start,
+    which unblocks SIGINT, comes first). In a process of its own: one server per process."""
+    code = """
+import os, signal
+from unittest import mock
+from multiprocessing import forkserver
+from pcabench.execute import forkserver as F
+got = []
+signal.signal(signal.SIGINT, lambda *a: got.append(1))
+real = forkserver.ensure_running
+def spawn():
+    os.kill(os.getpid(), signal.SIGINT)  # the terminal's Ctrl-C, in the window
+    real()
+with mock.patch.object(forkserver, "ensure_running", spawn):
+    F.start_server()
+print(len(got))
+"""
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() == "1", proc.stderr[-2000:]

@@ -83,20 +83,26 @@ def prepare(specs: list) -> None:
 
 def start_server() -> None:
     """multiprocessing's forkserver started if it is not running, with SIGINT ignored from its first instant:
-    ignored only while it is spawned (a disposition set to ignore survives fork and exec, a blocked mask does
-    not survive multiprocessing's spawn), a few milliseconds, not while it imports (its start does not wait for
+    ignored (and held back from this process, not lost) only while it is spawned (a disposition set to ignore
+    survives fork and exec, a blocked mask does not survive multiprocessing's spawn), a few milliseconds, not while it imports (its start does not wait for
     that). A terminal's Ctrl-C reaches the whole foreground group: the sweep, not its server, answers it (the
     server, still importing, printed a traceback). The runs' children are in sessions of their own."""
-    from multiprocessing import forkserver
+    from multiprocessing import forkserver, resource_tracker
 
     if threading.current_thread() is not threading.main_thread():
         forkserver.ensure_running()
         return
+    # blocked first: a Ctrl-C in those milliseconds stays pending (Linux never discards a blocked signal, even an
+    # ignored one) and reaches the restored handler when unblocked, instead of being lost to the ignore; the
+    # resource tracker is started before, as its own start unblocks SIGINT (multiprocessing/resource_tracker.py)
+    resource_tracker.ensure_running()
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     before = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         forkserver.ensure_running()
     finally:
         signal.signal(signal.SIGINT, before)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 class InheritedFd:
