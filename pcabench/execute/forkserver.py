@@ -82,11 +82,12 @@ def prepare(specs: list) -> None:
 
 
 def start_server() -> None:
-    """multiprocessing's forkserver started if it is not running, with SIGINT ignored from its first instant:
-    ignored (and held back from this process, not lost) only while it is spawned (a disposition set to ignore
-    survives fork and exec, a blocked mask does not survive multiprocessing's spawn), a few milliseconds, not while it imports (its start does not wait for
-    that). A terminal's Ctrl-C reaches the whole foreground group: the sweep, not its server, answers it (the
-    server, still importing, printed a traceback). The runs' children are in sessions of their own."""
+    """multiprocessing's forkserver started if it is not running, with SIGINT ignored from its first instant: ignored
+    (and held back from this process, not lost) only while it is spawned (a disposition set to ignore survives fork
+    and exec, a blocked mask does not survive multiprocessing's spawn), a few milliseconds, not while it imports
+    (its start does not wait for that). A terminal's Ctrl-C reaches the whole foreground group: the sweep, not its
+    server, answers it (the server, still importing, printed a traceback). The runs' children are in sessions of
+    their own."""
     from multiprocessing import forkserver, resource_tracker
 
     if threading.current_thread() is not threading.main_thread():
