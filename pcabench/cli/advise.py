@@ -320,7 +320,8 @@ def check_problem(name: str, mach: float, edges: str) -> None:
     from solvers import SceneError
 
     try:
-        Scene(name=name, dx=scene_kind(name).smallest.get("dx", 1.0), steps=1, mach=mach, open=edges, model="linear")
+        smallest = scene_kind(name).smallest  # the kind's smallest case (a wall clear of the kernel's support)
+        Scene(**{**smallest, "name": name, "steps": 1, "mach": mach, "open": edges, "model": "linear"})
     except (SceneError, ValueError) as exc:
         text = str(exc)  # Scene's own range checks name the parameter, its kinds' the option
         raise OptionError(f"--mach: {text}" if text.startswith("mach ") else text) from None
