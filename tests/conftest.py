@@ -82,7 +82,16 @@ def study_process(results, *args) -> subprocess.Popen:
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=default_sigint,  # as a terminal starts it, whatever the test worker inherited
     )
+
+
+def default_sigint() -> None:
+    """SIGINT at its default in a child about to exec (an ignored disposition is inherited through exec: a
+    test worker that ignores SIGINT would make a child deaf to the Ctrl-C a test sends it)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def cli_main(*args, capsys):

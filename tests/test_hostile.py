@@ -25,7 +25,7 @@ from pcabench.store import provenance, schema
 from pcabench.store.record import RunRecord
 from solvers import Scene
 
-from .conftest import cli_main, run_children, study_process
+from .conftest import cli_main, default_sigint, run_children, study_process
 
 
 def record(**kw):
@@ -590,6 +590,7 @@ def test_ctrl_c_during_a_run_ends_its_progress_line_first():
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
         start_new_session=True,
+        preexec_fn=default_sigint,  # as a terminal starts it
     )
     err = bytearray()
 
