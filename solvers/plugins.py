@@ -4,7 +4,9 @@
 An entry is found in three places, in this order:
 
 * the modules of its package (a built-in is one new file there; ``base`` and
-  ``registry`` modules and those starting with ``_`` are not searched): the
+  ``registry`` modules and those starting with ``_`` are not searched), or, for
+  a registry with a ``role``, the module of that name in each folder of its
+  package (a study's ``plan.py``, its ``section.py``: a new one is one folder): the
   subclasses of the registry's ``base`` with a ``name`` of their own defined
   in the module (made into an entry by ``make``), or the instances of ``base``
   the module holds;
@@ -21,6 +23,7 @@ its own or repeats a taken name is left out with one :class:`PluginWarning`;
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import inspect
 import pkgutil
 import re
@@ -63,7 +66,9 @@ class Registry:
     entry (None: it can); ``order(entry)`` sorts the built-ins (default: the default name first, then by
     name); ``option`` names the choice in errors ("--scene"); ``declares(path)`` may keep a module from
     being imported (the solvers': only a module whose source defines a ``name``, so that no GPU library is
-    touched to list them); ``pinned``: a name keeps the object it was first registered as for the life of the
+    touched to list them); ``role``: the built-ins are the module ``role`` of each sub-package of ``package``
+    (``pcabench.studies.<study>.plan``), sub-packages on every folder of the package's ``__path__``, in name
+    order; ``pinned``: a name keeps the object it was first registered as for the life of the
     process (the kernels': compiled loops and predictions are cached by kernel name).
     """
 
@@ -82,9 +87,11 @@ class Registry:
         error: type[Exception] = ValueError,
         declares: Callable[[Path], bool] | None = None,
         pinned: bool = False,
+        role: str | None = None,
     ):
         self.what, self.package, self.base, self.group, self.default = what, package, base, group, default
         self.make, self.problem, self.option, self.error, self.declares = make, problem, option, error, declares
+        self.role = role  # the module of each sub-package that holds the built-ins (None: the package's modules)
         self.pinned = pinned  # a name keeps what it was first registered as for the life of the process
         self.order = order or (lambda entry: (entry.name != default, entry.name))
         self._found: dict[str, Any] | None = None
@@ -110,16 +117,29 @@ class Registry:
     def _entry(self, obj):
         return self.make(obj) if inspect.isclass(obj) else obj
 
+    def _modules(self) -> list[str]:
+        """The dotted names of the modules that hold the built-ins, in name order."""
+        package = importlib.import_module(self.package)
+        if self.role is not None:
+            subs = sorted({i.name for i in pkgutil.iter_modules(package.__path__) if i.ispkg and i.name[0] != "_"})
+            return [
+                f"{self.package}.{sub}.{self.role}"
+                for sub in subs
+                if importlib.util.find_spec(f"{self.package}.{sub}.{self.role}") is not None
+            ]
+        folder = Path(package.__file__).parent
+        return [
+            f"{self.package}.{info.name}"
+            for info in sorted(pkgutil.iter_modules([str(folder)]), key=lambda m: m.name)
+            if info.name not in ("base", "registry")
+            and not info.name.startswith("_")
+            and (self.declares is None or self.declares(folder / f"{info.name}.py"))
+        ]
+
     def _builtin(self) -> list:
-        module = importlib.import_module(self.package)
-        folder = Path(module.__file__).parent
         found, seen = [], set()
-        for info in sorted(pkgutil.iter_modules([str(folder)]), key=lambda m: m.name):
-            if info.name in ("base", "registry") or info.name.startswith("_"):
-                continue
-            if self.declares is not None and not self.declares(folder / f"{info.name}.py"):
-                continue
-            mod = importlib.import_module(f"{self.package}.{info.name}")
+        for name in self._modules():
+            mod = importlib.import_module(name)
             for _, obj in inspect.getmembers(mod):
                 own = (
                     inspect.isclass(obj)

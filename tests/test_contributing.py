@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pcabench import presets, store
+from pcabench import store, studies
 from pcabench.conformance import registered
 from pcabench.execute.run import run
-from pcabench.reports import sections
+from pcabench.reports.section import SECTIONS, in_order
 from pcabench.spec import RunSpec
 from solvers import Scene, registry, solver_names
 from solvers.scenes import SCENES, scene_names
@@ -30,8 +30,7 @@ RECIPES = (
     "Add a solver",
     "Add a kernel",
     "Add a scene",
-    "Add a report section",
-    "Add a preset",
+    "Add a study",
     "Add an absorber",
     "Add a boundary method",
 )
@@ -53,7 +52,7 @@ def run_recipe(tmp_path, monkeypatch):
     monkeypatch.setenv("PCABENCH_HOME", str(tmp_path / "home"))
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # the recipe's mkdtemp() lands in the test's folder
     solvers_before, scenes_before = dict(registry()), scene_names()
-    sections_before, presets_before = sections.SECTIONS.all(), presets.PRESETS.all()
+    sections_before, presets_before = SECTIONS.all(), studies.PRESETS.all()
 
     def execute(title: str) -> dict:
         namespace = {"__name__": "__recipe__"}
@@ -63,8 +62,8 @@ def run_recipe(tmp_path, monkeypatch):
     yield execute
     # each recipe unregisters what it registered
     assert dict(registry()) == solvers_before and scene_names() == scenes_before
-    assert sections.SECTIONS.all() == sections_before
-    assert presets.PRESETS.all() == presets_before
+    assert SECTIONS.all() == sections_before
+    assert studies.PRESETS.all() == presets_before
 
 
 def test_every_recipe_has_one_block_and_the_workflow_is_named():
@@ -131,25 +130,62 @@ def test_the_scene_recipe_registers_a_scene_with_finite_initial_fields(run_recip
     assert kind.name not in scene_names()
 
 
-def test_the_section_recipe_adds_its_section_to_the_report(run_recipe):
-    before = [s.name for s in sections.in_order()]
-    ns = run_recipe("Add a report section")
-    assert isinstance(ns["mine"], sections.Section) and ns["mine"].name not in before
-    assert [s.name for s in sections.in_order()] == before  # unregistered once its block ended
-    report = (ns["folder"] / "reports" / "my-laptop" / "report.md").read_text()
-    assert "- [Runs by status](#runs-by-status)" in report  # in the report's contents list
-    table = report.split("## Runs by status")[1].split("\n## ")[0]
-    assert "| ok | 1 |" in table
+def study_files(title: str = "Add a study") -> dict[str, str]:
+    """The files a recipe writes: each ```python block titled with its path, {path: text}."""
+    text = (ROOT / "CONTRIBUTING.md").read_text()
+    part = re.search(rf"^## {re.escape(title)}\n(.*?)(?=^## |\Z)", text, re.S | re.M).group(1)
+    return dict(re.findall(r'^```python title="([^"]+)"\n(.*?)^```', part, re.S | re.M))
 
 
-def test_the_preset_recipe_expands_to_runs_that_a_sweep_stores(run_recipe):
-    ns = run_recipe("Add a preset")
-    assert "tiny" not in presets.PRESETS  # unregistered
+@pytest.fixture
+def study_folder(tmp_path):
+    """The recipe's folder written as it says, on the studies' path (in the house: pcabench/studies/), the
+    registries searching it; afterwards neither it nor its modules are left."""
+    import sys
+
+    import pcabench.studies
+
+    files = study_files()
+    assert files and all(path.startswith("pcabench/studies/tiny/") for path in files), list(files)
+    root = tmp_path / "house"
+    for path, text in files.items():
+        (root / path).parent.mkdir(parents=True, exist_ok=True)
+        (root / path).write_text(text)
+    pcabench.studies.__path__.append(str(root / "pcabench" / "studies"))
+    studies.PRESETS.cache_clear()
+    SECTIONS.cache_clear()
+    try:
+        yield root
+    finally:
+        pcabench.studies.__path__.remove(str(root / "pcabench" / "studies"))
+        for name in [m for m in sys.modules if m.startswith("pcabench.studies.tiny")]:
+            del sys.modules[name]
+        studies.PRESETS.cache_clear()
+        SECTIONS.cache_clear()
+
+
+def test_the_study_recipe_is_one_folder_that_the_command_line_and_the_report_find(study_folder, run_recipe):
+    assert "tiny" in studies.PRESETS and "statuses" in SECTIONS  # found in its folder, with no other edit
+    assert [s.name for s in in_order()][-1] == "statuses"
+    ns = run_recipe("Add a study")
     specs = ns["specs"]
     assert [s.scene.dx for s in specs] == [1.0, 0.8, 0.5] and {s.preset for s in specs} == {"tiny"}
     rows = store.read_rows(ns["store_path"])
     assert len(rows) == 3 and {r["preset"] for r in rows} == {"tiny"} and {r["status"] for r in rows} == {"ok"}
     assert sorted(r["n_particles"] for r in rows) == sorted(s.scene.n_particles for s in specs)
+    (report,) = [p.read_text() for p in (ns["folder"] / "reports").glob("*/report.md")]
+    assert "- [Runs by status](#runs-by-status)" in report  # in the report's contents list
+    assert "| ok | 3 |" in report.split("## Runs by status")[1].split("\n## ")[0]
+
+
+def test_a_study_folder_is_not_found_without_its_files(study_folder):
+    """The registries find a study by its files: a folder without plan.py offers no preset."""
+    import importlib
+
+    (study_folder / "pcabench" / "studies" / "tiny" / "plan.py").unlink()
+    importlib.invalidate_caches()
+    studies.PRESETS.cache_clear()
+    assert "tiny" not in studies.PRESETS and "statuses" in SECTIONS
 
 
 def test_the_boundary_method_recipe_registers_a_method_the_cylinder_runs(run_recipe):

@@ -226,7 +226,7 @@ def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_pa
 
     from pcabench import store
     from pcabench.reports import frame
-    from pcabench.reports.sections import cylinder as S
+    from pcabench.studies.cylinder import section as S
 
     from .test_study import row
 

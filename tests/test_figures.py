@@ -18,8 +18,12 @@ import dataclasses  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 
-from pcabench import paths, presets, store  # noqa: E402
-from pcabench.reports import sections, write_reports  # noqa: E402
+from pcabench import paths, store, studies  # noqa: E402
+from pcabench.reports import (
+    build,  # noqa: E402
+    write_reports,  # noqa: E402
+)
+from pcabench.reports.section import Section, in_order  # noqa: E402
 from pcabench.store.record import RunRecord  # noqa: E402
 
 from .figure_check import problems, record  # noqa: E402
@@ -32,7 +36,7 @@ def quick_records() -> list[RunRecord]:
     16K as a sweep would predict) and errors of the right shape (linear second order, the stability
     scene stable to CFL 2, inaccurate near 5, unstable past it)."""
     out = []
-    for i, spec in enumerate(presets.preset("quick")):
+    for i, spec in enumerate(studies.preset("quick")):
         spec = spec.resolved()
         s = spec.scene
         n = s.n_particles
@@ -90,7 +94,7 @@ def quick_records() -> list[RunRecord]:
     return out
 
 
-def recorded(section: sections.Section, texts: dict, drawn: dict) -> sections.Section:
+def recorded(section: Section, texts: dict, drawn: dict) -> Section:
     """``section`` as the registry declares it, its Markdown and each figure it draws recorded by its name."""
 
     def text(rows, ctx):
@@ -118,8 +122,8 @@ def quick_report(tmp_path_factory):
         store.append(rec, tmp / "store" / f"{PROFILE}.jsonl")
     texts, drawn = {}, {}
     with pytest.MonkeyPatch.context() as patch, record() as found:
-        recorded_sections = [recorded(s, texts, drawn) for s in sections.in_order()]
-        patch.setattr(sections, "in_order", lambda: recorded_sections)
+        recorded_sections = [recorded(s, texts, drawn) for s in in_order()]
+        patch.setattr(build, "in_order", lambda: recorded_sections)
         write_reports(tmp / "store", tmp / "reports")
     return tmp / "reports", found, texts, drawn
 
@@ -129,9 +133,9 @@ def test_a_quick_study_writes_every_section_and_figure_of_the_registry(quick_rep
     declares; one with none (Table 6 needs a GPU's runs) writes and draws nothing. Every PNG is a section's."""
     out, found, texts, drawn = quick_report
     report = (out / PROFILE / "report.md").read_text()
-    written = [s for s in sections.in_order() if texts.get(s.name)]
-    assert len(written) > len(sections.in_order()) // 2, [s.name for s in written]  # the quick study's purpose
-    for section in sections.in_order():
+    written = [s for s in in_order() if texts.get(s.name)]
+    assert len(written) > len(in_order()) // 2, [s.name for s in written]  # the quick study's purpose
+    for section in in_order():
         lines, paths = texts.get(section.name), drawn.get(section.name, [])
         if not lines:
             assert not any(paths), (section.name, paths)  # no rows: no figure either

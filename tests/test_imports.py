@@ -122,8 +122,8 @@ def _circles(graph) -> list[list[str]]:
 
 def test_the_graph_is_read():
     """The walk sees the imports it must: inside functions, relative, and through a package's face."""
-    assert "solvers.scene" in GRAPH["pcabench.presets.base"]  # `from solvers import Scene`, through the face
-    assert "pcabench.presets.base" in GRAPH["pcabench.cli.study"]  # imported inside a function
+    assert "solvers.scene" in GRAPH["pcabench.studies.preset"]  # `from solvers import Scene`, through the face
+    assert "pcabench.studies.preset" in GRAPH["pcabench.cli.study"]  # imported inside a function
     assert len(GRAPH) > 50 and sum(map(len, GRAPH.values())) > 150
 
 
@@ -176,20 +176,31 @@ LAYERS = (
     ("pcabench.machine",),  # this machine's profile and memory
     ("pcabench.predict",),  # wall time, stability and the fastest methods, predicted
     ("pcabench.execute",),  # the stage clock, a run, its child, the sweep
-    ("pcabench.conformance", "pcabench.presets"),  # what every solver must do; the studies
-    ("pcabench.reports",),  # tables, sections, figures
+    # what every solver must do; what a preset is, and each study's plan (pcabench/studies/<study>/plan.py)
+    ("pcabench.conformance", "pcabench.studies", "pcabench.studies.preset", "pcabench.studies.*.plan"),
+    # the report's frame, tables and figure toolkit; each study's sections and what they draw (every other module
+    # of a study's folder)
+    ("pcabench.reports", "pcabench.studies.*"),
     ("pcabench.bench",),  # asv
     ("pcabench.gpu",),  # the GPU check
     ("pcabench.cli", "pcabench.console"),  # the command line, and the console script that imports it
 )
 
 
+def _names(module: str, pattern: str) -> bool:
+    """Whether ``pattern`` (a dotted prefix; ``*`` stands for one name: ``pcabench.studies.*.plan``) names
+    ``module`` or a package above it."""
+    parts, want = module.split("."), pattern.split(".")
+    return len(parts) >= len(want) and all(w in ("*", p) for w, p in zip(want, parts))
+
+
 def layer_of(module: str) -> int | None:
+    """The layer of the most specific pattern that names ``module``: the most names, then the fewest ``*``."""
     best = max(
-        ((len(p), i) for i, layer in enumerate(LAYERS) for p in layer if module == p or module.startswith(p + ".")),
+        ((len(p.split(".")), -p.count("*"), i) for i, layer in enumerate(LAYERS) for p in layer if _names(module, p)),
         default=None,
     )
-    return None if best is None else best[1]
+    return None if best is None else best[2]
 
 
 def test_every_module_of_the_house_has_a_layer():
@@ -208,5 +219,18 @@ def test_no_module_imports_from_a_layer_above_its_own():
 
 
 def test_an_upward_arrow_is_found():
-    assert layer_of("pcabench.store.record") < layer_of("pcabench.reports.sections.walls")
+    assert layer_of("pcabench.store.record") < layer_of("pcabench.studies.walls.section")
     assert layer_of("solvers.scene") < layer_of("solvers.search.celllist") < layer_of("pcabench.spec")
+
+
+def test_a_study_is_one_folder_in_two_layers():
+    """A study's plan sits with the presets, below the report; its sections and what they draw with the report;
+    the machinery of presets is not a study's."""
+    plan, report = layer_of("pcabench.studies.walls.plan"), layer_of("pcabench.reports.build")
+    assert plan == layer_of("pcabench.studies.preset") == layer_of("pcabench.studies") < report
+    assert layer_of("pcabench.studies.walls.section") == layer_of("pcabench.studies.paper.table4") == report
+    assert layer_of("pcabench.studies.walls") == report  # a study's face: its docstring, above nothing
+    studies = {m.split(".")[2] for m in MODULES if m.startswith("pcabench.studies.") and m.count(".") >= 3}
+    assert {"paper", "front", "walls", "cylinder", "high_order"} <= studies
+    for study in studies:
+        assert f"pcabench.studies.{study}.plan" in MODULES or f"pcabench.studies.{study}.section" in MODULES, study

@@ -24,8 +24,9 @@ from scipy import integrate
 from pcabench import cli
 from pcabench.execute.run import run
 from pcabench.predict.methods import fastest
-from pcabench.presets import front_axes, matrix
 from pcabench.spec import RunSpec, identity, row_identity, scene_from_row
+from pcabench.studies import matrix
+from pcabench.studies.front.plan import front_axes
 from solvers import Scene, SceneError, kernel_named, kernel_names, registry
 from solvers.kernels import Kernel, KernelPluginWarning, register, unregister
 from solvers.kernels import constants as kernel

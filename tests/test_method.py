@@ -77,10 +77,10 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
     df = frame.load(paths.reference_results())
     data = {(s, m, k, h, i, corr): v for (s, m, k, h, _c, i, corr), v in measured_limits().items()}
     checked = 0
-    from pcabench.presets.cylinder import CYLINDER_ADVISED
+    from pcabench.studies.cylinder.plan import CYLINDER_ADVISED
 
     paper = ("gaussian", 2.13)
-    from pcabench.presets.high_order import LONG_CFLS, LONG_H
+    from pcabench.studies.high_order.plan import LONG_CFLS, LONG_H
 
     high_order = {(kernel, LONG_H) for kernel, _integrator in LONG_CFLS}  # every corrected method advise searches
     presets = (

@@ -17,10 +17,12 @@ matplotlib.use("Agg")
 
 import pytest  # noqa: E402
 
-from pcabench import presets, store  # noqa: E402
-from pcabench.presets import open_edges as P  # noqa: E402
-from pcabench.reports import frame, sections  # noqa: E402
-from pcabench.reports.sections import open_edges as S  # noqa: E402
+from pcabench import store, studies  # noqa: E402
+from pcabench.reports import frame  # noqa: E402
+from pcabench.reports.section import in_order  # noqa: E402
+from pcabench.studies.open_edges import plan as P  # noqa: E402
+from pcabench.studies.open_edges import section as S  # noqa: E402
+from pcabench.studies.stability.plan import LONG_T_END
 from solvers import Scene  # noqa: E402
 
 from .conftest import cli_main  # noqa: E402
@@ -30,7 +32,7 @@ from .test_study import row  # noqa: E402
 
 @pytest.fixture(scope="module")
 def plan():
-    return presets.preset(P.OPEN)
+    return studies.preset(P.OPEN)
 
 
 def test_the_open_preset_scans_both_incidences_absorbers_widths_and_strengths(plan):
@@ -60,7 +62,7 @@ def test_the_cost_runs_alternate_and_the_long_runs_open_the_stability_scenes(pla
         mine = [s for s in first if s.name == name]
         assert {(s.open, s.absorber) for s in mine} == {("", ""), *((edges, a) for a in absorbers)}
         assert all(s.dx == dx and s.steps == P.OPEN_COST_STEPS and s.model == "lagrangian" for s in mine)
-    long = [s.scene for s in plan if s.scene.t_end == presets.LONG_T_END]
+    long = [s.scene for s in plan if s.scene.t_end == LONG_T_END]
     assert {(s.name, s.open) for s in long} == set(P.OPEN_LONG_EDGES.items())
     assert {s.cfl for s in long} == set(P.OPEN_LONG_CFL) and {s.model for s in long} == set(P.OPEN_LONG_MODELS)
 
@@ -163,7 +165,7 @@ def test_open_edges_lower_the_limit_where_they_blow_up_at_a_cfl_the_closed_scene
 
 
 def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):
-    (section,) = [s for s in sections.in_order() if s.name == "open_edges"]
+    (section,) = [s for s in in_order() if s.name == "open_edges"]
     assert section.all_scenes
     data = S.rows(frame.load(_store(tmp_path / "store" / "m.jsonl").parent))
     with record() as found:
@@ -181,7 +183,7 @@ def test_no_open_run_no_section(tmp_path):
 def test_open_alone_is_the_preset_and_with_values_the_matrix(tmp_path, capsys):
     code, out, err = cli_main("study", "--open", "--list", "--results", str(tmp_path / "r"), capsys=capsys)
     assert code == 0, err
-    assert len(out.strip().splitlines()) == len(presets.preset(P.OPEN)) and not (tmp_path / "r").exists()
+    assert len(out.strip().splitlines()) == len(studies.preset(P.OPEN)) and not (tmp_path / "r").exists()
     code, out, err = cli_main(
         "study", "--open", "x", "--dx", "0.5", "--list", "--results", str(tmp_path / "r"), capsys=capsys
     )

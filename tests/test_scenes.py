@@ -199,7 +199,7 @@ def test_the_fast_methods_come_from_the_prediction():
     """The front's fast methods on the paper's scene are the cheapest the prediction says reach the paper's
     configuration's error, one per kernel, within the model's margin of the predicted stable CFL."""
     from pcabench.predict.methods import MARGIN, fastest
-    from pcabench.presets import fast_methods
+    from pcabench.studies.front.plan import fast_methods
 
     paper = predict(Scene(dx=0.05, t_end=10.0, model="linear")).predicted_error
     found = fastest(paper, 10.0, "linear")

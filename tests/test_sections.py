@@ -5,10 +5,11 @@ from __future__ import annotations
 import pytest
 
 from pcabench import store
-from pcabench.reports import sections, write_reports
 from pcabench.reports import tables as T
-from pcabench.reports.sections import long_runs as long_runs_section
-from pcabench.reports.sections import stability as stability_section
+from pcabench.reports import write_reports
+from pcabench.reports.section import SECTIONS, Section
+from pcabench.studies.stability import long_runs as long_runs_section
+from pcabench.studies.stability import section as stability_section
 
 from .test_study import fixture_rows
 
@@ -50,7 +51,7 @@ def test_a_new_section_is_one_entry_with_its_rows_text_and_figure(tmp_path, monk
         path.write_bytes(b"")
         return path
 
-    with sections.SECTIONS.registered(sections.Section("mine", rows, text, (figure,))):
+    with SECTIONS.registered(Section("mine", rows, text, (figure,))):
         write_reports(_results(tmp_path), tmp_path / "out")
     report = (tmp_path / "out" / "machine-a" / "report.md").read_text()
     assert "## My table" in report and "runs on machine-a" in report and "![my_figure](my_figure.png)" in report

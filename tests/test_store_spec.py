@@ -634,13 +634,14 @@ def test_a_plugin_that_exits_at_import_is_left_out_not_obeyed(tmp_path):
 
 
 def test_the_study_help_counts_each_presets_runs_from_its_plan():
-    from pcabench import cli, presets
+    from pcabench import cli, studies
+    from pcabench.studies.front.plan import front
 
     text = " ".join(cli.build_parser()._subparsers._group_actions[0].choices["study"].format_help().split())
     for name in ("quick", "paper", "stability", "stability-long", "walls"):
-        assert f"({len(presets.preset(name))} runs" in text, name
-    fixed = len(presets.front("quick", fast=False))
-    made = len(presets.preset("front"))
+        assert f"({len(studies.preset(name))} runs" in text, name
+    fixed = len(front("quick", fast=False))
+    made = len(studies.preset("front"))
     extra = int(re.search(rf"quick: .*?\({fixed} runs and up to (\d+) predicted fastest", text).group(1))
     assert fixed < made <= fixed + extra
 

@@ -108,7 +108,7 @@ def test_the_linear_run_at_a_wall_is_its_prediction(name):
 def test_the_plane_walls_gap_to_its_prediction_is_its_free_left_end():
     """With the free left end 20 m further away the plane wall's linear run is its prediction to round-off (the
     report's words on the gap at x_min = -10 m rest on this)."""
-    from pcabench.reports.sections.walls import free_end_moved
+    from pcabench.studies.walls.section import free_end_moved
 
     x_min, _ = free_end_moved()  # the data the report's words cite
     scene = Scene(

@@ -16,9 +16,13 @@ matplotlib.use("Agg")
 
 import pytest  # noqa: E402
 
-from pcabench import presets, store  # noqa: E402
-from pcabench.reports import frame, sections  # noqa: E402
-from pcabench.reports.sections import walls as W  # noqa: E402
+from pcabench import store, studies  # noqa: E402
+from pcabench.reports import frame  # noqa: E402
+from pcabench.reports.section import in_order  # noqa: E402
+from pcabench.studies.front.plan import FRONT_T_END, front_axes
+from pcabench.studies.stability.plan import LONG_T_END, STABILITY_DX
+from pcabench.studies.walls import section as W  # noqa: E402
+from pcabench.studies.walls.plan import FREE_COUNTERPART, WALL_COST_DX, WALL_COST_ROUNDS, WALLS, cost_round
 from solvers import Scene, kernel_names, scenes  # noqa: E402
 from solvers.method import Method
 from solvers.reference.dispersion import predict, stable_cfl  # noqa: E402
@@ -29,25 +33,25 @@ from .test_study import row  # noqa: E402
 
 @pytest.fixture(scope="module")
 def plan():
-    return presets.preset(presets.WALLS)
+    return studies.preset(WALLS)
 
 
 def test_the_walls_preset_covers_every_wall_scene_of_the_registry(plan):
     walled = {name for name, kind in scenes().items() if kind.walls}
     assert walled and walled == set(W.wall_scenes())
-    accuracy = [s for s in plan if s.preset == presets.WALLS and s.scene.t_end == presets.FRONT_T_END]
+    accuracy = [s for s in plan if s.preset == WALLS and s.scene.t_end == FRONT_T_END]
     for name in walled:
         mine = [s.scene for s in accuracy if s.scene.name == name]
         assert {s.model for s in mine} == {"linear", "lagrangian"}
         assert len({s.dx for s in mine}) >= 2 and all(Method.of(s).is_paper() for s in mine)
         assert all((s.strip_height is not None) == scenes()[name].strip for s in mine)  # plane-wall on its strip
-    assert all(s.preset == presets.WALLS or presets.cost_round(s.preset) for s in plan)
+    assert all(s.preset == WALLS or cost_round(s.preset) for s in plan)
     assert len(plan) == len(set(plan))
 
 
 def test_the_stability_runs_bracket_each_methods_predicted_limit(plan):
-    long = [s.scene for s in plan if s.scene.t_end == presets.LONG_T_END]
-    assert long and all(s.dx == presets.STABILITY_DX for s in long)
+    long = [s.scene for s in plan if s.scene.t_end == LONG_T_END]
+    assert long and all(s.dx == STABILITY_DX for s in long)
     for name in W.wall_scenes():
         mine = [s for s in long if s.name == name]
         assert {s.kernel for s in mine if s.model == "linear"} == set(kernel_names())  # every registered kernel
@@ -66,15 +70,15 @@ def test_the_stability_runs_bracket_each_methods_predicted_limit(plan):
 
 
 def test_the_cost_runs_pair_each_wall_with_its_free_counterpart_in_alternating_rounds(plan):
-    cost = [s for s in plan if presets.cost_round(s.preset)]
-    rounds = sorted({presets.cost_round(s.preset) for s in cost})
-    assert rounds == list(range(1, presets.WALL_COST_ROUNDS + 1)) and len(rounds) >= 3
+    cost = [s for s in plan if cost_round(s.preset)]
+    rounds = sorted({cost_round(s.preset) for s in cost})
+    assert rounds == list(range(1, WALL_COST_ROUNDS + 1)) and len(rounds) >= 3
     firsts = []
     for i in rounds:
-        mine = [s.scene for s in cost if presets.cost_round(s.preset) == i]
+        mine = [s.scene for s in cost if cost_round(s.preset) == i]
         pairs = list(zip(mine[::2], mine[1::2]))
         for a, b in pairs:
-            assert {a.name, b.name} in [{w, f} for w, f in presets.FREE_COUNTERPART.items()]
+            assert {a.name, b.name} in [{w, f} for w, f in FREE_COUNTERPART.items()]
             assert (a.n_particles, a.dx, a.n_steps, a.model, a.x_min, a.x_max) == (
                 b.n_particles,
                 b.dx,
@@ -84,14 +88,14 @@ def test_the_cost_runs_pair_each_wall_with_its_free_counterpart_in_alternating_r
                 b.x_max,
             )
         firsts.append(tuple(a.kind.walls != () for a, _ in pairs))
-        for wall in presets.FREE_COUNTERPART:
+        for wall in FREE_COUNTERPART:
             assert len({s.dx for s in mine if s.name == wall}) >= 2
     assert firsts[0] != firsts[1]  # which side goes first alternates
 
 
 def test_cost_round_reads_only_its_own_tags():
-    assert presets.cost_round("walls-cost-2") == 2
-    assert [presets.cost_round(p) for p in ("walls", "walls-cost-", "walls-cost-x", "quick", "")] == [None] * 5
+    assert cost_round("walls-cost-2") == 2
+    assert [cost_round(p) for p in ("walls", "walls-cost-", "walls-cost-x", "quick", "")] == [None] * 5
 
 
 def _store(path):
@@ -167,7 +171,7 @@ def test_the_section_renders_the_stores_numbers_and_findings(tmp_path):
 def test_the_registrys_section_draws_its_figure_and_it_reads_right(tmp_path):
     from types import SimpleNamespace
 
-    (section,) = [s for s in sections.in_order() if s.name == "walls"]
+    (section,) = [s for s in in_order() if s.name == "walls"]
     assert section.all_scenes  # it reads every scene's runs, not the paper's scene's only
     data = W.rows(frame.load(_store(tmp_path / "store" / "m.jsonl").parent))
     with record() as found:
@@ -186,11 +190,11 @@ def test_no_wall_run_no_section(tmp_path):
 @pytest.mark.parametrize("name", ["plane-wall", "pulse-wall"])
 def test_the_front_of_a_wall_scene_is_its_own_product_with_the_papers_method(name):
     kind = scenes()[name]
-    runs = presets.preset("front", name)
+    runs = studies.preset("front", name)
     assert runs and {s.scene.name for s in runs} == {name}
     assert all((s.scene.strip_height is not None) == kind.strip for s in runs)  # plane-wall on its strip
-    axes = presets.front_axes("quick", name)
-    assert axes == presets.front_axes("quick", "plane-pulse" if kind.strip else "acoustic-pulse")
+    axes = front_axes("quick", name)
+    assert axes == front_axes("quick", "plane-pulse" if kind.strip else "acoustic-pulse")
     assert {s.scene.kernel for s in runs} == set(kernel_names())
     paper = [s.scene for s in runs if Method.of(s.scene).is_paper()]
     assert {s.model for s in paper} == {"linear", "lagrangian"} and len({s.dx for s in paper}) >= 2
@@ -203,9 +207,9 @@ def test_study_list_prints_the_plan_and_runs_nothing(tmp_path, capsys):
 
     code = cli.main(["study", "--walls", "--list", "--results", str(tmp_path / "r")])
     out = capsys.readouterr().out.splitlines()
-    assert code == 0 and len(out) == len(presets.preset(presets.WALLS)) and not (tmp_path / "r").exists()
+    assert code == 0 and len(out) == len(studies.preset(WALLS)) and not (tmp_path / "r").exists()
     assert out[0].startswith(f"[1/{len(out)}] walls: ")
-    assert sum("walls-cost-3:" in line for line in out) == 2 * sum(len(d) for d in presets.WALL_COST_DX.values())
+    assert sum("walls-cost-3:" in line for line in out) == 2 * sum(len(d) for d in WALL_COST_DX.values())
 
 
 def test_advise_searches_the_prediction_on_a_wall_scene(tmp_path, capsys):

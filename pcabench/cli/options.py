@@ -107,7 +107,7 @@ def add_parameter_options(p: argparse.ArgumentParser, parameters, many: bool = F
     """Options for ``parameters`` (pcabench/parameters.py), each with its help and Scene's default. In a matrix
     (``many``) an option that is also a preset's flag (``--open``) takes no values too: given alone, it is the
     preset (:func:`preset_given`)."""
-    from pcabench.presets import flags
+    from pcabench.studies import flags
 
     for par in parameters:
         kind = {"choices": par.choices()} if par.choices else {"type": number(par.option)} if par.numeric else {}
@@ -266,10 +266,10 @@ def home_option() -> str:
 # ---------------------------------------------------------------- the parser
 class PresetHelpFormatter(argparse.RawDescriptionHelpFormatter):
     """``{size:PRESET}`` in an option's help is the preset's run count, counted from its plan when the help is
-    shown (:meth:`pcabench.presets.Preset.size`), so the help cannot drift from the runs."""
+    shown (:meth:`pcabench.studies.Preset.size`), so the help cannot drift from the runs."""
 
     def _expand_help(self, action):
-        from pcabench.presets import MATRIX_BUDGET, PRESETS, size_text
+        from pcabench.studies import MATRIX_BUDGET, PRESETS, size_text
 
         text = super()._expand_help(action)
         budgets = ", ".join(f"{p.name} {p.budget:g}" for p in PRESETS.all().values()) + f", matrix {MATRIX_BUDGET:g}"
@@ -278,11 +278,11 @@ class PresetHelpFormatter(argparse.RawDescriptionHelpFormatter):
 
 
 def add_preset_options(group, matrix: bool = False) -> None:
-    """One option per preset flag (pcabench/presets/: each preset names its flag, choice and help): a flag of
+    """One option per preset flag (pcabench/studies/*/plan.py: each preset names its flag, choice and help): a flag of
     one preset is a switch, a flag several share takes their choices (the first one's when none is given). A
     flag that is also an option of the scene's (``matrix``: the parser has them too; ``--open``) is that option
     given alone, which the matrix's option offers (:func:`add_parameter_options`)."""
-    from pcabench.presets import flags
+    from pcabench.studies import flags
 
     taken = {par.dest for par in PARAMETERS} if matrix else set()
 

@@ -105,7 +105,7 @@ def run_study(
 
 def study_specs(args) -> tuple[str, list[RunSpec]]:
     """The preset named by the flags, or the matrix built from the scene options."""
-    from pcabench.presets import DEFAULT_PRESET, PRESETS, flags, matrix, named_by, preset
+    from pcabench.studies import DEFAULT_PRESET, PRESETS, flags, matrix, named_by, preset
 
     given = [flag for flag in flags() if preset_given(args, flag)]
     if args.dx and given:
@@ -148,7 +148,7 @@ def study_specs(args) -> tuple[str, list[RunSpec]]:
 
 
 def cmd_study(args) -> int:
-    from pcabench.presets import budget
+    from pcabench.studies import budget
 
     name, specs = study_specs(args)
     if args.cluster:  # the workers check their own solvers (a GPU run needs a GPU worker, not a GPU here)

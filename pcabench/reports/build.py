@@ -1,6 +1,6 @@
 """Write the Markdown reports: one per measured profile, the card comparison, and the index.
 
-reports/<profile>/report.md   every section of the registry ``sections.SECTIONS`` with its figures
+reports/<profile>/report.md   each study's sections (registry ``section.SECTIONS``), figures inline
 reports/cards.md              Table 6 and Fig. 14 across systems, GPU cards side by side
 reports/README.md             the index
 """
@@ -15,13 +15,14 @@ from pcabench import store
 from pcabench.errors import NoResults
 from pcabench.machine import profiles
 from pcabench.reports import figures as F
-from pcabench.reports import frame, sections
+from pcabench.reports import frame
 from pcabench.reports import paper as P
 from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.sections import Context, table6_md
+from pcabench.reports.section import Context, in_order
 from pcabench.store import runs
 from pcabench.store.safeio import own_folder, write_file
+from pcabench.studies.paper.table6 import table6_md
 from solvers import DEFAULT_SCENE
 
 
@@ -68,7 +69,7 @@ def report_for(ctx: Context, progress: Callable[[str], None] | None = None) -> P
     out, df = ctx.out, ctx.df_scenes if ctx.df_scenes is not None else ctx.df
     own_folder(out, "report folder", within=out.parent)  # a link is refused: nothing written or deleted there
     body, figs = [], []
-    chosen = [s for s in sections.in_order() if not ctx.df.empty or s.all_scenes]  # else: other scenes only
+    chosen = [s for s in in_order() if not ctx.df.empty or s.all_scenes]  # else: other scenes only
     for i, section in enumerate(chosen, 1):  # read at each report: a section registered since is in it
         if progress:
             progress(f"report {ctx.name}: section {i} of {len(chosen)}, {section.name}")
@@ -269,7 +270,7 @@ def summary(results_dir: Path, profile: str) -> str:
 def open_study(df):
     """Which rows are the open-edges study's: open edges, or the preset's own closed runs (``open``,
     ``open-cost-<round>``: contrasts scored once the pulse has gone, and cost baselines)."""
-    from pcabench.presets.open_edges import OPEN, open_cost_round
+    from pcabench.studies.open_edges.plan import OPEN, open_cost_round
 
     if df.empty:
         return df.index == df.index

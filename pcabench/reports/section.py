@@ -1,0 +1,111 @@
+"""What a report section is, and the section registry.
+
+A :class:`Section` is an object in a study's ``section.py`` (``pcabench/studies/<study>/section.py``, found by
+the registry :data:`SECTIONS`; a plug-in through the entry-point group ``pcabench.sections``): ``rows(ctx)`` computes
+its numbers once per report, ``text(rows, ctx)`` writes its Markdown from them, and ``figures`` draw its PNGs
+(with the toolkit ``figures.py``) from the same rows; ``order`` places it in the report. Rows shared by several
+sections (Table 4 for Table 5 and Fig. 13; Table 6 across every machine and the cards page) are computed once
+through :meth:`Context.once`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+import pandas as pd
+
+from pcabench.reports import tables as T
+from solvers.plugins import Registry
+
+ENTRY_POINT_GROUP = "pcabench.sections"
+
+
+@dataclass
+class Context:
+    """One machine's report: its runs (``df``), every machine's (``df_all``), its name and folder, and the
+    rows computed once per report or once per set of reports (``shared``)."""
+
+    df: pd.DataFrame
+    df_all: pd.DataFrame
+    name: str
+    out: Path
+    shared: dict = field(default_factory=dict)
+    cache: dict = field(default_factory=dict)
+    df_scenes: pd.DataFrame | None = None  # every scene's runs of this machine (``df`` holds the paper's scene's)
+    # the open-edges study's runs too (``pcabench study --open``: open edges, their closed contrasts and cost
+    # baselines), which only the "Open edges" section reads: the other sections' scenes are the closed ones
+    df_open: pd.DataFrame | None = None
+
+    def every_run(self):
+        """This machine's runs with the open-edges study's (open edges, the cylinder's), for the sections that read
+        them: ``df_open``, else every scene's, else the paper scene's."""
+        for df in (self.df_open, self.df_scenes, self.df):
+            if df is not None:
+                return df
+        return None
+
+    @property
+    def pid(self) -> str:
+        df = self.df_scenes if self.df_scenes is not None else self.df
+        return str(df.profile_id.iloc[0])
+
+    def once(self, key: str, compute: Callable[[], Any], across_machines: bool = False):
+        """``compute()`` the first time ``key`` is asked for in this report (or in every report)."""
+        cache = self.shared if across_machines else self.cache
+        if key not in cache:
+            cache[key] = compute()
+        return cache[key]
+
+    def table4(self):
+        return self.once("table4", lambda: T.table4(self.df))
+
+    def table6(self):
+        return self.once("table6", lambda: T.table6(self.df_all), across_machines=True)
+
+
+@dataclass(frozen=True)
+class Section:
+    """A part of the report: ``rows(ctx)``, ``text(rows, ctx)`` (Markdown lines, [] when the rows hold
+    nothing) and ``figures`` (each ``figure(rows, ctx)`` -> a PNG path or None)."""
+
+    name: str
+    rows: Callable[[Context], Any]
+    text: Callable[[Any, Context], list[str]]
+    figures: tuple[Callable[[Any, Context], Path | None], ...] = ()
+    all_scenes: bool = False  # reads ``ctx.df_scenes``; the others read the paper's scene only
+    order: float = 1000.0  # its place in the report (the built-ins' are 10, 20, ...; the default: last)
+
+
+def _problem(section: Section) -> str | None:
+    if not (callable(section.rows) and callable(section.text) and all(map(callable, section.figures))):
+        return "a section needs callable rows, text and figures"
+    return None
+
+
+SECTIONS = Registry(
+    "section",
+    "pcabench.studies",  # each study's section.py
+    Section,
+    group=ENTRY_POINT_GROUP,
+    order=lambda s: (s.order, s.name),
+    problem=_problem,
+    role="section",
+)
+
+
+def in_order() -> list[Section]:
+    """Every registered section, in report order (read at each report: one registered since is in it)."""
+    return sorted(SECTIONS.all().values(), key=lambda s: (s.order, s.name))
+
+
+def stored_measure(r, name: str) -> float | None:
+    """A scene's stored error measure ``name`` of a report row (``err_<name>``), None where not a finite number."""
+    v = r.get(f"err_{name}")
+    return None if v is None or not np.isfinite(v) else float(v)
+
+
+def limit_words(stable_cfl: float) -> str:
+    return f"{stable_cfl:.3g}" if stable_cfl > 0 else "none (grows at every CFL)"

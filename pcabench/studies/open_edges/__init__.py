@@ -1,0 +1,2 @@
+"""Sound in the open (``pcabench study --open``): what an open edge leaves behind, what its layer costs,
+whether it is stable."""
