@@ -94,9 +94,9 @@ class Method:
         """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion
         relation's, solvers/reference/dispersion.py; the same at every dx, so dx = 1 stands for all; 0 where the
         integrator grows at any step)."""
-        from solvers.reference.dispersion import stable_cfl, unit_scene
+        from solvers.reference.dispersion import stable_cfl
 
-        return stable_cfl(unit_scene(**{**self.scene_fields(), "cfl": 0.2}))
+        return stable_cfl(self)
 
     def scene_fields(self) -> dict:
         """The Scene fields this method sets (a compact kernel's ``cutoff_factor`` left at its default)."""

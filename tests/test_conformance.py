@@ -291,7 +291,8 @@ def test_a_new_scene_kind_is_checked_everywhere_with_no_list_to_edit():
     """Issue 58: the conformance suite and the GPU check read their cases from the scene kinds
     (SceneKind.smallest, smallest_open, card, card_open): a kind registered now is in both."""
     from pcabench.conformance import Subject, scene_cases
-    from pcabench.gpu.plan import Plan
+    from pcabench.studies.open_edges import gpu as open_gpu
+    from pcabench.studies.walls import gpu as walls_gpu
     from solvers.scenes import SCENES
     from solvers.scenes.plane_pulse import PlanePulse
     from solvers.scenes.plane_wall import PlaneWall
@@ -312,7 +313,6 @@ def test_a_new_scene_kind_is_checked_everywhere_with_no_list_to_edit():
         claimed = Subject(LinkedListCPU, quick=True).claimed_scenes()
         assert {"short-duct", "open-line", "open-line-open"} <= set(claimed)
         Scene(**cases["short-duct"], steps=1)  # a case the Scene takes
-        plan = Plan()
-        assert {"name": "short-duct", "dx": 0.5} in plan.wall_scenes
-        assert {"name": "open-line", "dx": 0.5, "open": "x"} in plan.open_scenes
-    assert "short-duct" not in scene_cases() and "short-duct" not in str(Plan().wall_scenes)
+        assert {"name": "short-duct", "dx": 0.5} in walls_gpu.cases(rehearse=False).scenes
+        assert {"name": "open-line", "dx": 0.5, "open": "x"} in open_gpu.cases(rehearse=False).scenes
+    assert "short-duct" not in scene_cases() and "short-duct" not in str(walls_gpu.cases(rehearse=False).scenes)

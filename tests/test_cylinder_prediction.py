@@ -94,7 +94,7 @@ def test_advise_names_the_cheapest_method_predicted_to_reach_the_probes_target(m
     gets the closest method, predicted, in words."""
     from pcabench import cli, store
     from pcabench.predict import search as A
-    from pcabench.predict.stability import scene_limit
+    from pcabench.predict.stability import stable_cfl
     from solvers import kernel_named, kernel_names
 
     from .test_study import row
@@ -107,7 +107,7 @@ def test_advise_names_the_cheapest_method_predicted_to_reach_the_probes_target(m
     for kernel in (k for k in kernel_names() if not kernel_named(k).negative_lobe):  # near a body: corrected only
         for dx in (0.04, 0.02):
             base = Scene(name="cylinder", dx=dx, t_end=10.0, model="linear", kernel=kernel, h_factor=1.0)
-            trial = base.replace(cfl=round(0.8 * scene_limit(base), 2))
+            trial = base.replace(cfl=round(0.8 * stable_cfl(base), 2))
             predicted[kernel, dx] = (trial.kind.predict_headline(trial).predicted_error, trial)
     errors = sorted(e for e, _ in predicted.values())
     target = (errors[0] + errors[1]) / A.BODY_MARGIN / 2  # one method reaches it (near a body: with the margin)

@@ -213,8 +213,10 @@ def test_gpu_graph_replays_the_plain_step(requires_gpu, precision, tol):
 def test_gpu_walls_match_cpu(requires_gpu, tmp_path):
     """The GPU check's walls stage on the card: plane-wall and pulse-wall (mirror particles), linear and
     lagrangian, float64 and float32, against linkedlist-cpu."""
-    from pcabench.gpu.agreement import agrees, walls_against_cpu
+    from pcabench.gpu.agreement import agrees
     from pcabench.gpu.plan import FULL
+    from pcabench.studies.walls import gpu as walls_gpu
 
-    rows = walls_against_cpu(FULL, tmp_path)
-    assert len(rows) == len(FULL.wall_scenes) * 2 * len(FULL.wall_models) and agrees(rows), rows
+    cases = walls_gpu.cases(rehearse=False)
+    rows = walls_gpu.against_cpu(cases, FULL.compare_steps, tmp_path)
+    assert len(rows) == len(cases.scenes) * 2 * len(cases.models) and agrees(rows), rows

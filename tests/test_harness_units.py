@@ -138,12 +138,14 @@ def test_step_seconds_is_the_step_stages_per_step():
 
 
 def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
-    """The GPU check's stages (pcabench/gpu/check.py STAGES): a stage that raises is recorded as failed, one
+    """The GPU check's stages (pcabench/gpu/check.py stages(): its own and the studies'): a stage that raises is
+    recorded as failed, one
     the budget cannot start is recorded as not run, and the stages after them still run."""
     from pathlib import Path
 
     from pcabench.gpu import check as G
     from pcabench.gpu import plan
+    from pcabench.gpu import stage as S
 
     ran = []
 
@@ -155,20 +157,21 @@ def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
 
     budget = plan.Budget(100.0)
     budget.say = lambda *a, **k: None  # quiet
-    check = G.Check(plan.REHEARSAL, Path("."), budget, {"stages": []}, {"id": "m"}, None, Path("s.jsonl"), True, {})
-    for stage in (G.Stage("broken", 0, broken), G.Stage("greedy", 1e9, fine), G.Stage("fine", 0, fine)):
+    check = S.Check(plan.REHEARSAL, Path("."), budget, {"stages": []}, {"id": "m"}, None, Path("s.jsonl"), True, {})
+    for stage in (S.Stage("broken", 0, broken), S.Stage("greedy", 1e9, fine), S.Stage("fine", 0, fine)):
         G.run_stage(stage, check)
     status = {s["stage"]: s["status"] for s in check.state["stages"]}
     assert status["broken"].startswith("failed: RuntimeError: no card")
     assert status["greedy"].startswith("not run:") and status["fine"] == "ok" and ran == ["fine"]
-    assert [s.name for s in G.STAGES][:4] == ["profile", "compare", "walls", "sweep"]  # the order of value
+    assert [s.name for s in G.stages()][:4] == ["profile", "compare", "walls", "sweep"]  # the order of value
 
 
 def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows():
     """The walls stage (GPU against CPU on the walled scenes) fails on a row past its precision's tolerance or
     on no rows, and the check's tables list its rows; the rehearsal's walled scenes are check-solver's tiny ones."""
     from pcabench.conformance import SCENES
-    from pcabench.gpu import agreement, plan, tables
+    from pcabench.gpu import agreement, tables
+    from pcabench.studies.walls import gpu as walls_gpu
     from solvers import Scene
 
     row = {"scene": "pulse-wall", "N": 182, "precision": "float32", "model": "lagrangian", "dx": 1.0, "steps": 3}
@@ -186,10 +189,10 @@ def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows()
         },
     )
     assert "## Rigid walls" in text and "| pulse-wall | 182 | float32 | lagrangian | 1.0 | 3 | 5.00e-05 |" in text
-    assert {Scene(**w).name for w in plan.FULL.wall_scenes} == {"plane-wall", "pulse-wall"}
-    assert set(plan.FULL.wall_models) == {"linear", "lagrangian"}
-    assert plan.REHEARSAL.wall_scenes and all(
-        w in SCENES.values() and Scene(**w).walls for w in plan.REHEARSAL.wall_scenes
+    assert {Scene(**w).name for w in walls_gpu.cases(False).scenes} == {"plane-wall", "pulse-wall"}
+    assert set(walls_gpu.cases(False).models) == {"linear", "lagrangian"}
+    assert walls_gpu.cases(True).scenes and all(
+        w in SCENES.values() and Scene(**w).walls for w in walls_gpu.cases(True).scenes
     )
 
 
@@ -197,12 +200,13 @@ def test_the_gpu_checks_open_stage_compares_open_scenes_and_tables_their_cost():
     """The open stage runs open scenes (the rehearsal's: check-solver's open square, free y edges and the PML)
     against the CPU, and the check's tables list them and the layer's cost on the GPU."""
     from pcabench.conformance import SCENES
-    from pcabench.gpu import plan, tables
+    from pcabench.gpu import tables
+    from pcabench.studies.open_edges import gpu as open_gpu
     from solvers import Scene
 
-    assert plan.REHEARSAL.open_scenes == (SCENES["acoustic-pulse-open"],)
-    assert {Scene(**s).open for s in plan.FULL.open_scenes} == {"x", "xy"}
-    assert all(Scene(**s).open for s in plan.FULL.open_cost + plan.REHEARSAL.open_cost)
+    assert open_gpu.cases(True).scenes == (SCENES["acoustic-pulse-open"],)
+    assert {Scene(**s).open for s in open_gpu.cases(False).scenes} == {"x", "xy"}
+    assert all(Scene(**s).open for s in open_gpu.cases(False).cost + open_gpu.cases(True).cost)
     row = {"scene": "acoustic-pulse", "N": 324, "precision": "float64", "model": "lagrangian", "dx": 1.0, "steps": 3}
     cost = {"scene": "plane-pulse", "dx": 0.025, "open": "x", "absorber": "sponge", "N": 1984000}
     cost.update(closed_N=1600000, step_ms=3.1, closed_ms=2.5, ratio=1.24)
@@ -224,18 +228,20 @@ def test_the_gpu_checks_body_stage_compares_the_cylinder_with_each_boundary_meth
     """The body stage runs the cylinder (the rehearsal's: check-solver's, one method, model and precision; on a
     card the workshop's at dx 0.04 with both boundary methods) against the CPU, and the tables list it."""
     from pcabench.conformance import SCENES
-    from pcabench.gpu import plan, tables
+    from pcabench.gpu import tables
+    from pcabench.studies.cylinder import gpu as cylinder_gpu
+    from pcabench.studies.high_order import gpu as high_order_gpu
     from solvers import Scene
     from solvers.bodies import boundary_method_names
 
-    assert plan.REHEARSAL.body_scenes == (SCENES["cylinder"],)
-    assert all(Scene(**s).body is not None for s in plan.FULL.body_scenes + plan.REHEARSAL.body_scenes)
+    assert cylinder_gpu.cases(True).scenes == (SCENES["cylinder"],)
+    assert all(Scene(**s).body is not None for s in cylinder_gpu.cases(False).scenes + cylinder_gpu.cases(True).scenes)
     from solvers.bodies import boundary_method_named
 
     # every boundary method has a stage: the ghosts' in the body stage, a corrected method's wall (weak) in the
     # high-order stage
-    corrected = {s["boundary_method"] for s in plan.FULL.high_order_scenes if "boundary_method" in s}
-    assert set(plan.FULL.body_methods) | corrected == set(boundary_method_names())
+    corrected = {s["boundary_method"] for s in high_order_gpu.cases(False).scenes if "boundary_method" in s}
+    assert set(cylinder_gpu.cases(False).methods) | corrected == set(boundary_method_names())
     assert all(boundary_method_named(m).needs_correction for m in corrected)
     row = {"scene": "cylinder (rings)", "N": 1376, "precision": "float32", "model": "lagrangian", "dx": 0.125}
     text = tables.markdown(

@@ -182,7 +182,7 @@ LAYERS = (
     # of a study's folder)
     ("pcabench.reports", "pcabench.studies.*"),
     ("pcabench.bench",),  # asv
-    ("pcabench.gpu",),  # the GPU check
+    ("pcabench.gpu", "pcabench.studies.*.gpu"),  # the GPU check, and each study's stage of it
     ("pcabench.cli", "pcabench.console"),  # the command line, and the console script that imports it
 )
 
@@ -230,6 +230,7 @@ def test_a_study_is_one_folder_in_two_layers():
     assert plan == layer_of("pcabench.studies.preset") == layer_of("pcabench.studies") < report
     assert layer_of("pcabench.studies.walls.section") == layer_of("pcabench.studies.paper.table4") == report
     assert layer_of("pcabench.studies.walls") == report  # a study's face: its docstring, above nothing
+    assert layer_of("pcabench.studies.walls.gpu") == layer_of("pcabench.gpu.check") > report  # its GPU stage
     studies = {m.split(".")[2] for m in MODULES if m.startswith("pcabench.studies.") and m.count(".") >= 3}
     assert {"paper", "front", "walls", "cylinder", "high_order"} <= studies
     for study in studies:

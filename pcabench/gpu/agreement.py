@@ -1,5 +1,5 @@
-"""The GPU solver against the CPU one on the same scenes, every model and precision, walls and open edges included
-(stage 2), and the open layer's cost on the GPU."""
+"""The GPU solver against the CPU one on the same scene (stage 2: the paper's scene, every model and precision);
+the studies' stages (pcabench/studies/<study>/gpu.py) compare their own scenes with the same row and test."""
 
 from __future__ import annotations
 
@@ -72,84 +72,3 @@ def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
         for precision in PRECISIONS
         for model in MODELS
     ]
-
-
-def walls_against_cpu(plan: Plan, out: Path) -> list[dict]:
-    """The same on each walled scene of the plan (mirror particles), each wall model and precision."""
-    return [
-        gpu_against_cpu(Scene(**{**walled, "steps": plan.compare_steps, "model": model, "precision": precision}), out)
-        for walled in plan.wall_scenes
-        for precision in PRECISIONS
-        for model in plan.wall_models
-    ]
-
-
-def body_against_cpu(plan: Plan, out: Path) -> list[dict]:
-    """The same on each scene of the plan with a body (the cylinder), each boundary method, model and precision."""
-    return [
-        gpu_against_cpu(
-            Scene(
-                **{
-                    **scene,
-                    "steps": plan.compare_steps,
-                    "boundary_method": method,
-                    "model": model,
-                    "precision": precision,
-                }
-            ),
-            out,
-        )
-        for scene in plan.body_scenes
-        for method in plan.body_methods
-        for model in plan.body_models
-        for precision in plan.body_precisions
-    ]
-
-
-def high_order_against_cpu(plan: Plan, out: Path) -> list[dict]:
-    """The same on each high-order scene of the plan (the kernel gradient correction's moments sweep and passes,
-    RK4's sums, the weak wall), each model and precision."""
-    return [
-        gpu_against_cpu(Scene(**{**scene, "steps": plan.compare_steps, "model": model, "precision": precision}), out)
-        for scene in plan.high_order_scenes
-        for model in plan.high_order_models
-        for precision in plan.high_order_precisions
-    ]
-
-
-def open_against_cpu(plan: Plan, out: Path) -> list[dict]:
-    """The same on each open-edge scene of the plan (an absorbing layer: free y edges, the PML, the sponge),
-    lagrangian (the layer's particles moving), both precisions."""
-    return [
-        gpu_against_cpu(Scene(**{**scene, "steps": plan.compare_steps, "model": "lagrangian", "precision": p}), out)
-        for scene in plan.open_scenes
-        for p in PRECISIONS
-    ]
-
-
-def open_cost(plan: Plan) -> list[dict]:
-    """linkedlist-gpu's time per step (SNP + PI + SU, s) of each ``plan.open_cost`` scene closed and open, float32,
-    lagrangian, in rounds that alternate which goes first; per scene the best of each side and their ratio."""
-    from pcabench.store.record import STEP_STAGES
-
-    best: dict = {}
-    for i in range(plan.open_cost_rounds):
-        for setting in plan.open_cost:
-            pair = [{**setting, "open": ""}, setting][:: 1 if i % 2 == 0 else -1]
-            for scene_args in pair:
-                scene = Scene(**scene_args, steps=plan.open_cost_steps, precision="float32")
-                rec = run(RunSpec(GPU_SOLVER, scene))
-                if rec.status != "ok":
-                    raise RuntimeError(f"{GPU_SOLVER} {scene.describe()}: {rec.status} {rec.message}")
-                t = sum(rec.stages[s] for s in STEP_STAGES) / rec.steps
-                key = (scene.name, scene.dx, scene.open, scene.absorber_used if scene.open else "")
-                best[key] = min(best.get(key, (np.inf, 0)), (t, scene.n_particles))
-    rows = []
-    for (name, dx, edges, absorber), (t, n) in sorted(best.items()):
-        closed = best[(name, dx, "", "")]
-        if edges:
-            rows.append(
-                {"scene": name, "dx": dx, "open": edges, "absorber": absorber, "N": n, "closed_N": closed[1],
-                 "step_ms": 1e3 * t, "closed_ms": 1e3 * closed[0], "ratio": t / closed[0]}
-            )  # fmt: skip
-    return rows

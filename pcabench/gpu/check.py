@@ -5,19 +5,22 @@
 
 A GPU machine is lent rarely and briefly, so the first real run has to work
 and bring everything back from one call. The check runs these stages
-(:data:`STAGES`, a registry like the report's sections: a stage is one
-function of the shared :class:`Check` and one entry) in order of value, each
-given what is left of the budget, and stops cleanly when the budget is
-spent, keeping what it has:
+(:func:`stages`: its own, :data:`OWN`, and each study's from its folder,
+``pcabench/studies/<study>/gpu.py``, found by the registry
+:data:`pcabench.gpu.stage.STAGES`; a stage is one function of the shared
+:class:`~pcabench.gpu.stage.Check`) in order of value, each given what is
+left of the budget, and stops cleanly when the budget is spent, keeping what
+it has:
 
 1. ``profile``: the hardware profile, with the card's measured ceilings
    (device copy bandwidth, FP32 and FP64 FMA rates, the SM clock);
 2. ``compare``: linkedlist-gpu against linkedlist-cpu, every model and precision;
-   ``walls``: the same on the scenes with rigid walls (plane-wall, pulse-wall:
-   mirror particles), linear and lagrangian, both precisions; ``open``: the same on
-   open edges (the 2D pulse's open square with the PML, the paper's pulse's open x
-   with the sponge), and the time per step closed and open, alternating; ``body``:
-   the same on the workshop's cylinder, each boundary method (ghost particles);
+   the studies' stages: ``walls`` the same on the scenes with rigid walls
+   (plane-wall, pulse-wall: mirror particles), linear and lagrangian, both
+   precisions; ``open`` on open edges (the 2D pulse's open square with the PML,
+   the paper's pulse's open x with the sponge), and the time per step closed and
+   open, alternating; ``body`` on the workshop's cylinder, each boundary method
+   (ghost particles); ``high-order`` with the gradient correction;
 3. ``sweep``: linkedlist-gpu, lagrangian Verlet, both precisions, 100K to 62.5M
    particles on the paper's domain, steps sized to the budget; runs go to the
    results store (preset ``gpu``) through the ordinary sweep, in this process
@@ -53,22 +56,13 @@ import shutil
 import sys
 import tarfile
 import time
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
-from pcabench.gpu.agreement import (
-    agrees,
-    body_against_cpu,
-    compare_with_cpu,
-    high_order_against_cpu,
-    open_against_cpu,
-    open_cost,
-    walls_against_cpu,
-)
+from pcabench.gpu.agreement import agrees, compare_with_cpu
 from pcabench.gpu.ceilings import measure_ceilings
 from pcabench.gpu.graph_timing import graph_vs_plain
 from pcabench.gpu.plan import FULL, REHEARSAL, Budget, Plan
+from pcabench.gpu.stage import STAGES, Check, Stage
 from pcabench.gpu.sweeps import cpu_peer_specs, gpu_specs, run_and_release
 from pcabench.gpu.tables import markdown
 from pcabench.gpu.tools import ncu_command, run_logged
@@ -81,32 +75,7 @@ from solvers.gpu.device import device_backend, simulated
 H100_COMMIT = "bf587a5"  # the commit the H100 was measured at: asv compares the cards there
 
 
-# ---------------------------------------------------------------- the stages
-@dataclass
-class Check:
-    """What the stages share: the plan, where they write, the budget, and the results so far (``state``)."""
-
-    plan: Plan
-    out: Path
-    budget: Budget
-    state: dict
-    profile: dict
-    cupy: object  # CuPy on a GPU, None in the simulator
-    store_path: Path
-    rehearse: bool
-    env: dict  # the environment of the stages' child processes
-
-
-@dataclass(frozen=True)
-class Stage:
-    """One stage of the check: it runs if ``need_s`` seconds are left; ``work(check)`` returns False when it
-    failed (an exception fails it too, and the next stage still runs)."""
-
-    name: str
-    need_s: float
-    work: Callable[[Check], object]
-
-
+# ---------------------------------------------------------------- the check's own stages
 def measure(c: Check):
     if c.cupy is None:
         c.profile["measured"] = {"note": "rehearsal: no GPU, no ceilings"}
@@ -121,27 +90,6 @@ def measure(c: Check):
 def compare(c: Check) -> bool:
     c.state["compare"] = compare_with_cpu(c.plan, c.out)
     return agrees(c.state["compare"])
-
-
-def walls(c: Check) -> bool:
-    c.state["walls"] = walls_against_cpu(c.plan, c.out)
-    return agrees(c.state["walls"])
-
-
-def body(c: Check) -> bool:
-    c.state["body"] = body_against_cpu(c.plan, c.out)
-    return agrees(c.state["body"])
-
-
-def high_order(c: Check) -> bool:
-    c.state["high-order"] = high_order_against_cpu(c.plan, c.out)
-    return agrees(c.state["high-order"])
-
-
-def open_edges(c: Check) -> bool:
-    c.state["open"] = open_against_cpu(c.plan, c.out)
-    c.state["open_cost"] = open_cost(c.plan)
-    return agrees(c.state["open"])
 
 
 def stored_sweep(c: Check, specs, spare_s: float) -> list[dict]:
@@ -239,22 +187,24 @@ def ncu(c: Check) -> bool:
     return c.state["ncu"]["exit"] == 0
 
 
-# In order: each one's seconds to start (what it needs at the least), its work.
-STAGES = (
-    Stage("profile", 0, measure),
-    Stage("compare", 40, compare),
-    Stage("walls", 40, walls),
-    Stage("sweep", 60, gpu_sweep),
-    Stage("open", 40, open_edges),
-    Stage("body", 40, body),
-    Stage("high-order", 40, high_order),
-    Stage("graph", 40, graph),
-    Stage("cpu", 40, cpu_peers),
-    Stage("asv", 60, asv),
-    Stage("bench", 60, bench),
-    Stage("pytest-gpu", 40, pytest_gpu),
-    Stage("ncu", 45, ncu),
+# Each one's seconds to start (what it needs at the least), its work and its place: the studies' stages (walls 20,
+# open 40, body 50, high-order 60; STAGES, each study's gpu.py) run between them, in order of value.
+OWN = (
+    Stage("profile", 0, measure, order=0),
+    Stage("compare", 40, compare, order=10),
+    Stage("sweep", 60, gpu_sweep, order=30),
+    Stage("graph", 40, graph, order=70),
+    Stage("cpu", 40, cpu_peers, order=80),
+    Stage("asv", 60, asv, order=90),
+    Stage("bench", 60, bench, order=100),
+    Stage("pytest-gpu", 40, pytest_gpu, order=110),
+    Stage("ncu", 45, ncu, order=120),
 )
+
+
+def stages() -> list[Stage]:
+    """Every stage the check runs, in order: its own and each study's (read at each check)."""
+    return sorted((*OWN, *STAGES.all().values()), key=lambda s: (s.order, s.name))
 
 
 def run_stage(stage: Stage, c: Check) -> None:
@@ -292,7 +242,7 @@ def missing_tools() -> list[str]:
 def gpu_check(
     out: Path, results: Path, reports: Path, budget_s: float = 480.0, rehearse: bool = False, plan: Plan | None = None
 ) -> int:
-    """Every stage of :data:`STAGES` within ``budget_s`` seconds; 0 when every stage that ran passed, else 1.
+    """Every stage of :func:`stages` within ``budget_s`` seconds; 0 when every stage that ran passed, else 1.
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
@@ -325,11 +275,11 @@ def gpu_check(
         rehearse,
         dict(os.environ, PCABENCH_COMMIT=state["commit"]),
     )
-    for stage in STAGES:
+    for stage in stages():
         run_stage(stage, c)
 
     state["elapsed_s"] = budget.elapsed()
-    text = markdown(profile, state)
+    text = markdown(profile, state, stages())
     write_file(out / "gpu_check.md", text)
     write_file(out / "gpu_check.json", json.dumps(state, indent=1, default=str) + "\n")
     print(text, flush=True)

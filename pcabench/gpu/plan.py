@@ -1,5 +1,6 @@
-"""What the GPU check runs and within what time: the full plan (sized on the H100 run), the rehearsal's, and
-the budget each stage is given."""
+"""What the GPU check's own stages run and within what time: the full plan (sized on the H100 run), the
+rehearsal's, and the budget each stage is given. A study's stage sizes its own cases in its folder
+(``pcabench/studies/<study>/gpu.py``), from the scene kinds' card sizes (:func:`card_cases`)."""
 
 from __future__ import annotations
 
@@ -7,15 +8,11 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from pcabench.conformance import SCENES
 from solvers import Scene
 
 GPU_SOLVER = "linkedlist-gpu"  # the solver this check measures (its CUDA graph path, its kernels under ncu)
 GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
 CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
-
-# The high-order method (solvers/corrections/gradient.py): Laguerre-Gauss at h 1.5 dx cut at 4 h, corrected.
-HIGH_ORDER = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0, "correction": "gradient"}
 
 RESERVE_S = 25.0  # kept back from every stage for the reports and the tarball
 
@@ -42,30 +39,6 @@ class Plan:
     max_steps: int = 100
     compare_dx: float = 0.5
     compare_steps: int = 20
-    # the walled scenes (Scene fields, name included), run compare_steps steps: every scene kind with walls at
-    # its card size (SceneKind.card: a new walled kind is checked with no list to edit)
-    wall_scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: bool(kind.walls)))
-    wall_models: tuple = ("linear", "lagrangian")  # mirrors set once; mirrors following the particles
-    # open edges (issue 41): the 2D pulse in a 24 m open square (free y edges, the PML) and the paper's pulse with
-    # open x edges (the sponge), against the CPU solver; then the time per step closed and open, alternating
-    open_scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: kind.card_open is not None, True))
-    # a body (issue 42): the workshop's cylinder at 5 particles a pulse width (102,400 particles), each boundary
-    # method (its ghosts filled from the fluid on the host), linear and lagrangian, against the CPU solver
-    body_scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: kind.body))
-    body_methods: tuple = ("lattice", "rings")
-    body_models: tuple = ("linear", "lagrangian")
-    body_precisions: tuple = ("float64", "float32")
-    # high-order SPH (issue 56): the kernel gradient correction with the Laguerre-Gauss kernel, on the plane pulse
-    # with RK4 and on the cylinder with its weak wall (no ghosts), each model and precision, against the CPU solver
-    high_order_scenes: tuple = (
-        {"dx": 0.25, "integrator": "rk4", "cfl": 1.0, **HIGH_ORDER},
-        {"name": "cylinder", "dx": 0.04, "boundary_method": "weak", "cfl": 0.5, **HIGH_ORDER},
-    )
-    high_order_models: tuple = ("linear", "lagrangian")
-    high_order_precisions: tuple = ("float64", "float32")
-    open_cost: tuple = ({"dx": 0.025, "open": "x"}, {"name": "acoustic-pulse", "dx": 0.05, "open": "xy"})
-    open_cost_steps: int = 50
-    open_cost_rounds: int = 3
     graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
     graph_steps: int = 50
     graph_rounds: int = 5
@@ -88,23 +61,6 @@ REHEARSAL = Plan(
     max_steps=2,
     compare_dx=1.0,
     compare_steps=3,
-    # check-solver's 182-particle duct walled at both ends (both mirror branches), its mirrors following the
-    # particles: 2 runs, not 8 (~20 s each in the simulator); check-solver runs every walled case there
-    wall_scenes=(SCENES["pulse-wall"],),
-    wall_models=("lagrangian",),
-    open_scenes=(SCENES["acoustic-pulse-open"],),  # check-solver's open square: free y edges and the PML
-    body_scenes=(SCENES["cylinder"],),  # check-solver's cylinder (1,376 particles): one run a side in the simulator
-    body_methods=("rings",),
-    body_models=("lagrangian",),
-    body_precisions=("float32",),
-    # check-solver's cylinder with the weak wall: the correction's moments and passes, one run a side (RK4 in the
-    # simulator: tests/test_high_order.py)
-    high_order_scenes=({**SCENES["cylinder"], "boundary_method": "weak", "cfl": 0.5, **HIGH_ORDER},),
-    high_order_models=("linear",),  # its moments once: a minute in the simulator (lagrangian: twice that)
-    high_order_precisions=("float64",),
-    open_cost=({"dx": 1.0, "x_min": -8.0, "x_max": 8.0, "open": "x"},),
-    open_cost_steps=2,
-    open_cost_rounds=1,
     graph_dx=(1.0,),
     graph_steps=2,
     graph_rounds=1,

@@ -48,8 +48,13 @@ def scene_agreement(what: str, rows) -> list[str]:
     ]
 
 
-def markdown(profile: dict, results: dict) -> str:
-    """The check's tables: stages run, ceilings, agreement, sweep, graph path, CPU peers."""
+def markdown(profile: dict, results: dict, stages=None) -> str:
+    """The check's tables: stages run, ceilings, agreement, each stage's own tables (``stages``, default: the
+    studies' stages), sweep, graph path, CPU peers."""
+    if stages is None:
+        from pcabench.gpu.stage import STAGES
+
+        stages = STAGES.all().values()
     g = profile.get("gpu") or {}
     lines = [
         f"# GPU check: {g.get('name', 'no GPU (rehearsal)')} ({profile['id']})",
@@ -73,27 +78,9 @@ def markdown(profile: dict, results: dict) -> str:
             f"{r['max_rel_diff_drho']:.2e} |"
             for r in results["compare"]
         ]
-    for key, what in (
-        ("walls", "Rigid walls (mirror particles)"),
-        ("open", "Open edges (an absorbing layer)"),
-        ("body", "A rigid cylinder (ghost particles)"),
-        ("high-order", "High-order SPH (the gradient correction, Laguerre-Gauss, RK4; the weak wall)"),
-    ):
-        if results.get(key):
-            lines += scene_agreement(what, results[key])
-    if results.get("open_cost"):
-        lines += [
-            "",
-            "## The open layer's cost on the GPU (linkedlist-gpu, float32, lagrangian; best of alternating rounds)",
-            "",
-            "| scene | dx | open | absorber | N closed | N open | ms / step closed | ms / step open | open / closed |",
-            "|---|---|---|---|---|---|---|---|---|",
-        ]
-        lines += [
-            f"| {r['scene']} | {r['dx']} | {r['open']} | {r['absorber']} | {r['closed_N']:,} | {r['N']:,} | "
-            f"{r['closed_ms']:.4g} | {r['step_ms']:.4g} | {r['ratio']:.3f} |"
-            for r in results["open_cost"]
-        ]
+    for stage in stages:  # the studies' stages: each its own tables (walls, open edges, the cylinder, high order)
+        if stage.report is not None:
+            lines += stage.report(results)
     if results.get("gpu_rows"):
         lines += [
             "",

@@ -13,7 +13,7 @@ import shlex
 import sys
 
 from pcabench.predict.methods import high_order_methods, step_weight
-from pcabench.predict.stability import margin, scene_limit
+from pcabench.predict.stability import margin, stable_cfl
 from solvers import DEFAULT_SCENE, DEFAULT_SOLVER, Scene, kernel_named, kernel_names, scene_kind
 from solvers.kernels import truncated
 from solvers.method import Method
@@ -143,7 +143,7 @@ def suggest(
             **method_fields(s),
             dx=s.dx,
             predicted_error=p.predicted_error,
-            stable_cfl=scene_limit(s),
+            stable_cfl=stable_cfl(s),
             **({} if kind.strip else {"n_particles": s.n_particles, "steps": s.n_steps}),
             study=shlex.join(
                 [
@@ -177,7 +177,7 @@ def _trial(kind, scene: str, t_end: float, method: dict, share: float, tried: di
         except Exception:  # noqa: BLE001 - a combination Scene refuses is not a candidate
             tried[dx] = None
             return None
-        limit = scene_limit(base)  # predicted, or lower where long runs of the scene measured it
+        limit = stable_cfl(base)  # predicted, or lower where long runs of the scene measured it
         if not limit > 0:
             tried[dx] = None
             return None

@@ -1,7 +1,7 @@
 """A run's predicted stability: the largest stable CFL of its method, and how far past it the run went.
 
-The limit comes from the dispersion relation (solvers/reference/dispersion.py
-``stable_cfl``): exact for the `linear` model on a periodic lattice; for
+The limit (:func:`stable_cfl`, the suite's one) comes from the dispersion relation
+(solvers/reference/dispersion.py ``stable_cfl``): exact for the `linear` model on a periodic lattice; for
 `fixed` and `lagrangian` it is their linear part's (design section 4). Where
 long runs of a scene measured a lower one (free ends, or a moving model's
 nonlinear terms: :func:`measured_limits`), that one is used.
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 ROUND_OFF_E_FOLDINGS = math.log(1e16)  # ~37: from float64 round-off to the pulse's size
-# The one margin rule: the largest share of a method's stable CFL (:func:`stable_limit`) at which advise names a
+# The one margin rule: the largest share of a method's stable CFL (:func:`stable_cfl`) at which advise names a
 # stored run or suggests one, and the front picks its methods. The prediction is exact for `linear`; for the
 # moving models it is their linear part's, and their measured limits lie lower.
 MARGIN = {"linear": 0.9, "fixed": 0.7, "lagrangian": 0.7}
@@ -129,22 +129,20 @@ def measured_limit(r) -> float | None:
     return None
 
 
-def stable_limit(r) -> float:
-    """The largest stable CFL of run ``r``'s method: predicted (0: its integrator grows at any step), or the
-    limit long runs of its scene and model measured where that is lower (:func:`measured_limits`)."""
-    linear, measured = _limits(*method_of(r))[0], measured_limit(r)
-    return linear if measured is None else min(linear, measured)
-
-
-def scene_limit(scene) -> float:
-    """The stable CFL of a Scene's method on its scene and model, for choosing a step: :func:`stable_limit` (the
-    prediction, or the lower limit long runs of the scene measured). Open edges keep it: their damping is a term
-    of each update (solvers/absorbers/base.py; measured with `pcabench study --open` and the cylinder's long
-    runs, docs/accuracy.md "Open edges")."""
+def stable_cfl(r) -> float:
+    """The largest stable CFL of ``r``'s method on its scene and model, ``r`` a stored run, a front point or a
+    :class:`~solvers.Scene`: the periodic lattice's prediction (0: its integrator grows at any step), or the limit
+    long runs of its scene and model measured where that is lower (:func:`measured_limits`). Every stable CFL the
+    suite states or steps by (advise, the fronts, the reports, the presets' CFLs) is this one. Open edges keep
+    it: their damping is a term of each update (solvers/absorbers/base.py; measured with `pcabench study --open`
+    and the cylinder's long runs, docs/accuracy.md "Open edges")."""
+    from solvers import Scene
     from solvers.method import Method
 
-    row = {"scene": scene.name, "model": scene.model, "open": scene.open, **Method.of(scene).scene_fields()}
-    return stable_limit(row)
+    if isinstance(r, Scene):
+        r = {"scene": r.name, "model": r.model, "open": r.open, **Method.of(r).scene_fields()}
+    linear, measured = _limits(*method_of(r))[0], measured_limit(r)
+    return linear if measured is None else min(linear, measured)
 
 
 def past_limit(cfl: float, limit: float) -> bool:
@@ -180,7 +178,7 @@ def assess(r) -> dict:
     ``limit_from``
     ("prediction", or "long runs" where the limit long runs of its scene measured is the lower) and
     ``predicted`` (the periodic lattice's predicted limit)."""
-    limit, cfl, predicted = stable_limit(r), float(r["cfl"]), _limits(*method_of(r))[0]
+    limit, cfl, predicted = stable_cfl(r), float(r["cfl"]), _limits(*method_of(r))[0]
     fraction = cfl / limit if limit > 0 else math.inf
     return {
         "stable_cfl": limit,

@@ -217,11 +217,15 @@ def largest_stable_z(integrator: str) -> float:
 
 
 def stable_cfl(scene) -> float:
-    """The largest stable CFL (dt c0 / dx) for the scene's kernel, h/dx, cutoff, integrator and correction (it does not
-    depend on dx: D scales as 1/dx at fixed h/dx)."""
-    return _stable_cfl(
-        scene.kernel, float(scene.h_factor), float(scene.cutoff_factor), scene.integrator, scene.correction
-    )
+    """The largest stable CFL (dt c0 / dx) on the periodic lattice for the scene's (or a
+    :class:`~solvers.method.Method`'s) kernel, h/dx, cutoff, integrator and correction (it does not depend on dx: D
+    scales as 1/dx at fixed h/dx). The harness's stable CFL of a run (pcabench/predict/stability.py ``stable_cfl``)
+    is this, or the lower limit long runs of its scene measured."""
+    from solvers.scene import Scene
+
+    cut = getattr(scene, "cutoff_factor", None)
+    cut = Scene.default("cutoff_factor") if cut is None else cut  # a compact kernel's: its support, whatever this
+    return lattice_stable_cfl(scene.kernel, float(scene.h_factor), float(cut), scene.integrator, scene.correction)
 
 
 def unit_scene(**method):
@@ -236,7 +240,10 @@ def unit_scene(**method):
 
 
 @lru_cache(maxsize=1024)
-def _stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str = "none") -> float:
+def lattice_stable_cfl(
+    kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str = "none"
+) -> float:
+    """:func:`stable_cfl` of one method, by its fields (cached: the same at every dx)."""
     unit = unit_scene(
         kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor, integrator=integrator, correction=correction
     )

@@ -127,7 +127,7 @@ class SceneKind:
     # checked everywhere without a list to edit: ``smallest``, a few hundred particles with its boundaries acting
     # from the first step, for the conformance suite (pcabench/conformance.py) and the GPU check's rehearsal;
     # ``smallest_open`` the same with open edges (None: none to open); ``card`` and ``card_open`` the GPU check's
-    # comparison of the GPU solver with the CPU one on a card (pcabench/gpu/plan.py: walls, bodies, open edges).
+    # comparison of the GPU solver with the CPU one on a card (the walls, open-edges and cylinder studies' gpu.py).
     smallest: dict = {"dx": 1.0}
     smallest_open: dict | None = None
     card: dict = {"dx": 0.5}

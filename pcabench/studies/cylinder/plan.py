@@ -52,12 +52,12 @@ CYLINDER_HIGH_ORDER_LONG_T_END = 100.0
 def advised_cfl() -> float:
     """The advised method's CFL: CYLINDER_ADVISED_SHARE of its stable CFL on this scene (the prediction, which
     long runs with the body and the open edges reach: part 6), as advise rounds it."""
-    from pcabench.predict.stability import scene_limit
+    from pcabench.predict.stability import stable_cfl
     from solvers import Scene
 
     kernel, h = CYLINDER_ADVISED
     scene = Scene(name=CYLINDER, dx=0.02, kernel=kernel, h_factor=h, model="linear")
-    return round(CYLINDER_ADVISED_SHARE * scene_limit(scene), 2)
+    return round(CYLINDER_ADVISED_SHARE * stable_cfl(scene), 2)
 
 
 def _run(dx, method, kernel, h, **more):

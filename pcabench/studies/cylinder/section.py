@@ -16,7 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from pcabench.predict.stability import scene_limit
+from pcabench.predict.stability import stable_cfl
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, stored_measure
@@ -24,7 +24,7 @@ from pcabench.reports.tables import latest
 from pcabench.spec import scene_from_row
 from pcabench.studies.cylinder.plan import CYLINDER, CYLINDER_T_END
 from solvers.method import Method
-from solvers.reference.dispersion import stable_cfl
+from solvers.reference import dispersion
 
 TARGET = 0.02  # the issue's: 2 % relative RMS at the probes
 TARGET_DX = 0.02  # at no more than 10 particles a pulse width
@@ -192,7 +192,7 @@ def text(data, ctx) -> list[str]:
             label, cfl = key
             reach = [dx for dx, e in pts if e <= TARGET]
             scene = next(r["scene_value"] for r in ok if (r["label"], r["cfl"]) == key)
-            limit = scene_limit(scene.replace(model="linear"))
+            limit = stable_cfl(scene.replace(model="linear"))
             past = (
                 f" (at or past CFL {limit:g}, where long runs of this scene blew up: bounded only to t = 10 s)"
                 if cfl >= limit
@@ -243,7 +243,7 @@ def text(data, ctx) -> list[str]:
                 f"CFL {r['cfl']:g} " + ("bounded" if r["status"] == "ok" else f"{r['status']} at step {_step(r)}")
                 for r in mine
             )
-            + f"; the periodic lattice's predicted limit is {stable_cfl(mine[0]['scene_value']):.3g}."
+            + f"; the periodic lattice's predicted limit is {dispersion.stable_cfl(mine[0]['scene_value']):.3g}."
         )
     return lines + [""]
 
@@ -277,7 +277,7 @@ def probes_figure(data, ctx):
     ok = [r for r in ok if r["model"] == "linear" and np.isclose(r["t_end"], CYLINDER_T_END)]
     if not ok:
         return None
-    held = [r for r in ok if r["cfl"] < scene_limit(r["scene_value"].replace(model="linear"))]
+    held = [r for r in ok if r["cfl"] < stable_cfl(r["scene_value"].replace(model="linear"))]
     ok = held or ok  # a run past the limit long runs measured is bounded only because it is short: not shown first
     best = min(ok, key=lambda r: (-1 if r["dx"] == min(x["dx"] for x in ok) else 0, r["probes"]))
     same = ("dx", "label", "cfl")
@@ -329,7 +329,7 @@ def error_figure(data, ctx):
     colours = F.palette(len(kernels))
     past_limit = {
         key: " (past the long runs' limit)"
-        if key[1] >= scene_limit(next(r for r in ok if (r["label"], r["cfl"]) == key)["scene_value"])
+        if key[1] >= stable_cfl(next(r for r in ok if (r["label"], r["cfl"]) == key)["scene_value"])
         else ""
         for key in kernels
     }

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcabench.predict.stability import past_limit, stable_limit
+from pcabench.predict.stability import past_limit, stable_cfl
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section
@@ -24,12 +24,6 @@ from solvers import DEFAULT_SCENE, Scene, scene_kind
 TARGETS = (0.10, 0.05, 0.02)  # relative RMS errors of the primary field
 T_FINAL = 10.0  # s
 MODEL_TARGET = 0.02  # "which model this scene needs": the error against the isothermal physics asked for
-
-
-def stable_cfl_of(r) -> float:
-    """The largest stable CFL of row ``r``'s method (pcabench/predict/stability.py: the prediction, or the lower limit
-    long runs measured for a moving model)."""
-    return stable_limit(r)
 
 
 def points(df) -> list[dict]:
@@ -43,7 +37,7 @@ def points(df) -> list[dict]:
         error = r.mse if r.model == "linear" else r.mse_isothermal
         if error is None or not np.isfinite(error):
             continue
-        stable = stable_cfl_of(r)
+        stable = stable_cfl(r)
         out.append(
             {
                 "scene": r.scene,

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from pcabench.predict.stability import scene_limit
+from pcabench.predict.stability import stable_cfl
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
@@ -17,7 +17,7 @@ from pcabench.reports.tables import latest
 from pcabench.spec import scene_from_row
 from pcabench.studies.high_order.plan import HIGH_ORDER, HIGH_ORDER_T_END
 from solvers.method import Method
-from solvers.reference.dispersion import stable_cfl
+from solvers.reference import dispersion
 
 TARGET = 1e-4  # the plane-pulse target at dx 0.1 for the high-order method (RK4, CFL 1)
 SCENES = {"plane-pulse": "the plane pulse (5 m strip)", "acoustic-pulse": "the 2D pulse (40 m square)"}
@@ -47,8 +47,8 @@ def rows(df) -> dict | None:
                 "error": float(r.mse) if r.status == "ok" and np.isfinite(r.mse) else None,
                 "seconds": float(r.t_solution) if r.status == "ok" else None,
                 "N": int(r.n_particles),
-                "limit": scene_limit(scene),
-                "predicted": stable_cfl(scene),
+                "limit": stable_cfl(scene),
+                "predicted": dispersion.stable_cfl(scene),
             }
         )
     return {"runs": runs}
