@@ -141,7 +141,7 @@ def test_a_quick_study_writes_every_section_and_figure_of_the_registry(quick_rep
             assert not any(paths), (section.name, paths)  # no rows: no figure either
             continue
         assert lines[0].startswith("## ") and lines[0] in report, (section.name, lines[:1])
-        # each figure drawn; but the scenes' fronts, which need F.FRONT_PANEL_RUNS runs on two scenes (a quick
+        # each figure drawn; but the scenes' fronts, which need FRONT_PANEL_RUNS runs on two scenes (a quick
         # study makes two 2D runs at the default amplitude: no front to draw)
         expected = [p is not None or (section.name, i) == ("scenes", 0) for i, p in enumerate(paths)]
         assert len(paths) == len(section.figures) and all(expected), (section.name, paths)

@@ -15,11 +15,11 @@ from benchmarks.common import gpu_available
 from pcabench import cli, store
 from pcabench.execute.sweep import run_child
 from pcabench.machine import profiles
-from pcabench.reports import tables as T
 from pcabench.reports import write_reports
 from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
 from pcabench.store.provenance import git_commit
+from pcabench.studies.paper.rows import table6
 from solvers import Scene
 
 from .conftest import cli_main
@@ -109,7 +109,7 @@ def test_table6_finds_a_gpu_and_the_cpu_of_its_own_host(machine, tmp_path):
     merged = tmp_path / "results"
     store.append(cpu, merged / path.name)
     store.append(gpu, merged / path.name)
-    [row] = T.table6(load_frame(merged))
+    [row] = table6(load_frame(merged))
     assert (row["gpu_profile"], row["cpu_profile"], row["same_machine"]) == (mid, mid, True)
     assert row["speedup"] == pytest.approx(10)
     write_reports(merged, tmp_path / "reports")

@@ -10,6 +10,7 @@ from pcabench.reports import frame
 from pcabench.reports.tables import default_numerics, is_paper_method, numerics_label
 from pcabench.spec import RunSpec, scene_from_row
 from pcabench.store.record import RunRecord
+from pcabench.studies.stability.rows import long_run_limits
 from solvers import Scene
 from solvers.method import Method
 
@@ -72,7 +73,6 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
     from pcabench import paths
     from pcabench.predict.stability import measured_limits
     from pcabench.reports import frame
-    from pcabench.reports import tables as T
 
     df = frame.load(paths.reference_results())
     data = {(s, m, k, h, i, corr): v for (s, m, k, h, _c, i, corr), v in measured_limits().items()}
@@ -90,7 +90,7 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
         ("high-order", high_order),
     )
     for preset, methods in presets:
-        for r in T.long_run_limits(df, preset):
+        for r in long_run_limits(df, preset):
             if (r["kernel"], r["h_factor"]) not in methods or r["blew_up_from"] is None:
                 continue
             key = (r["scene"], r["model"], r["kernel"], r["h_factor"], r["integrator"], r["correction"])

@@ -5,11 +5,13 @@ from __future__ import annotations
 import pytest
 
 from pcabench import store
-from pcabench.reports import tables as T
 from pcabench.reports import write_reports
 from pcabench.reports.section import SECTIONS, Section
+from pcabench.studies.paper.rows import fig9_rows
 from pcabench.studies.stability import long_runs as long_runs_section
 from pcabench.studies.stability import section as stability_section
+from pcabench.studies.stability.figures import stability_map
+from pcabench.studies.stability.rows import long_run_limits, stability
 
 from .test_study import fixture_rows
 
@@ -22,15 +24,30 @@ def _results(tmp_path):
 
 
 def test_each_table_is_computed_once_per_report_and_table6_once_per_set(tmp_path, monkeypatch):
+    import sys
+
+    from pcabench.studies.front import rows as front_rows
+    from pcabench.studies.paper import rows as paper_rows
+    from pcabench.studies.stability import rows as stability_rows
+
     calls = {}
-    for name in ("table4", "table6", "error_series", "speed_front", "stability", "cards"):
-        original = getattr(T, name)
+    for home, name in (
+        (paper_rows, "table4"),
+        (paper_rows, "table6"),
+        (paper_rows, "error_series"),
+        (front_rows, "speed_front"),
+        (stability_rows, "stability"),
+        (paper_rows, "cards"),
+    ):
+        original = getattr(home, name)
 
         def counted(*args, _name=name, _original=original, **kwargs):
             calls[_name] = calls.get(_name, 0) + 1
             return _original(*args, **kwargs)
 
-        monkeypatch.setattr(T, name, counted)
+        for module in [m for m in list(sys.modules.values()) if getattr(m, "__name__", "").startswith("pcabench")]:
+            if getattr(module, name, None) is original:  # every module that took it by name
+                monkeypatch.setattr(module, name, counted)
     write_reports(_results(tmp_path), tmp_path / "out")
     machines = 2  # machine-a and machine-b
     assert calls["table6"] == 1
@@ -100,9 +117,7 @@ def test_the_stability_summary_agrees_with_the_prediction_and_the_map(tmp_path, 
     import matplotlib.axes
     import matplotlib.figure
 
-    from pcabench.reports import figures as F
-
-    points, limits = T.stability(_stability_frame(tmp_path), 0.2)
+    points, limits = stability(_stability_frame(tmp_path), 0.2)
     for p in points:  # at or past the predicted 4.97 a run is unstable, blown up or by prediction
         assert (p["class"] in ("unstable", "unstable by prediction")) == (p["cfl"] >= 4.97), p
     lines = stability_section.text((points, limits), None)
@@ -140,7 +155,7 @@ def test_the_stability_summary_agrees_with_the_prediction_and_the_map(tmp_path, 
     monkeypatch.setattr(matplotlib.axes.Axes, "scatter", record_scatter)
     monkeypatch.setattr(matplotlib.axes.Axes, "plot", record_plot)
     monkeypatch.setattr(matplotlib.figure.Figure, "savefig", record_ticks)
-    assert F.stability_map(points, limits, tmp_path, "m", 0.2)
+    assert stability_map(points, limits, tmp_path, "m", 0.2)
     configs = [lim["config"] for lim in limits]
     by_class = {}
     for p in points:
@@ -164,7 +179,7 @@ def test_fig9_keeps_the_loop_measured_beside_the_most_all_pair_runs(tmp_path):
     rec = row(dx=1.0, steps=10, stamp=5)
     rec.pair_loop = "gather"
     store.append(rec, path)
-    rows = T.fig9(frame.load(path.parent))
+    rows = fig9_rows(frame.load(path.parent))
     assert {r["linkedlist_loop"] for r in rows} == {"list"}
     assert all(r["linkedlist_ms"] for r in rows)  # both N keep their linked-list time
 
@@ -201,7 +216,7 @@ def test_the_long_run_table_measures_each_models_limit_below_its_first_blow_up(t
                 ),
                 path,
             )
-    rows = {r["model"]: r for r in T.long_run_limits(frame.load(path.parent))}
+    rows = {r["model"]: r for r in long_run_limits(frame.load(path.parent))}
     lin, fixed = rows["linear"], rows["fixed"]
     assert lin["predicted"] == pytest.approx(4.97, abs=0.01) and lin["bounded_to"] == 4.9
     assert lin["blew_up_from"] == 5.0 and lin["e_foldings"] < 1e-9 and lin["held"] is None

@@ -13,8 +13,19 @@ import pytest
 
 from pcabench import store
 from pcabench.reports import frame, write_reports
-from pcabench.reports import tables as T
 from pcabench.store.record import RunRecord
+from pcabench.studies.front.rows import speed_front
+from pcabench.studies.paper.rows import (
+    accuracy_bars,
+    error_series,
+    fig9_rows,
+    float32_vs_float64,
+    simplifications,
+    table4,
+    table5,
+    table6,
+)
+from pcabench.studies.stability.rows import stability
 from solvers import Scene
 
 SWEEP = ["--dx", "1", "0.5", "--solver", "linkedlist-cpu", "allpair-cpu", "--steps", "3", "--no-report"]
@@ -207,31 +218,31 @@ def results(tmp_path):
 def test_tables_from_a_fixed_results_file(results):
     df = frame.load(results)
     a = df[df.profile_id == "machine-a"]
-    rows4 = T.table4(a)
+    rows4 = table4(a)
     t4 = {(r["config"], r["threads"], r["N"]): r for r in rows4}
     assert t4[("linkedlist-cpu float64", 1, 4000)]["pi"] == pytest.approx(16.0)
     assert t4[("linkedlist-cpu float64", 1, 1000)]["init"] == pytest.approx(2.0)
     assert t4[("linkedlist-cpu float64", 1, 1000)]["protocol"] == "10 steps, full, gather, 1 thread"
-    t5 = {(r["config"], r["protocol"], r["N"]): r for r in T.table5(rows4)}
+    t5 = {(r["config"], r["protocol"], r["N"]): r for r in table5(rows4)}
     assert t5[("linkedlist-cpu float64", "10 steps, full, gather, 2 threads", 1000)]["snp"] == pytest.approx(
         100 * 0.5 / 2.55
     )
-    six = {(r["gpu_profile"], r["N"], r["precision"]): r for r in T.table6(df)}
+    six = {(r["gpu_profile"], r["N"], r["precision"]): r for r in table6(df)}
     assert six[("machine-a", 4000, "float32")]["speedup"] == pytest.approx(4 * 5.1 / 0.11)
     assert six[("machine-a", 4000, "float32")]["speedup_all_cores"] == pytest.approx(4 * 2.55 / 0.11)
     # machine-b has no CPU runs: its row names machine-a's CPU
     assert six[("machine-b", 1000, "float64")]["cpu_profile"] == "machine-a"
     assert six[("machine-b", 1000, "float64")]["speedup"] == pytest.approx(5.1 / 0.055)
-    fig9 = {r["N"]: r for r in T.fig9(a) if r["steps"] == 10}
+    fig9 = {r["N"]: r for r in fig9_rows(a) if r["steps"] == 10}
     assert fig9[4000]["eta"] == pytest.approx((320 + 16 + 0.4) / (4 * 5.1))
     assert fig9[16000]["allpair_status"] == "skipped" and "predicted" in fig9[16000]["allpair_note"]
 
-    series = {(s["model"], s["precision"], s["domain"]): s for s in T.error_series(a)}
+    series = {(s["model"], s["precision"], s["domain"]): s for s in error_series(a)}
     assert series[("linear", "float64", "strip")]["order"] == pytest.approx(2.0)
     assert series[("lagrangian", "float64", "strip")]["stops_falling"] == pytest.approx(0.2)
-    assert {b["verdict"] for b in T.accuracy_bars(T.error_series(a))} == {"met"}
+    assert {b["verdict"] for b in accuracy_bars(error_series(a))} == {"met"}
 
-    points, limits = T.stability(a, inaccurate_above=0.15)
+    points, limits = stability(a, inaccurate_above=0.15)
     lim = {x["config"].split(",")[0]: x for x in limits}
     # CFL 5 ended bounded but is past verlet's predicted 4.97: unstable by prediction, with its e-foldings
     # the periodic lattice's 4.967, lowered to 4.8 by long runs on the paper's strip (its free ends)
@@ -243,14 +254,14 @@ def test_tables_from_a_fixed_results_file(results):
     assert lim["euler"]["stable_cfl"] == 0 and lim["euler"]["accurate_at"] == []
     assert lim["euler"]["blew_up_at"] == [(0.2, 30)]
 
-    f32 = {r["model"]: r for r in T.float32_vs_float64(a)}
+    f32 = {r["model"]: r for r in float32_vs_float64(a)}
     assert f32["linear"]["stops_at"] == pytest.approx(0.05)
-    simp = {(r["simplification"][:5], r["dx"]): r for r in T.simplifications(a)}
+    simp = {(r["simplification"][:5], r["dx"]): r for r in simplifications(a)}
     strip = simp[("y-per", 0.2)]
     assert strip["N"] == (25000, 5000) and strip["speedup"] == pytest.approx(0.512 / 0.053)
     assert strip["mse"] == pytest.approx((0.004, 0.064))
     assert simp[("float", 0.1)]["speedup"] == pytest.approx(0.053 / 0.0275)
-    _, front = T.speed_front(a)
+    _, front = speed_front(a)
     for key in {(p["t_final"], p["model"]) for p in front}:  # slower points on a front are always more accurate
         assert all(np.diff([p["mse"] for p in front if (p["t_final"], p["model"]) == key]) < 0)
 

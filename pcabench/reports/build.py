@@ -14,14 +14,14 @@ from typing import Callable
 from pcabench import store
 from pcabench.errors import NoResults
 from pcabench.machine import profiles
-from pcabench.reports import figures as F
 from pcabench.reports import frame
 from pcabench.reports import paper as P
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Context, in_order
 from pcabench.store import runs
 from pcabench.store.safeio import own_folder, write_file
+from pcabench.studies.paper.figures import cards_figure, fig14
+from pcabench.studies.paper.rows import card_ceilings, card_ratios, cards, table4, table6
 from pcabench.studies.paper.table6 import table6_md
 from solvers import DEFAULT_SCENE
 
@@ -108,7 +108,7 @@ def report_for(ctx: Context, progress: Callable[[str], None] | None = None) -> P
 
 def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
     """Table 6 and Fig. 14 across every system (``ours``: Table 6's rows), and the GPU cards side by side."""
-    cards = T.cards(df_all)
+    card_rows = cards(df_all)
     lines = [
         "# Systems and GPU cards side by side",
         "",
@@ -156,7 +156,7 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
         "",
     ]
     lines += ["## GPU cards: one lagrangian step (SNP + PI + SU)", ""]
-    if cards:
+    if card_rows:
         lines += [
             md_table(
                 [
@@ -184,14 +184,14 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
                         fmt(r["ns_per_particle_step"], ".2f"),
                         fmt(r["ps_per_pair"], ".2f"),
                     ]
-                    for r in cards
+                    for r in card_rows
                 ],
             ),
             "",
             "ps per pair counts both sweeps of a Verlet step (2 x N x mean neighbours pairs).",
             "",
         ]
-        ceilings = T.card_ceilings(cards)
+        ceilings = card_ceilings(card_rows)
         if ceilings:
             lines += [
                 "### Each card's measured ceilings",
@@ -205,7 +205,7 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
                 ),
                 "",
             ]
-        ratios = T.card_ratios(cards)
+        ratios = card_ratios(card_rows)
         if ratios:
             lines += [
                 "### Two cards against the ratio of their ceilings",
@@ -238,7 +238,7 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
         f"the Quadro M4000's and GeForce GT730's Table 6 ({P.CONVERSION['Table 6']}).",
         "",
     ]
-    figs = [F.fig14(ours, reports_dir, "all systems"), F.cards_figure(cards, reports_dir)]
+    figs = [fig14(ours, reports_dir, "all systems"), cards_figure(card_rows, reports_dir)]
     lines += [f"![{p.stem}]({p.name})\n" for p in figs]
     path = write_file(reports_dir / "cards.md", "\n".join(lines) + "\n")
     return [path, *figs]
@@ -247,7 +247,7 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
 def summary(results_dir: Path, profile: str) -> str:
     """A study's closing table for the terminal: this machine's step times (Table 4's SNP / PI / SU columns)."""
     df = frame.load(results_dir)
-    rows = T.table4(df[(df.profile_id == profile) & (df.scene == DEFAULT_SCENE)]) if not df.empty else []
+    rows = table4(df[(df.profile_id == profile) & (df.scene == DEFAULT_SCENE)]) if not df.empty else []
     if not rows:
         return ""
     return "Step times on this machine, ms per step (the paper's scene; the report has every table):\n" + md_table(
@@ -312,8 +312,8 @@ def write_reports(
         )
         for name, g in everything[~open_study(everything)].groupby("machine")
     ]
-    table6 = shared.get("table6")
-    paths += cards_page(paper, reports_dir, table6 if table6 is not None else T.table6(paper))
+    rows6 = shared.get("table6")  # Table 6 across machines, as the reports computed it (table6_of)
+    paths += cards_page(paper, reports_dir, rows6 if rows6 is not None else table6(paper))
     index = [
         "# Reports",
         "",

@@ -4,8 +4,8 @@ A :class:`Section` is an object in a study's ``section.py`` (``pcabench/studies/
 the registry :data:`SECTIONS`; a plug-in through the entry-point group ``pcabench.sections``): ``rows(ctx)`` computes
 its numbers once per report, ``text(rows, ctx)`` writes its Markdown from them, and ``figures`` draw its PNGs
 (with the toolkit ``figures.py``) from the same rows; ``order`` places it in the report. Rows shared by several
-sections (Table 4 for Table 5 and Fig. 13; Table 6 across every machine and the cards page) are computed once
-through :meth:`Context.once`.
+sections (Table 4 for Table 5 and Fig. 13; Table 6 across every machine and the cards page: the paper study's
+``table4_of``, ``table6_of``) are computed once through :meth:`Context.once`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,6 @@ from typing import Any, Callable
 import numpy as np
 import pandas as pd
 
-from pcabench.reports import tables as T
 from solvers.plugins import Registry
 
 ENTRY_POINT_GROUP = "pcabench.sections"
@@ -58,12 +57,6 @@ class Context:
         if key not in cache:
             cache[key] = compute()
         return cache[key]
-
-    def table4(self):
-        return self.once("table4", lambda: T.table4(self.df))
-
-    def table6(self):
-        return self.once("table6", lambda: T.table6(self.df_all), across_machines=True)
 
 
 @dataclass(frozen=True)

@@ -14,11 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from pcabench.predict.stability import past_limit, stable_cfl
-from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section
 from pcabench.reports.tables import is_paper_method, latest, linear_floor, numerics_label
 from pcabench.spec import scene_from_row
+from pcabench.studies.front.figures import phase_direction, scene_fronts
 from solvers import DEFAULT_SCENE, Scene, scene_kind
 
 TARGETS = (0.10, 0.05, 0.02)  # relative RMS errors of the primary field
@@ -375,8 +375,8 @@ SECTION = Section(
     rows,
     text,
     (
-        lambda d, ctx: F.scene_fronts(d["points"], ctx.out, ctx.name) if d else None,
-        lambda d, ctx: F.phase_direction(d["phase"], d["fronts"], ctx.out, ctx.name) if d else None,
+        lambda d, ctx: scene_fronts(d["points"], ctx.out, ctx.name) if d else None,
+        lambda d, ctx: phase_direction(d["phase"], d["fronts"], ctx.out, ctx.name) if d else None,
     ),
     all_scenes=True,
     order=140,

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from pcabench.reports import figures as F
 from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section, limit_words
+from pcabench.studies.front.figures import speed_vs_accuracy
+from pcabench.studies.front.rows import fastest_to, predicted_by_model, predicted_error, speed_front, unstable_on_front
 from pcabench.studies.front.scenes import SECTION as SCENES  # every scene kind's fronts: the study's second section
 from solvers import Scene
 
@@ -27,8 +28,8 @@ def point_cells(p) -> list[str]:
 
 
 def rows(ctx):
-    points, front = T.speed_front(ctx.df)
-    return {"points": points, "front": front, "predicted": T.predicted_by_model(ctx.df) if points else []}
+    points, front = speed_front(ctx.df)
+    return {"points": points, "front": front, "predicted": predicted_by_model(ctx.df) if points else []}
 
 
 def unstable_front_text(rows) -> list[str]:
@@ -93,7 +94,7 @@ def past_margin_text(front) -> list[str]:
     ]
 
 
-def predicted_by_model(predicted) -> list[str]:
+def predicted_by_model_text(predicted) -> list[str]:
     rows = [
         [r["model"], fmt(r["dx"], "g"), pct(r["measured"]), pct(r["predicted"]), pct(r["isothermal"])]
         for r in predicted
@@ -161,7 +162,7 @@ def text(data, ctx) -> list[str]:
     if not points:
         return []
     rows = []
-    for r in T.fastest_to(points):
+    for r in fastest_to(points):
         best, paper = r["best"], r["paper"]
         if best is None:
             continue
@@ -185,7 +186,7 @@ def text(data, ctx) -> list[str]:
     fronts = [
         [
             *point_cells(p),
-            fmt(T.predicted_error(p), ".3g"),
+            fmt(predicted_error(p), ".3g"),
         ]
         for p in front
     ]
@@ -242,8 +243,8 @@ def text(data, ctx) -> list[str]:
         md_table(["model", "t (s)", "method", "dx", "domain", "precision", "time (s)", "error", "predicted"], fronts),
         "",
         *past_margin_text(front),
-        *unstable_front_text(T.unstable_on_front(points)),
-        *predicted_by_model(data["predicted"]),
+        *unstable_front_text(unstable_on_front(points)),
+        *predicted_by_model_text(data["predicted"]),
         *why_the_paper_method(),
     ]
 
@@ -252,7 +253,7 @@ SECTION = Section(
     "front",
     rows,
     text,
-    (lambda rows, ctx: F.speed_vs_accuracy(rows["points"], rows["front"], ctx.out, ctx.name),),
+    (lambda rows, ctx: speed_vs_accuracy(rows["points"], rows["front"], ctx.out, ctx.name),),
     order=80,
 )
 

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from pcabench.reports import figures as F
 from pcabench.reports import paper as P
-from pcabench.reports import tables as T
 from pcabench.reports.section import Section
+from pcabench.studies.paper.figures import fig10
+from pcabench.studies.paper.rows import runtime_series
 
 
 def text(rows, ctx) -> list[str]:
@@ -35,8 +35,8 @@ def text(rows, ctx) -> list[str]:
 
 SECTION = Section(
     "fig10",
-    lambda ctx: T.runtime_series(ctx.df),
+    lambda ctx: runtime_series(ctx.df),
     text,
-    (lambda rows, ctx: F.fig10(rows, ctx.out, ctx.name),),
+    (lambda rows, ctx: fig10(rows, ctx.out, ctx.name),),
     order=30,
 )

@@ -4,24 +4,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcabench.reports import figures as F
 from pcabench.reports import paper as P
 from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section
+from pcabench.studies.paper.figures import fig8
+from pcabench.studies.paper.rows import accuracy_bars, error_series, trend
 from solvers import Scene
 
 
 def rows(ctx):
-    series = T.error_series(ctx.df)
-    return {"series": series, "bars": T.accuracy_bars(series)}
+    series = error_series(ctx.df)
+    return {"series": series, "bars": accuracy_bars(series)}
 
 
 def lagrangian_note(s) -> str:
     t = s["t_final"][0] if len(set(np.round(s["t_final"], 6))) == 1 else None
     ref = T.linear_floor(Scene.default("name"), Scene.default("mach"), round(t, 6)) if t else None
     return (
-        f"it {T.trend(s)} ({', '.join(pct(e) for e in s['mse'])} for dx = "
+        f"it {trend(s)} ({', '.join(pct(e) for e in s['mse'])} for dx = "
         f"{', '.join(f'{d:g}' for d in s['dx'])}). The lagrangian model solves the isothermal (nonlinear) "
         "equations at Ma = 0.05, not the linear ones, so against the linear pulse its error tends to the "
         "difference between the two solutions"
@@ -67,7 +68,7 @@ def text(rows, ctx) -> list[str]:
             lines.append(head + lagrangian_note(s))
         elif s["stops_falling"] and s["protocol"].startswith("t ="):
             lines.append(
-                head + f"its error {T.trend(s)} "
+                head + f"its error {trend(s)} "
                 f"({', '.join(pct(e) for e in s['mse'])} for dx = {', '.join(f'{d:g}' for d in s['dx'])})"
                 + (
                     "; the fixed model keeps the nonlinear rho div(u) term of the paper's equations but "
@@ -79,7 +80,7 @@ def text(rows, ctx) -> list[str]:
                 + ". No order is fitted."
             )
         else:
-            lines.append(head + T.trend(s) + ".")
+            lines.append(head + trend(s) + ".")
     bars = [b for b in rows["bars"] if b["verdict"] != "not measured" or b["bar"].startswith("relative")]
     if bars:
         lines += [
@@ -92,4 +93,4 @@ def text(rows, ctx) -> list[str]:
     return lines
 
 
-SECTION = Section("fig8", rows, text, (lambda rows, ctx: F.fig8(rows["series"], ctx.out, ctx.name),), order=70)
+SECTION = Section("fig8", rows, text, (lambda rows, ctx: fig8(rows["series"], ctx.out, ctx.name),), order=70)

@@ -2,17 +2,18 @@
 
 from __future__ import annotations
 
-from pcabench.reports import figures as F
 from pcabench.reports import paper as P
 from pcabench.reports import tables as T
 from pcabench.reports.md import first_words, fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper.figures import fig9
+from pcabench.studies.paper.rows import fig9_rows, fig9_steps
 
 
 def text(rows, ctx) -> list[str]:
     if not any(r["allpair_ms"] or r["allpair_status"] == "skipped" for r in rows):
         return []
-    steps = T.fig9_steps(rows)
+    steps = fig9_steps(rows)
     pub = [p for p in P.step_times() if p["source"] == "Fig. 9 text"]
     return [
         "## Fig. 9: all-pair against linked list (serial, float64, paper's scene)",
@@ -50,5 +51,5 @@ def text(rows, ctx) -> list[str]:
 
 
 SECTION = Section(
-    "fig9", lambda ctx: T.fig9(ctx.df), text, (lambda rows, ctx: F.fig9(rows, ctx.out, ctx.name),), order=60
+    "fig9", lambda ctx: fig9_rows(ctx.df), text, (lambda rows, ctx: fig9(rows, ctx.out, ctx.name),), order=60
 )

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from pcabench.reports import tables as T
 from pcabench.reports.section import Section
+from pcabench.studies.paper.rows import float32_vs_float64
 
 
 def text(rows, ctx) -> list[str]:
@@ -22,4 +22,4 @@ def text(rows, ctx) -> list[str]:
     return lines + [""]
 
 
-SECTION = Section("float32", lambda ctx: T.float32_vs_float64(ctx.df), text, order=120)
+SECTION = Section("float32", lambda ctx: float32_vs_float64(ctx.df), text, order=120)

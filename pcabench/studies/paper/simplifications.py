@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section
+from pcabench.studies.paper.rows import simplifications
 
 
 def text(rows, ctx) -> list[str]:
@@ -35,4 +35,4 @@ def text(rows, ctx) -> list[str]:
     ]
 
 
-SECTION = Section("simplifications", lambda ctx: T.simplifications(ctx.df), text, order=90)
+SECTION = Section("simplifications", lambda ctx: simplifications(ctx.df), text, order=90)

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper.rows import speed
 
 
 def text(rows, ctx) -> list[str]:
@@ -38,4 +38,4 @@ def text(rows, ctx) -> list[str]:
     ]
 
 
-SECTION = Section("speed", lambda ctx: T.speed(ctx.df), text, order=40)
+SECTION = Section("speed", lambda ctx: speed(ctx.df), text, order=40)

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from pcabench.reports import figures as F
 from pcabench.reports import paper as P
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper.figures import fig13
+from pcabench.studies.paper.rows import one_step_shares, table4_of
 
 
 def paper_cell(r) -> str:
@@ -77,8 +77,8 @@ def text(rows, ctx) -> list[str]:
     ]
 
 
-def fig13(rows, ctx):
-    return F.fig13(T.one_step_shares(rows), ctx.out, ctx.name)
+def draw_fig13(rows, ctx):
+    return fig13(one_step_shares(rows), ctx.out, ctx.name)
 
 
-SECTION = Section("table4", lambda ctx: ctx.table4(), text, (fig13,), order=10)
+SECTION = Section("table4", table4_of, text, (draw_fig13,), order=10)

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from pcabench.reports import figures as F
 from pcabench.reports import paper as P
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper.figures import fig11
+from pcabench.studies.paper.rows import table4_of, table5
 
 
 def text(rows, ctx) -> list[str]:
@@ -56,8 +56,8 @@ def text(rows, ctx) -> list[str]:
 
 SECTION = Section(
     "table5",
-    lambda ctx: T.table5(ctx.table4()),
+    lambda ctx: table5(table4_of(ctx)),
     text,
-    (lambda rows, ctx: F.fig11(rows, ctx.out, ctx.name),),
+    (lambda rows, ctx: fig11(rows, ctx.out, ctx.name),),
     order=20,
 )

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper.figures import fig14
+from pcabench.studies.paper.rows import table6_of
 
 
 def table6_md(rows, across: bool = False, gpu_column: bool = False) -> str:
@@ -75,9 +76,9 @@ def text(rows, ctx) -> list[str]:
 
 SECTION = Section(
     "table6",
-    lambda ctx: [r for r in ctx.table6() if r["gpu_profile"] == ctx.pid],
+    lambda ctx: [r for r in table6_of(ctx) if r["gpu_profile"] == ctx.pid],
     text,
     # drawn where this GPU was measured with its own host's CPU: the paper's lines alone are the cards page's
-    (lambda rows, ctx: F.fig14(rows, ctx.out, ctx.pid) if any(r["same_machine"] for r in rows) else None,),
+    (lambda rows, ctx: fig14(rows, ctx.out, ctx.pid) if any(r["same_machine"] for r in rows) else None,),
     order=50,
 )

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, limit_words
+from pcabench.studies.stability.rows import long_run_limits
 
 
 def text(rows, ctx) -> list[str]:
@@ -84,7 +84,7 @@ def text(rows, ctx) -> list[str]:
 
 SECTION = Section(
     "long-runs",
-    lambda ctx: T.long_run_limits(ctx.df_scenes if ctx.df_scenes is not None else ctx.df),
+    lambda ctx: long_run_limits(ctx.df_scenes if ctx.df_scenes is not None else ctx.df),
     text,
     all_scenes=True,
     order=110,

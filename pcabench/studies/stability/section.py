@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from pcabench.reports import figures as F
-from pcabench.reports import tables as T
 from pcabench.reports.md import md_table, pct
 from pcabench.reports.section import Section, limit_words
+from pcabench.studies.stability.figures import stability_map
 from pcabench.studies.stability.long_runs import SECTION as LONG_RUNS  # the study's second section
 from pcabench.studies.stability.plan import INACCURATE_ABOVE
+from pcabench.studies.stability.rows import cfl_ranges, stability
 from solvers import Scene
 
 
@@ -36,10 +36,10 @@ def stability_row(lim) -> list[str]:
         f"{lim['dx']:g}",
         ", ".join(f"{c:g}" for c in swept),
         limit,
-        T.cfl_ranges(lim["accurate_at"], swept) or "none",
+        cfl_ranges(lim["accurate_at"], swept) or "none",
         "; ".join(f"{c:g} ({pct(e)})" for c, e in lim["inaccurate_at"]) or "-",
         "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in blew) or "-",
-        (f"{T.cfl_ranges([b[0] for b in bounded], swept)}: " + e_fold_words(bounded)) if bounded else "-",
+        (f"{cfl_ranges([b[0] for b in bounded], swept)}: " + e_fold_words(bounded)) if bounded else "-",
     ]
 
 
@@ -91,19 +91,19 @@ def text(rows, ctx) -> list[str]:
                 else "predicted to grow at every CFL"
             ]
             if lim["blew_up_at"]:
-                parts.append(f"blew up at CFL {T.cfl_ranges([c for c, _ in lim['blew_up_at']], swept)}")
+                parts.append(f"blew up at CFL {cfl_ranges([c for c, _ in lim['blew_up_at']], swept)}")
             if lim["bounded_past_limit"]:
                 b = lim["bounded_past_limit"]
                 parts.append(
-                    f"CFL {T.cfl_ranges([x[0] for x in b], swept)} {e_fold_words(b)}: too few for "
+                    f"CFL {cfl_ranges([x[0] for x in b], swept)} {e_fold_words(b)}: too few for "
                     "round-off to grow, unstable by prediction, not stable"
                 )
             if lim["blew_up_below_limit"]:
                 parts.append(
                     f"blew up below the predicted limit at CFL "
-                    f"{T.cfl_ranges(lim['blew_up_below_limit'], swept)} (against the prediction)"
+                    f"{cfl_ranges(lim['blew_up_below_limit'], swept)} (against the prediction)"
                 )
-            accurate = T.cfl_ranges(lim["accurate_at"], swept)
+            accurate = cfl_ranges(lim["accurate_at"], swept)
             parts.append(
                 f"stable and within {100 * INACCURATE_ABOVE:g} % error at CFL {accurate}"
                 if accurate
@@ -113,10 +113,10 @@ def text(rows, ctx) -> list[str]:
     return lines + [""]
 
 
-def stability_map(rows, ctx):
-    return F.stability_map(*rows, ctx.out, ctx.name, INACCURATE_ABOVE)
+def draw_stability_map(rows, ctx):
+    return stability_map(*rows, ctx.out, ctx.name, INACCURATE_ABOVE)
 
 
-SECTION = Section("stability", lambda ctx: T.stability(ctx.df, INACCURATE_ABOVE), text, (stability_map,), order=100)
+SECTION = Section("stability", lambda ctx: stability(ctx.df, INACCURATE_ABOVE), text, (draw_stability_map,), order=100)
 
 __all__ = ["SECTION", "LONG_RUNS"]  # the registry finds both here

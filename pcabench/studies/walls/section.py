@@ -12,13 +12,14 @@ from pathlib import Path
 
 import numpy as np
 
-from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, stored_measure
-from pcabench.reports.tables import is_paper_method, latest, long_run_limits
+from pcabench.reports.tables import is_paper_method, latest
 from pcabench.spec import scene_from_row
 from pcabench.studies.front.scenes import T_FINAL
 from pcabench.studies.stability.plan import LONG_T_END
+from pcabench.studies.stability.rows import long_run_limits
+from pcabench.studies.walls.figures import wall_errors
 from pcabench.studies.walls.plan import FREE_COUNTERPART, WALLS, cost_round
 from solvers import Scene, scenes
 
@@ -70,8 +71,8 @@ def accuracy(df) -> list[dict]:
 
 def stability(df) -> list[dict]:
     """The walls preset's long runs (t = LONG_T_END) per wall scene, model and method, as the long-run table
-    measures them (``tables.long_run_limits``: the CFLs run, bounded up to, blew up from, the prediction, the
-    limit held), each with ``free``: the same model and method's long runs on the free counterpart scene
+    measures them (the stability study's ``long_run_limits``: the CFLs run, bounded up to, blew up from, the
+    prediction, the limit held), each with ``free``: the same model and method's long runs on the free counterpart scene
     (``pcabench study --stability long``), None where there are none."""
     long = df[(df.preset == WALLS) & np.isclose(df.t_final.astype(float), LONG_T_END)] if "preset" in df else df
     rows = long_run_limits(long, preset=WALLS)
@@ -528,7 +529,7 @@ SECTION = Section(
     "walls",
     lambda ctx: rows(ctx.df_scenes if ctx.df_scenes is not None else ctx.df),
     text,
-    (lambda d, ctx: F.wall_errors(d["accuracy"], ctx.out, ctx.name) if d else None,),
+    (lambda d, ctx: wall_errors(d["accuracy"], ctx.out, ctx.name) if d else None,),
     all_scenes=True,
     order=150,
 )
