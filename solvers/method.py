@@ -90,6 +90,16 @@ class Method:
         corrected = f", {self.correction}-corrected" if self.correction != Scene.default("correction") else ""
         return f"{self.kernel}, h {self.h_factor:g}dx{cut}{cfl}{step}{corrected}"
 
+    @property
+    def words(self) -> str:
+        """The method in a sentence's words, every field named (``Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet``):
+        how the reports name the paper's method (``Method.paper().words``)."""
+        cut = f", {self.cutoff_factor:g}h" if self.cutoff_factor is not None else ""
+        corrected = f", {self.correction}-corrected" if self.correction != "none" else ""
+        name = self.kernel[:1].upper() + self.kernel[1:]
+        step = self.integrator[:1].upper() + self.integrator[1:] if self.integrator == "verlet" else self.integrator
+        return f"{name}, h = {self.h_factor:g} dx{cut}, CFL {self.cfl:g}, {step}{corrected}"
+
     def stable_cfl(self) -> float:
         """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion
         relation's, solvers/reference/dispersion.py; the same at every dx, so dx = 1 stands for all; 0 where the

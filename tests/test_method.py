@@ -3,6 +3,8 @@ answer to "is this the paper's method"."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from pcabench import store
@@ -100,3 +102,21 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
             else:
                 assert key not in data, (key, r)  # no limit below the prediction where the runs found none
     assert checked == len(data) > 0  # every row checked against its runs, and there are rows
+
+
+def test_the_paper_method_is_named_in_words_from_scenes_defaults():
+    """Issue 58: the reports name the paper's method from Method.paper() (Scene's defaults), not from a copy
+    typed into each section: change a default and every sentence follows."""
+    from solvers import Scene
+    from solvers.method import Method
+
+    words = Method.paper().words
+    for part in (f"h = {Scene.default('h_factor'):g} dx", f"{Scene.default('cutoff_factor'):g}h",
+                 f"CFL {Scene.default('cfl'):g}", Scene.default("kernel").capitalize()):  # fmt: skip
+        assert part in words, (part, words)
+    corrected = Method("laguerre-gauss", 1.5, 4.0, 1.0, "rk4", "gradient").words
+    assert corrected.endswith("rk4, gradient-corrected") and "h = 1.5 dx, 4h" in corrected
+    assert Method("wendland-c2", 2.0, None, 0.5, "verlet").words == "Wendland-c2, h = 2 dx, CFL 0.5, Verlet"
+    studies = Path(__file__).resolve().parents[1] / "pcabench" / "studies"
+    typed = [p for p in studies.rglob("*.py") if "h = 2.13 dx, 3h" in p.read_text() or "h 2.13dx, 3h" in p.read_text()]
+    assert typed == []

@@ -18,6 +18,7 @@ from pcabench.reports.figures import (
 )
 from pcabench.studies.front.rows import FRONT_MODELS, predicted_error
 from solvers import kernel_names, scene_kind
+from solvers.method import Method
 
 
 def kernel_colour(kernel: str) -> str:
@@ -98,7 +99,7 @@ def speed_vs_accuracy(points, front, out: Path, pid: str):
                 mfc="none",
                 mec="black",
                 mew=1.1,
-                label="the paper's method (Gaussian, h 2.13dx, 3h, CFL 0.2)",
+                label=f"the paper's method ({Method.paper().words})",
             )
             fp = [p for p in front if (p["t_final"], p["model"]) == (t_final, model)]
             ax.step(

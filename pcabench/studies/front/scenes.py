@@ -20,6 +20,7 @@ from pcabench.reports.tables import is_paper_method, latest, linear_floor, numer
 from pcabench.spec import scene_from_row
 from pcabench.studies.front.figures import phase_direction, scene_fronts
 from solvers import DEFAULT_SCENE, Scene, scene_kind
+from solvers.method import Method
 
 TARGETS = (0.10, 0.05, 0.02)  # relative RMS errors of the primary field
 T_FINAL = 10.0  # s
@@ -342,7 +343,7 @@ def text(data, ctx) -> list[str]:
         lines += [
             "### Which model this scene needs",
             "",
-            "The paper's method (Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet) at several amplitudes, every "
+            f"The paper's method ({Method.paper().words}) at several amplitudes, every "
             "model scored against the isothermal physics (the equations the paper's moving particles "
             "solve): the cheapest run within the target, or the smallest error its runs reached. `linear`'s "
             "floor is the distance between the exact linear and the isothermal solutions at t = 10 s (no "

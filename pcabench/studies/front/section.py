@@ -11,6 +11,7 @@ from pcabench.studies.front.figures import speed_vs_accuracy
 from pcabench.studies.front.rows import fastest_to, predicted_by_model, predicted_error, speed_front, unstable_on_front
 from pcabench.studies.front.scenes import SECTION as SCENES  # every scene kind's fronts: the study's second section
 from solvers import Scene
+from solvers.method import Method
 
 
 def point_cells(p) -> list[str]:
@@ -195,8 +196,8 @@ def text(data, ctx) -> list[str]:
         "",
         "Every finished run at a fixed physical time, whatever its method (kernel, h/dx, cutoff, CFL), dx and "
         "precision: time to solution (init + steps, no JIT) against the relative RMS error of u. For each "
-        "error, the fastest run that reaches it, beside the fastest run of the paper's method (Gaussian, "
-        "h = 2.13 dx, cut at 3h, CFL 0.2, Verlet) that reaches it, on this machine, serial or as labelled. "
+        "error, the fastest run that reaches it, beside the fastest run of the paper's method "
+        f"({Method.paper().words}) that reaches it, on this machine, serial or as labelled. "
         "The paper's method is compared on the same kind of domain as the fastest run (a strip holds fewer "
         "particles than the full domain for the same answer; on a strip each method runs on the thinnest "
         "strip its support allows, so a compact kernel's strip is thinner). Errors are against what each model "

@@ -22,6 +22,7 @@ from pcabench.studies.stability.rows import long_run_limits
 from pcabench.studies.walls.figures import wall_errors
 from pcabench.studies.walls.plan import FREE_COUNTERPART, WALLS, cost_round
 from solvers import Scene, scenes
+from solvers.method import Method
 
 
 def wall_scenes() -> tuple[str, ...]:
@@ -243,7 +244,7 @@ def _accuracy_text(rows) -> list[str]:
     lines = [
         "### Accuracy at the wall, t = 10 s",
         "",
-        "The paper's method (Gaussian, h = 2.13 dx, 3h, CFL 0.2, Verlet) at Mach 0.05, scored against the exact "
+        f"The paper's method ({Method.paper().words}) at Mach 0.05, scored against the exact "
         "linear solution (the pulse plus its mirror image): u for plane-wall, drho for pulse-wall, relative RMS "
         "over the domain; near the wall (the particles within a cutoff of a wall, the ones with mirror "
         "neighbours) and in the bulk (the others), each over the RMS of the reference over the whole domain, "
