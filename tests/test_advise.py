@@ -7,8 +7,8 @@ import json
 import pytest
 
 from pcabench import store
-from pcabench.cli.advise import advise
 from pcabench.execute.sweep import failed_record
+from pcabench.predict.advice import advise
 from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
 from solvers import Scene

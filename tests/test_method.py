@@ -9,9 +9,9 @@ import pytest
 
 from pcabench import store
 from pcabench.reports import frame
-from pcabench.reports.tables import default_numerics, is_paper_method, numerics_label
 from pcabench.spec import RunSpec, scene_from_row
 from pcabench.store.record import RunRecord
+from pcabench.store.rows import default_numerics, is_paper_method, numerics_label
 from pcabench.studies.stability.rows import long_run_limits
 from solvers import Scene
 from solvers.method import Method

@@ -2,7 +2,7 @@
 it): a small grid of kernel x h/dx x dx x CFL share, and the high-order methods, each predicted from the dispersion
 relation (its scene kind's :meth:`predict_headline`), the CFL at most the margin of the stable one
 (:mod:`pcabench.predict.stability`), the cost particles x steps x neighbours x the step's sweeps. ``pcabench advise``
-(pcabench/cli/advise.py) prints what :func:`suggest` finds as a ``pcabench study`` command.
+(pcabench/predict/advice.py) names what :func:`suggest` finds as a ``pcabench study`` command.
 """
 
 from __future__ import annotations

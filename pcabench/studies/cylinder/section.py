@@ -20,8 +20,8 @@ from pcabench.predict.stability import stable_cfl
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, stored_measure
-from pcabench.reports.tables import latest
 from pcabench.spec import scene_from_row
+from pcabench.store.rows import latest
 from pcabench.studies.cylinder.plan import CYLINDER, CYLINDER_T_END
 from solvers.method import Method
 from solvers.reference import dispersion

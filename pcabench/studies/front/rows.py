@@ -5,14 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcabench.reports.tables import (
-    comparable,
-    error_column,
-    is_paper_method,
-    label,
-    latest,
-    numerics_label,
-)
+from pcabench.reports.tables import label
+from pcabench.store.rows import comparable, error_column, is_paper_method, latest, numerics_label
 from solvers import DEFAULT_KERNEL, Scene
 from solvers.method import Method
 

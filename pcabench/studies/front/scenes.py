@@ -16,8 +16,8 @@ import numpy as np
 from pcabench.predict.stability import past_limit, stable_cfl
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section
-from pcabench.reports.tables import is_paper_method, latest, linear_floor, numerics_label
 from pcabench.spec import scene_from_row
+from pcabench.store.rows import is_paper_method, latest, linear_floor, numerics_label
 from pcabench.studies.front.figures import phase_direction, scene_fronts
 from solvers import DEFAULT_SCENE, Scene, scene_kind
 from solvers.method import Method

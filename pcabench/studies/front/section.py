@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section, limit_words
+from pcabench.store.rows import linear_floor
 from pcabench.studies.front.figures import speed_vs_accuracy
 from pcabench.studies.front.rows import fastest_to, predicted_by_model, predicted_error, speed_front, unstable_on_front
 from pcabench.studies.front.scenes import SECTION as SCENES  # every scene kind's fronts: the study's second section
@@ -109,7 +109,7 @@ def predicted_by_model_text(predicted) -> list[str]:
         "change in Ma of the operator, and no advection: it solves neither the linear nor the isothermal "
         "equations, so it parts from the prediction by several times. `lagrangian` moves its particles and "
         "converges to the isothermal solution instead, whose distance from the linear pulse "
-        f"({pct(T.linear_floor(Scene.default('name'), Scene.default('mach'), 10.0))} at t = 10 s) its error "
+        f"({pct(linear_floor(Scene.default('name'), Scene.default('mach'), 10.0))} at t = 10 s) its error "
         "against the pulse approaches; against the isothermal solution (last column) its "
         "error follows the predicted linear part closely: the prediction describes its discretisation "
         "error, the pulse's Mach number the rest.",
@@ -204,7 +204,7 @@ def text(data, ctx) -> list[str]:
         "converges to: the linear "
         "pulse for `linear`, the isothermal solution (solvers/reference/isothermal1d.py) for `lagrangian` (its error "
         "against the linear pulse never falls below the two equations' "
-        f"{pct(T.linear_floor(Scene.default('name'), Scene.default('mach'), 10.0))} difference at t = 10 s; "
+        f"{pct(linear_floor(Scene.default('name'), Scene.default('mach'), 10.0))} difference at t = 10 s; "
         "lagrangian runs from before this was measured are left out). `fixed` solves neither and is in the "
         "cost of the simplifications below. "
         + (

@@ -13,8 +13,8 @@ from pcabench.predict.stability import stable_cfl
 from pcabench.reports import figures as F
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
-from pcabench.reports.tables import latest
 from pcabench.spec import scene_from_row
+from pcabench.store.rows import latest
 from pcabench.studies.high_order.plan import HIGH_ORDER, HIGH_ORDER_T_END
 from solvers.method import Method
 from solvers.reference import dispersion

@@ -7,10 +7,11 @@ import numpy as np
 from pcabench.reports import tables as T
 from pcabench.reports.md import first_words, fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.store.rows import latest
 
 
 def rows(ctx):
-    return T.latest(ctx.df[ctx.df.status != "ok"])
+    return latest(ctx.df[ctx.df.status != "ok"])
 
 
 def text(bad, ctx) -> list[str]:

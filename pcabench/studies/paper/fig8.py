@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from pcabench.reports import paper as P
-from pcabench.reports import tables as T
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section
+from pcabench.store.rows import linear_floor
 from pcabench.studies.paper.figures import fig8
 from pcabench.studies.paper.rows import accuracy_bars, error_series, trend
 from solvers import Scene
@@ -20,7 +20,7 @@ def rows(ctx):
 
 def lagrangian_note(s) -> str:
     t = s["t_final"][0] if len(set(np.round(s["t_final"], 6))) == 1 else None
-    ref = T.linear_floor(Scene.default("name"), Scene.default("mach"), round(t, 6)) if t else None
+    ref = linear_floor(Scene.default("name"), Scene.default("mach"), round(t, 6)) if t else None
     return (
         f"it {trend(s)} ({', '.join(pct(e) for e in s['mse'])} for dx = "
         f"{', '.join(f'{d:g}' for d in s['dx'])}). The lagrangian model solves the isothermal (nonlinear) "

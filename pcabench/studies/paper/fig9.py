@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 from pcabench.reports import paper as P
-from pcabench.reports import tables as T
 from pcabench.reports.md import first_words, fmt, md_table
 from pcabench.reports.section import Section
 from pcabench.studies.paper.figures import fig9
-from pcabench.studies.paper.rows import fig9_rows, fig9_steps
+from pcabench.studies.paper.rows import FIG9_LOOP_NAMES, fig9_rows, fig9_steps
 
 
 def text(rows, ctx) -> list[str]:
@@ -18,7 +17,7 @@ def text(rows, ctx) -> list[str]:
     return [
         "## Fig. 9: all-pair against linked list (serial, float64, paper's scene)",
         "",
-        f"Linked list: {T.FIG9_LOOP_NAMES.get(rows[0]['linkedlist_loop'], rows[0]['linkedlist_loop'])}, "
+        f"Linked list: {FIG9_LOOP_NAMES.get(rows[0]['linkedlist_loop'], rows[0]['linkedlist_loop'])}, "
         "the loop measured beside the most all-pair runs, one loop throughout"
         + (
             "."

@@ -27,7 +27,7 @@ from pcabench.reports.figures import (
 )
 from pcabench.store.record import STEP_STAGES
 from pcabench.store.safeio import save_figure
-from pcabench.studies.paper.rows import cards_published, fig9_steps, trend
+from pcabench.studies.paper.rows import FIG9_LOOP_NAMES, cards_published, fig9_steps, trend
 from solvers import STAGES
 
 STAGE_COLOURS = {
@@ -148,7 +148,7 @@ def fig9(rows, out: Path, pid: str):
         return None
     rows = [r for r in rows if r["steps"] == steps and (r["allpair_ms"] or r["linkedlist_ms"])]
     path = out / "fig9_allpair_vs_linkedlist.png"
-    loop = T.FIG9_LOOP_NAMES.get(rows[0]["linkedlist_loop"], rows[0]["linkedlist_loop"])
+    loop = FIG9_LOOP_NAMES.get(rows[0]["linkedlist_loop"], rows[0]["linkedlist_loop"])
     pub = [r for r in P.step_times() if r["source"] == "Fig. 9 text"]
     with figure(
         path,

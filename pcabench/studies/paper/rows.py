@@ -7,19 +7,12 @@ import numpy as np
 
 from pcabench.machine import profiles
 from pcabench.reports import paper as P
-from pcabench.reports.tables import (
-    PROTOCOL,
-    default_numerics,
-    label,
-    latest,
-    newest_per,
-    paper_scene,
-    per_step_ms,
-    protocol,
-    where,
-)
+from pcabench.reports.tables import PROTOCOL, label, paper_scene, per_step_ms, protocol, where
 from pcabench.store.record import STEP_STAGES
+from pcabench.store.rows import default_numerics, latest, newest_per
 from solvers import STAGES
+
+FIG9_LOOP_NAMES = {"gather": "the paper's gather loop", "list": "the pair list"}  # by ``linkedlist_loop``
 
 
 def _paper_kind(r) -> bool:

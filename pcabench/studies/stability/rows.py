@@ -5,9 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcabench.reports.tables import (
-    latest,
-)
+from pcabench.store.rows import latest
 from solvers import DEFAULT_KERNEL, Scene
 from solvers.kernels import truncated
 

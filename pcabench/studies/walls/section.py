@@ -14,8 +14,8 @@ import numpy as np
 
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, stored_measure
-from pcabench.reports.tables import is_paper_method, latest
 from pcabench.spec import scene_from_row
+from pcabench.store.rows import is_paper_method, latest
 from pcabench.studies.front.scenes import T_FINAL
 from pcabench.studies.stability.plan import LONG_T_END
 from pcabench.studies.stability.rows import long_run_limits
