@@ -3,13 +3,17 @@ the studies' stages (pcabench/studies/<study>/gpu.py) compare their own scenes w
 
 from __future__ import annotations
 
+import itertools
 import sys
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from pcabench.execute.run import run
 from pcabench.gpu.plan import GPU_SOLVER, Plan
+from pcabench.gpu.stage import Check, Stage
+from pcabench.gpu.tables import scene_agreement
 from pcabench.spec import RunSpec
 from pcabench.store.safeio import fresh
 from solvers import DEFAULT_SOLVER, MODELS, PRECISIONS, Scene
@@ -64,11 +68,32 @@ def agrees(rows: list[dict]) -> bool:
 
 
 def compare_with_cpu(plan: Plan, out: Path) -> list[dict]:
-    """Max relative difference GPU vs CPU of the final u and drho, every model and precision."""
+    """Max relative difference GPU vs CPU of the final u and drho on the paper's scene, every precision and model."""
+    return compare_cases(
+        [{"dx": plan.compare_dx, **plan.scene}], plan.compare_steps, out, precision=PRECISIONS, model=MODELS
+    )
+
+
+def compare_cases(scenes, steps: int, out: Path, **axes) -> list[dict]:
+    """:func:`gpu_against_cpu` on each of ``scenes`` (Scene fields) run ``steps`` steps, for every combination of
+    ``axes`` (a Scene field -> its values, the last varying fastest): a study's cases on a card."""
+    names = list(axes)
     return [
-        gpu_against_cpu(
-            Scene(dx=plan.compare_dx, steps=plan.compare_steps, model=model, precision=precision, **plan.scene), out
-        )
-        for precision in PRECISIONS
-        for model in MODELS
+        gpu_against_cpu(Scene(**{**scene, "steps": steps, **dict(zip(names, values))}), out)
+        for scene in scenes
+        for values in itertools.product(*axes.values())
     ]
+
+
+def agreement_stage(name: str, title: str, order: float, rows: Callable[[Check], list[dict]], need_s=40.0) -> Stage:
+    """A study's stage that runs its cases on the GPU and the CPU (``rows(check)``: their rows), passes when every
+    row agrees (:func:`agrees`) and reports them as a table titled ``title``; its rows are ``results[name]``."""
+
+    def work(c: Check) -> bool:
+        c.state[name] = rows(c)
+        return agrees(c.state[name])
+
+    def report(results: dict) -> list[str]:
+        return scene_agreement(title, results[name]) if results.get(name) else []
+
+    return Stage(name, need_s, work, order=order, report=report)

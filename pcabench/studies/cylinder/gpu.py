@@ -7,11 +7,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pcabench.conformance import SCENES
-from pcabench.gpu.agreement import agrees, gpu_against_cpu
+from pcabench.gpu.agreement import agreement_stage, compare_cases
 from pcabench.gpu.plan import card_cases
-from pcabench.gpu.stage import Check, Stage
-from pcabench.gpu.tables import scene_agreement
-from solvers import Scene
 
 TITLE = "A rigid cylinder (ghost particles)"
 
@@ -35,25 +32,9 @@ def cases(rehearse: bool) -> Cases:
 
 def against_cpu(cases: Cases, steps: int, out: Path) -> list[dict]:
     """Each scene with a body ``steps`` steps on the GPU and the CPU, each boundary method, model and precision."""
-    return [
-        gpu_against_cpu(
-            Scene(**{**scene, "steps": steps, "boundary_method": method, "model": model, "precision": precision}),
-            out,
-        )
-        for scene in cases.scenes
-        for method in cases.methods
-        for model in cases.models
-        for precision in cases.precisions
-    ]
+    return compare_cases(
+        cases.scenes, steps, out, boundary_method=cases.methods, model=cases.models, precision=cases.precisions
+    )
 
 
-def check(c: Check) -> bool:
-    c.state["body"] = against_cpu(cases(c.rehearse), c.plan.compare_steps, c.out)
-    return agrees(c.state["body"])
-
-
-def report(results: dict) -> list[str]:
-    return scene_agreement(TITLE, results["body"]) if results.get("body") else []
-
-
-STAGE = Stage("body", 40, check, order=50, report=report)
+STAGE = agreement_stage("body", TITLE, 50, lambda c: against_cpu(cases(c.rehearse), c.plan.compare_steps, c.out))

@@ -8,10 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from pcabench.conformance import SCENES
-from pcabench.gpu.agreement import agrees, gpu_against_cpu
-from pcabench.gpu.stage import Check, Stage
-from pcabench.gpu.tables import scene_agreement
-from solvers import Scene
+from pcabench.gpu.agreement import agreement_stage, compare_cases
 
 TITLE = "High-order SPH (the gradient correction, Laguerre-Gauss, RK4; the weak wall)"
 
@@ -44,21 +41,7 @@ def cases(rehearse: bool) -> Cases:
 
 def against_cpu(cases: Cases, steps: int, out: Path) -> list[dict]:
     """Each corrected scene ``steps`` steps on the GPU and the CPU, each model and precision: their rows."""
-    return [
-        gpu_against_cpu(Scene(**{**scene, "steps": steps, "model": model, "precision": precision}), out)
-        for scene in cases.scenes
-        for model in cases.models
-        for precision in cases.precisions
-    ]
+    return compare_cases(cases.scenes, steps, out, model=cases.models, precision=cases.precisions)
 
 
-def check(c: Check) -> bool:
-    c.state["high-order"] = against_cpu(cases(c.rehearse), c.plan.compare_steps, c.out)
-    return agrees(c.state["high-order"])
-
-
-def report(results: dict) -> list[str]:
-    return scene_agreement(TITLE, results["high-order"]) if results.get("high-order") else []
-
-
-STAGE = Stage("high-order", 40, check, order=60, report=report)
+STAGE = agreement_stage("high-order", TITLE, 60, lambda c: against_cpu(cases(c.rehearse), c.plan.compare_steps, c.out))

@@ -11,7 +11,7 @@ import numpy as np
 
 from pcabench.conformance import SCENES
 from pcabench.execute.run import run
-from pcabench.gpu.agreement import agrees, gpu_against_cpu
+from pcabench.gpu.agreement import agrees, compare_cases
 from pcabench.gpu.plan import GPU_SOLVER, card_cases
 from pcabench.gpu.stage import Check, Stage
 from pcabench.gpu.tables import scene_agreement
@@ -45,11 +45,7 @@ def cases(rehearse: bool) -> Cases:
 def against_cpu(cases: Cases, steps: int, out: Path) -> list[dict]:
     """Each open scene ``steps`` steps on the GPU and the CPU, lagrangian (the layer's particles moving), both
     precisions: their rows."""
-    return [
-        gpu_against_cpu(Scene(**{**scene, "steps": steps, "model": "lagrangian", "precision": p}), out)
-        for scene in cases.scenes
-        for p in PRECISIONS
-    ]
+    return compare_cases(cases.scenes, steps, out, model=("lagrangian",), precision=PRECISIONS)
 
 
 def open_cost(cases: Cases) -> list[dict]:

@@ -7,11 +7,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from pcabench.conformance import SCENES
-from pcabench.gpu.agreement import agrees, gpu_against_cpu
+from pcabench.gpu.agreement import agreement_stage, compare_cases
 from pcabench.gpu.plan import card_cases
-from pcabench.gpu.stage import Check, Stage
-from pcabench.gpu.tables import scene_agreement
-from solvers import PRECISIONS, Scene
+from solvers import PRECISIONS
 
 TITLE = "Rigid walls (mirror particles)"
 
@@ -33,22 +31,8 @@ def cases(rehearse: bool) -> Cases:
 
 
 def against_cpu(cases: Cases, steps: int, out: Path) -> list[dict]:
-    """Each walled scene ``steps`` steps on the GPU and the CPU, each wall model and precision: their rows."""
-    return [
-        gpu_against_cpu(Scene(**{**walled, "steps": steps, "model": model, "precision": precision}), out)
-        for walled in cases.scenes
-        for precision in PRECISIONS
-        for model in cases.models
-    ]
+    """Each walled scene ``steps`` steps on the GPU and the CPU, each precision and wall model: their rows."""
+    return compare_cases(cases.scenes, steps, out, precision=PRECISIONS, model=cases.models)
 
 
-def check(c: Check) -> bool:
-    c.state["walls"] = against_cpu(cases(c.rehearse), c.plan.compare_steps, c.out)
-    return agrees(c.state["walls"])
-
-
-def report(results: dict) -> list[str]:
-    return scene_agreement(TITLE, results["walls"]) if results.get("walls") else []
-
-
-STAGE = Stage("walls", 40, check, order=20, report=report)
+STAGE = agreement_stage("walls", TITLE, 20, lambda c: against_cpu(cases(c.rehearse), c.plan.compare_steps, c.out))
