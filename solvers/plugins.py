@@ -120,7 +120,7 @@ class Registry:
     def _modules(self) -> list[str]:
         """The dotted names of the modules that hold the built-ins, in name order."""
         package = importlib.import_module(self.package)
-        if self.role is not None:
+        if self.role is not None:  # a folder without __init__.py is no package: tests/test_imports.py finds none
             subs = sorted({i.name for i in pkgutil.iter_modules(package.__path__) if i.ispkg and i.name[0] != "_"})
             return [
                 f"{self.package}.{sub}.{self.role}"
@@ -179,7 +179,11 @@ class Registry:
     def all(self) -> dict[str, Any]:
         """{name: entry}: the built-ins (in their order), then plug-ins', then those registered here."""
         if self._found is None:
-            builtin = {e.name: e for e in self._builtin()}
+            found = self._builtin()
+            builtin = {e.name: e for e in found}
+            if len(builtin) < len(found):  # two built-ins of one name: a mistake in the house, never a choice
+                twice = sorted({e.name for e in found if sum(f.name == e.name for f in found) > 1})
+                raise ValueError(f"two built-in {self.what}s share the name {', '.join(map(repr, twice))}")
             self._found = {**builtin, **{e.name: e for e in self._plugins(set(builtin))}}
         return {**self._found, **self._added}
 

@@ -2,7 +2,7 @@
 
 The quick study's figures are drawn from records made from the quick preset's own run specs (the
 times and errors synthetic, the runs exactly those `study --quick` makes), so that the report of a
-quick study holds every section of the report's section registry (pcabench/reports/sections/,
+quick study holds every section of the report's section registry (each study's section.py,
 ``SECTIONS``) with every figure that section declares, each passing the checks: the list of sections
 and figures is the registry's, never one kept here. The committed reference's figures pass them too.
 """

@@ -250,3 +250,84 @@ def test_the_gpu_checks_body_stage_compares_the_cylinder_with_each_boundary_meth
                                                                   "max_rel_diff_drho": 1e-7}]},
     )  # fmt: skip
     assert "## A rigid cylinder" in text and "| cylinder (rings) | 1,376 | float32 | lagrangian | 0.125 | 3 |" in text
+
+
+def _study_folder(tmp_path, name: str, files: dict):
+    """A study folder ``name`` with ``files`` ({file name: text}) on the studies' path: undo with the returned
+    function (which also forgets its modules and the registries' finds)."""
+    import importlib
+    import sys
+
+    import pcabench.studies
+    from pcabench.gpu.stage import STAGES
+    from pcabench.studies import PRESETS
+
+    root = tmp_path / f"house-{name}"
+    (root / name).mkdir(parents=True)
+    for file, text in {"__init__.py": '"""A test\'s study."""\n', **files}.items():
+        (root / name / file).write_text(text)
+    pcabench.studies.__path__.append(str(root))
+    importlib.invalidate_caches()
+    STAGES.cache_clear()
+    PRESETS.cache_clear()
+
+    def undo():
+        pcabench.studies.__path__.remove(str(root))
+        for module in [m for m in sys.modules if m.startswith(f"pcabench.studies.{name}")]:
+            del sys.modules[module]
+        STAGES.cache_clear()
+        PRESETS.cache_clear()
+
+    return undo
+
+
+def test_a_study_gpu_stage_that_does_not_load_or_takes_a_taken_name_is_one_failed_stage(tmp_path):
+    """The GPU check still runs every other stage (a lent machine's minutes are not lost to one study's typo)."""
+    from pcabench.gpu import check as G
+
+    undo = _study_folder(tmp_path, "broken_gpu", {"gpu.py": "import a_module_that_is_not_there\n"})
+    try:
+        names = [s.name for s in G.stages()]
+        assert "studies" in names and {"profile", "compare", "sweep", "ncu"} <= set(names)
+        (failed,) = [s for s in G.stages() if s.name == "studies"]
+        with pytest.raises(RuntimeError, match="a_module_that_is_not_there"):
+            failed.work(None)
+    finally:
+        undo()
+    clash = "from pcabench.gpu.stage import Stage\nSTAGE = Stage('sweep', 0, lambda c: True, order=5)\n"
+    undo = _study_folder(tmp_path, "clashing_gpu", {"gpu.py": clash})
+    try:
+        (failed,) = [s for s in G.stages() if s.name == "studies"]
+        with pytest.raises(RuntimeError, match="the check's own name sweep"):
+            failed.work(None)
+        assert [s.name for s in G.stages()].count("sweep") == 1
+    finally:
+        undo()
+    assert "studies" not in [s.name for s in G.stages()]
+
+
+def test_two_built_in_studies_of_one_preset_name_are_refused(tmp_path):
+    from pcabench.studies import PRESETS
+
+    plan = "from pcabench.studies.preset import Preset\nP = Preset('quick', lambda: [], 1.0, flag='again')\n"
+    undo = _study_folder(tmp_path, "again", {"plan.py": plan})
+    try:
+        with pytest.raises(ValueError, match="two built-in presets share the name 'quick'"):
+            PRESETS.all()
+    finally:
+        undo()
+    assert "quick" in PRESETS
+
+
+def test_listing_the_gpu_stages_imports_no_gpu_library():
+    """A study's gpu.py is imported to list the check's stages on any machine (and by CI's rehearsal): it must
+    not import CuPy or numba's CUDA at its top."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from pcabench.gpu.check import stages; stages(); "
+        "print([m for m in ('cupy', 'numba.cuda', 'numba_cuda') if m in sys.modules])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]", out

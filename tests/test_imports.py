@@ -235,3 +235,12 @@ def test_a_study_is_one_folder_in_two_layers():
     assert {"paper", "front", "walls", "cylinder", "high_order"} <= studies
     for study in studies:
         assert f"pcabench.studies.{study}.plan" in MODULES or f"pcabench.studies.{study}.section" in MODULES, study
+        # its face is its docstring: importing its plan runs it, so a face that imported its sections would put
+        # the report under the plan's layer, which the graph (module to module) would not show
+        assert GRAPH[f"pcabench.studies.{study}"] == [], study
+
+
+def test_every_study_folder_is_a_package():
+    """The registries find a study's files through its package: a folder without ``__init__.py`` is skipped."""
+    folders = {p.parent for p in (ROOT / "pcabench" / "studies").rglob("*.py")}
+    assert [f for f in folders if not (f / "__init__.py").is_file()] == []

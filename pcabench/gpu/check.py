@@ -203,8 +203,23 @@ OWN = (
 
 
 def stages() -> list[Stage]:
-    """Every stage the check runs, in order: its own and each study's (read at each check)."""
-    return sorted((*OWN, *STAGES.all().values()), key=lambda s: (s.order, s.name))
+    """Every stage the check runs, in order: its own and each study's (read at each check). A study's gpu.py
+    that does not load, or a study's stage named like one of the check's own, is one failed stage: the check
+    still runs every other stage and brings back what it has."""
+    own = {s.name for s in OWN}
+    try:
+        studies = list(STAGES.all().values())
+        clash = sorted(own & {s.name for s in studies})
+        if clash:
+            raise ValueError(f"a study's GPU stage takes the check's own name {', '.join(clash)}")
+    except Exception as exc:  # noqa: BLE001 - reported as a failed stage, never the check's end
+        why = f"the studies' GPU stages (pcabench/studies/*/gpu.py): {type(exc).__name__}: {exc}"
+
+        def failed(c):
+            raise RuntimeError(why)
+
+        studies = [Stage("studies", 0, failed, order=15)]
+    return sorted((*OWN, *studies), key=lambda s: (s.order, s.name))
 
 
 def run_stage(stage: Stage, c: Check) -> None:

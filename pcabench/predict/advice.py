@@ -94,7 +94,7 @@ def advise(
 ) -> dict:
     """The fastest stored run of ``scene`` reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``,
     if given) within the margin of its stable CFL, the fastest run of the paper's configuration reaching it that
-    compares with it, and the ratio. Like is compared with like (``tables.comparable``): the same kind of domain (a
+    compares with it, and the ratio. Like is compared with like (``store.rows.comparable``): the same kind of domain (a
     strip holds fewer particles than the full domain; on a strip each method runs on the thinnest strip its
     support allows), the same threads and the same commit. A run past the margin of its method's stable CFL
     (pcabench/predict/stability.py ``MARGIN``, the one rule: at or past the limit it is unstable by prediction) is

@@ -133,7 +133,9 @@ def stable_cfl(r) -> float:
     """The largest stable CFL of ``r``'s method on its scene and model, ``r`` a stored run, a front point or a
     :class:`~solvers.Scene`: the periodic lattice's prediction (0: its integrator grows at any step), or the limit
     long runs of its scene and model measured where that is lower (:func:`measured_limits`). Every stable CFL the
-    suite states or steps by (advise, the fronts, the reports, the presets' CFLs) is this one. Open edges keep
+    suite states or steps by is this one (advise, the fronts, the reports, the cylinder's advised CFL), but for
+    a plan that brackets the periodic lattice's own limit on purpose (the walls study's long runs:
+    solvers.reference.dispersion.stable_cfl). Open edges keep
     it: their damping is a term of each update (solvers/absorbers/base.py; measured with `pcabench study --open`
     and the cylinder's long runs, docs/accuracy.md "Open edges")."""
     from solvers import Scene

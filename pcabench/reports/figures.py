@@ -1,7 +1,8 @@
-"""The report's PNG figures, each drawn from the rows of its section (``tables.py``), never from the store.
+"""The figure toolkit: what every study's figures (pcabench/studies/<study>/figures.py) are drawn with, each
+figure from the rows of its section, never from the store.
 
-Each function draws one figure into ``out`` and returns its path, or None
-when the rows hold nothing for it. One variable per visual channel, and a title
+A study's figure function draws one figure into ``out`` and returns its path,
+or None when the rows hold nothing for it. One variable per visual channel, and a title
 names a channel only where it varies (:func:`channels`): colour for the
 configuration or card, marker for precision, line style for the domain, facets
 for the protocol. The paper's numbers (:mod:`.paper`) are drawn in one style,

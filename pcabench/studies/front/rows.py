@@ -20,7 +20,7 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
     Every method counts (kernel, h/dx, cutoff, CFL, dx, precision). A run's
     ``error`` is against what its model converges to: the linear pulse for
     `linear`, the isothermal solution for `lagrangian` (its error against the
-    linear pulse never falls below the two equations' difference, :func:`linear_floor`; rows
+    linear pulse never falls below the two equations' difference, :func:`pcabench.store.rows.linear_floor`; rows
     from before that was measured are left out). The front of a model at a
     time holds the runs no faster run of that model beats in error, among the runs below their method's
     predicted stable CFL (``past_limit``: at or past it, a run is unstable by prediction whatever its error,

@@ -47,7 +47,7 @@ PAPER_MARKERS = {"paper-system-1": "^", "paper-system-2": "v", "paper-system-3":
 
 
 def _published(ax, rows, marker, label, **style):
-    """The paper's rows (from :mod:`.paper`) as one published series: grey, dashed, hollow."""
+    """The paper's rows (from :mod:`pcabench.reports.paper`) as one published series: grey, dashed, hollow."""
     pts = sorted((r["N"], r["ms"]) for r in rows)
     ax.plot(*zip(*pts), marker=marker, **{**PUBLISHED, **style}, label=label)
 

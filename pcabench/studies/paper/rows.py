@@ -532,7 +532,7 @@ def _ratio(x, y):
 
 def cards_published() -> list[dict]:
     """The paper's cards, one step (ms) by N, one source per card: the K20c's Table 4 (measured per step),
-    the other two cards' Table 6 (:mod:`.paper` states the conversion)."""
+    the other two cards' Table 6 (:mod:`pcabench.reports.paper` states the conversion)."""
     return [
         r
         for r in P.step_times()

@@ -24,7 +24,7 @@ CLASS_STYLE = {
 
 
 def stability_map(points, limits, out: Path, pid: str, inaccurate_above: float):
-    """Each method's runs by CFL, in the classes of the section's table (``tables.stability``), and the
+    """Each method's runs by CFL, in the classes of the section's table (``stability/rows.py``'s ``stability``), and the
     predicted stable CFL of each row as a black bar; a tick at every CFL swept."""
     if not points:
         return None

@@ -3,7 +3,7 @@ its prediction, the stable CFL at the wall over long runs beside the free scenes
 and without the wall at the same N.
 
 Wall scenes are the scene kinds with ``walls`` (solvers/scenes/); each has a free counterpart (the same pulse
-without the wall: ``presets.FREE_COUNTERPART``) whose long runs and step times it is compared with.
+without the wall: ``FREE_COUNTERPART``, walls/plan.py) whose long runs and step times it is compared with.
 """
 
 from __future__ import annotations
