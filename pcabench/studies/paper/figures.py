@@ -263,14 +263,7 @@ def fig10(series, out: Path, pid: str):
                     label=f"{s['config']}, {s['loop']}, {T.where(s['threads'], s['device'])}",
                 )
             ax.set_title(f"runs to t = {run[4:]}" if run.startswith("t =") else f"runs of {run}", fontsize=9)
-            sizes = [n for s in series if s["run"] == run for n in s["N"]]
-            if max(sizes) / min(sizes) < 100:  # under two decades: ticks at the sizes run, never 2x10^5
-                plain_log_ticks(ax, sizes, axis="x", spread=3.0)
-                ax.xaxis.set_minor_locator(NullLocator())
-            ax.xaxis.set_major_formatter(particle_count)  # every panel writes N alike: 1K, 25K, 1M
-            if run != paper_panel:
-                continue
-            if ("cpu", "linked list") in kinds:
+            if run == paper_panel and ("cpu", "linked list") in kinds:
                 cpu = [
                     r
                     for r in P.step_times()
@@ -286,9 +279,15 @@ def fig10(series, out: Path, pid: str):
                         f"{pts[0]['conversion']} (published)",
                         ls="--" if len(pts) > 1 else "none",
                     )
-            if ("gpu", "linked list") in kinds:
+            if run == paper_panel and ("gpu", "linked list") in kinds:
                 pts = [r for r in P.step_times() if r["device"] == "gpu" and r["source"] == "Table 4"]
                 _published(ax, pts, "^", f"paper GPU, {pts[0]['processor']}, Table 4: one step (published)")
+            # ticks at every N drawn on the panel (the paper's points too, which run past a small study's)
+            sizes = [float(n) for line in ax.get_lines() for n in line.get_xdata()]
+            if max(sizes) / min(sizes) < 100:  # under two decades: ticks at the sizes drawn, never 2x10^5
+                plain_log_ticks(ax, sizes, axis="x", spread=3.0)
+                ax.xaxis.set_minor_locator(NullLocator())
+            ax.xaxis.set_major_formatter(particle_count)  # every panel writes N alike: 1K, 25K, 1M
         if spare:
             handles = {}
             for ax in axes[: len(runs)]:
