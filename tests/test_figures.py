@@ -19,10 +19,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pytest  # noqa: E402
 
 from pcabench import paths, store, studies  # noqa: E402
-from pcabench.reports import (
-    build,  # noqa: E402
-    write_reports,  # noqa: E402
-)
+from pcabench.reports import build  # noqa: E402
+from pcabench.reports.build import write_reports  # noqa: E402
 from pcabench.reports.section import Section, in_order  # noqa: E402
 from pcabench.store.record import RunRecord  # noqa: E402
 

@@ -86,7 +86,15 @@ def _imports(module: str):
                     yield node.lineno, target, (alias.name,) if private else ()
 
 
-GRAPH = {m: sorted({t for _, t, _ in _imports(m) if t != m}) for m in MODULES}
+def _faces(module: str, target: str) -> list[str]:
+    """The package faces importing ``target`` runs (``pcabench.reports`` for ``pcabench.reports.paper``), but for
+    ``module``'s own packages, which ran before it: an import of a submodule is an import of its packages too."""
+    parts = target.split(".")
+    above = [".".join(parts[:i]) for i in range(1, len(parts))]
+    return [a for a in above if a in MODULES and not (module == a or module.startswith(a + "."))]
+
+
+GRAPH = {m: sorted({u for _, t, _ in _imports(m) if t != m for u in (t, *_faces(m, t)) if u != m}) for m in MODULES}
 
 
 def _circles(graph) -> list[list[str]]:
@@ -124,7 +132,23 @@ def test_the_graph_is_read():
     """The walk sees the imports it must: inside functions, relative, and through a package's face."""
     assert "solvers.scene" in GRAPH["pcabench.studies.preset"]  # `from solvers import Scene`, through the face
     assert "pcabench.studies.preset" in GRAPH["pcabench.cli.study"]  # imported inside a function
+    # `from pcabench.reports import paper` runs the face pcabench.reports first: an edge to it too
+    assert {"pcabench.reports.paper", "pcabench.reports"} <= set(GRAPH["pcabench.studies.paper.rows"])
     assert len(GRAPH) > 50 and sum(map(len, GRAPH.values())) > 150
+
+
+def test_a_circle_through_a_package_face_is_found():
+    """A face that imports its build closes a circle with a module the build imports that imports the face's
+    toolkit (what pcabench/reports/__init__.py did: a study -> pcabench.reports -> build -> the study)."""
+    graph = {"pkg": ["pkg.build"], "pkg.build": ["study"], "study": ["pkg.tool", *_faces_of("study", "pkg.tool")]}
+    graph["pkg.tool"] = []
+    assert _circles(graph) == [["pkg", "pkg.build", "study"]]
+
+
+def _faces_of(module: str, target: str) -> list[str]:
+    """:func:`_faces` over a toy house of the packages named in ``target``."""
+    parts = target.split(".")
+    return [".".join(parts[:i]) for i in range(1, len(parts)) if not module.startswith(".".join(parts[:i]))]
 
 
 def test_a_circle_is_found():
@@ -177,10 +201,11 @@ LAYERS = (
     ("pcabench.predict",),  # wall time, stability and the fastest methods, predicted
     ("pcabench.execute",),  # the stage clock, a run, its child, the sweep
     # what every solver must do; what a preset is, and each study's plan (pcabench/studies/<study>/plan.py)
-    ("pcabench.conformance", "pcabench.studies", "pcabench.studies.preset", "pcabench.studies.*.plan"),
+    # (a study's face, ``pcabench.studies.<study>``, runs before its plan: it sits with it, importing nothing)
+    ("pcabench.conformance", "pcabench.studies", "pcabench.studies.*", "pcabench.studies.*.plan"),
     # the report's frame, tables and figure toolkit; each study's sections and what they draw (every other module
     # of a study's folder)
-    ("pcabench.reports", "pcabench.studies.*"),
+    ("pcabench.reports", "pcabench.studies.*.*"),
     ("pcabench.bench",),  # asv
     ("pcabench.gpu", "pcabench.studies.*.gpu"),  # the GPU check, and each study's stage of it
     ("pcabench.cli", "pcabench.console"),  # the command line, and the console script that imports it
@@ -229,7 +254,7 @@ def test_a_study_is_one_folder_in_two_layers():
     plan, report = layer_of("pcabench.studies.walls.plan"), layer_of("pcabench.reports.build")
     assert plan == layer_of("pcabench.studies.preset") == layer_of("pcabench.studies") < report
     assert layer_of("pcabench.studies.walls.section") == layer_of("pcabench.studies.paper.table4") == report
-    assert layer_of("pcabench.studies.walls") == report  # a study's face: its docstring, above nothing
+    assert layer_of("pcabench.studies.walls") == plan  # a study's face: its docstring, run before its plan
     assert layer_of("pcabench.studies.walls.gpu") == layer_of("pcabench.gpu.check") > report  # its GPU stage
     studies = {m.split(".")[2] for m in MODULES if m.startswith("pcabench.studies.") and m.count(".") >= 3}
     assert {"paper", "front", "walls", "cylinder", "high_order"} <= studies

@@ -15,7 +15,7 @@ from benchmarks.common import gpu_available
 from pcabench import cli, store
 from pcabench.execute.sweep import run_child
 from pcabench.machine import profiles
-from pcabench.reports import write_reports
+from pcabench.reports.build import write_reports
 from pcabench.reports.frame import load as load_frame
 from pcabench.spec import RunSpec
 from pcabench.store.provenance import git_commit

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from pcabench import store
-from pcabench.reports import write_reports
+from pcabench.reports.build import write_reports
 from pcabench.reports.section import SECTIONS, Section
 from pcabench.studies.paper.rows import fig9_rows
 from pcabench.studies.stability import long_runs as long_runs_section

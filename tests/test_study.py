@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from pcabench import store
-from pcabench.reports import frame, write_reports
+from pcabench.reports import frame
+from pcabench.reports.build import write_reports
 from pcabench.store.record import RunRecord
 from pcabench.studies.front.rows import speed_front
 from pcabench.studies.paper.rows import (

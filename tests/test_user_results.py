@@ -41,7 +41,7 @@ def test_two_hosts_of_one_profile_get_two_stores_and_two_reports(tmp_path):
             r.host = host
             r.run_id = f"{host}-{r.run_id}"
             store.append(r, results / store.store_name(r.profile_id, host))
-    from pcabench.reports import write_reports
+    from pcabench.reports.build import write_reports
 
     write_reports(results, tmp_path / "out")
     assert (tmp_path / "out" / "machine-a--h1" / "report.md").exists()
@@ -55,7 +55,7 @@ def reports(tmp_path):
     results = tmp_path / "results"
     for r in fixture_rows():
         store.append(r, results / f"{r.profile_id}.jsonl")
-    from pcabench.reports import write_reports
+    from pcabench.reports.build import write_reports
 
     write_reports(results, tmp_path / "out")
     return tmp_path / "out"

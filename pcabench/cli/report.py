@@ -23,7 +23,7 @@ def report_progress(line: str) -> None:
 
 
 def cmd_report(args) -> int:
-    from pcabench.reports import write_reports
+    from pcabench.reports.build import write_reports
 
     results, reports = args.results, args.out
     if args.reference:

@@ -272,7 +272,7 @@ def gpu_check(
         config.reload_config()  # and this one: numba read its settings when the solver registry imported it
     plan = plan or (REHEARSAL if rehearse else FULL)
     from pcabench.machine import profiles
-    from pcabench.reports import write_reports
+    from pcabench.reports.build import write_reports
     from pcabench.store.provenance import git_commit
 
     budget = Budget(budget_s)
