@@ -20,7 +20,7 @@ from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel
 from solvers.absorbers import absorber_named, absorber_names
 from solvers.bodies import DEFAULT_BOUNDARY_METHOD, boundary_method_names
 from solvers.corrections import correction_named, correction_names
-from solvers.scene import OPEN_EDGES
+from solvers.edges import OPEN_EDGES
 
 
 @dataclass(frozen=True)

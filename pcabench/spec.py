@@ -152,8 +152,7 @@ class RunSpec:
 
 def scene_parameters(scene: Scene) -> dict:
     """The scene's own parameters (no derived quantities, no machine limit), as stored."""
-    fields = Scene.__dataclass_fields__
-    return {k: getattr(scene, k) for k in fields if fields[k].compare}
+    return scene.parameters()
 
 
 def stored_parameters(scene: dict) -> dict:
@@ -161,8 +160,7 @@ def stored_parameters(scene: dict) -> dict:
     its default: the value runs had before the parameter existed (rows without ``kernel`` are Gaussian), and an
     open row's default layer the one it ran with (LAYER_WIDTHS_BEFORE, where the row does not state its layer).
     The one place old rows are brought up to the current fields (the frame, the resume key, scene_from_row)."""
-    fields = Scene.__dataclass_fields__
-    out = {k: fields[k].default if scene.get(k) is None else scene[k] for k in fields if fields[k].compare}
+    out = {k: Scene.keyword_default(k) if scene.get(k) is None else scene[k] for k in Scene.PARAMETERS}
     ran = _layer_ran(scene, out)
     try:
         kind = scene_kind(out["name"])

@@ -2,9 +2,9 @@
 
 A :class:`Method` is what a Scene's numerics are (``Scene.method``) and what a stored row's are
 (:meth:`Method.of`): the one answer to "which method is this" (its :attr:`~Method.label`) and "is this the
-paper's" (:meth:`~Method.is_paper`). Its defaults are Scene's (``Scene.default``: one place per fact); the
-Gaussian-only rule lives here: a kernel of compact support (the Wendland kernels) is cut at its support, so
-its ``cutoff_factor`` is no part of its method.
+paper's" (:meth:`~Method.is_paper`). Its defaults are the paper's method (:data:`PAPER`, which Scene's defaults
+read: one place per fact); the Gaussian-only rule lives here: a kernel of compact support (the Wendland kernels)
+is cut at its support, so its ``cutoff_factor`` is no part of its method (None).
 """
 
 from __future__ import annotations
@@ -12,7 +12,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-FIELDS = ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator", "correction")  # Scene's fields a Method holds
+from solvers.corrections import DEFAULT_CORRECTION
+from solvers.kernels import DEFAULT_KERNEL
+
+FIELDS = ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator", "correction")  # Scene's parameters it holds
+# The paper's method, every Scene's default: a Gaussian at h = 2.13 dx cut at 3h, dt = 0.2 dx / c0, Verlet.
+PAPER = {
+    "kernel": DEFAULT_KERNEL,
+    "h_factor": 2.13,
+    "cutoff_factor": 3.0,
+    "cfl": 0.2,
+    "integrator": "verlet",
+    "correction": DEFAULT_CORRECTION,
+}
 
 
 def _close(a: float, b: float) -> bool:
@@ -34,14 +46,16 @@ class Method:
     @classmethod
     def of(cls, values) -> "Method":
         """The method of a Scene or of a stored row (a dict, a DataFrame row: the fields of :data:`FIELDS`; one a
-        row predates at Scene's default)."""
+        row predates at the paper's, :data:`PAPER`)."""
         from solvers.kernels import truncated
-        from solvers.scene import Scene
+
+        if isinstance(getattr(values, "method", None), cls):  # a Scene: its own
+            return values.method
 
         def get(name):
             value = getattr(values, name, None) if not hasattr(values, "get") else values.get(name)
             if value is None or isinstance(value, float) and math.isnan(value):
-                return Scene.default(name)
+                return PAPER[name]
             return value
 
         kernel = str(get("kernel"))
@@ -56,10 +70,9 @@ class Method:
 
     @classmethod
     def paper(cls) -> "Method":
-        """The paper's method: Scene's defaults (the Gaussian at h = 2.13 dx, cut at 3h, CFL 0.2, Verlet)."""
-        from solvers.scene import Scene
-
-        return cls.of({name: Scene.default(name) for name in FIELDS})
+        """The paper's method, every Scene's default (:data:`PAPER`: the Gaussian at h = 2.13 dx, cut at 3h,
+        CFL 0.2, Verlet)."""
+        return cls.of(PAPER)
 
     def is_paper(self) -> bool:
         """Whether this is the paper's method (floats compared as stored floats are)."""
@@ -82,12 +95,10 @@ class Method:
         return self._words(with_step=False)
 
     def _words(self, with_step: bool) -> str:
-        from solvers.scene import Scene
-
         cut = f", {self.cutoff_factor:g}h" if self.cutoff_factor is not None else ""
         cfl = f", CFL {self.cfl:g}" if with_step else ""
-        step = f", {self.integrator}" if self.integrator != Scene.default("integrator") else ""
-        corrected = f", {self.correction}-corrected" if self.correction != Scene.default("correction") else ""
+        step = f", {self.integrator}" if self.integrator != PAPER["integrator"] else ""
+        corrected = f", {self.correction}-corrected" if self.correction != PAPER["correction"] else ""
         return f"{self.kernel}, h {self.h_factor:g}dx{cut}{cfl}{step}{corrected}"
 
     @property
@@ -99,14 +110,6 @@ class Method:
         name = self.kernel[:1].upper() + self.kernel[1:]
         step = self.integrator[:1].upper() + self.integrator[1:] if self.integrator == "verlet" else self.integrator
         return f"{name}, h = {self.h_factor:g} dx{cut}, CFL {self.cfl:g}, {step}{corrected}"
-
-    def stable_cfl(self) -> float:
-        """The largest stable CFL of this method's kernel, h/dx, truncation and integrator (the dispersion
-        relation's, solvers/reference/dispersion.py; the same at every dx, so dx = 1 stands for all; 0 where the
-        integrator grows at any step)."""
-        from solvers.reference.dispersion import stable_cfl
-
-        return stable_cfl(self)
 
     def scene_fields(self) -> dict:
         """The Scene fields this method sets (a compact kernel's ``cutoff_factor`` left at its default)."""

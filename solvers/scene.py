@@ -19,10 +19,14 @@ pcabench/machine/memory.py, before any work).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
+from typing import ClassVar
 
 from solvers.corrections import DEFAULT_CORRECTION, Correction, correction_named
-from solvers.kernels import DEFAULT_KERNEL, Kernel, kernel_named
+from solvers.edges import Edges
+from solvers.kernels import Kernel, kernel_named
+from solvers.method import FIELDS as METHOD_FIELDS
+from solvers.method import Method
 from solvers.scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
@@ -48,13 +52,13 @@ MIN_CFL = 1e-3  # the smallest cfl: 1e7 steps of it cross 1e4 cells, a step smal
 # Scene parameters that choose the numerical method rather than the physics.
 # The domain: the scene kind's default (solvers/scenes/) where not given.
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
-OPEN_EDGES = ("", "x", "y", "xy")  # Scene.open: none, the x edges, the y edges, all four
 PAPER_DOMAIN = {"x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
 # Parameters whose default is the scene kind's where it states one (SceneKind.defaults), else these (the paper's;
 # a body's radius only where the kind has a body).
 PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
 PER_KIND = ("pulse_width", "pulse_center", "cylinder_radius")
-LAYER_UNSET = {"absorber": "", "layer_width": None, "absorber_strength": None}  # a closed scene's layer options
+LAYER_UNSET = Edges.layer_unset()  # a closed scene's layer options
+DEFAULT_METHOD = Method.paper()  # Scene's method unless given (solvers/method.py: the paper's)
 
 
 class SceneError(ValueError):
@@ -68,7 +72,7 @@ def bytes_per_particle(precision: str, extra: int = 0) -> int:
     return (FLOAT_ARRAYS_PER_PARTICLE + extra) * item + INT_ARRAYS_PER_PARTICLE * 8
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class Scene:
     """One simulation, fully specified. Lengths in m, times in s, density in kg/m^3."""
 
@@ -87,23 +91,104 @@ class Scene:
     cylinder_radius: float | None = None  # a rigid cylinder's radius, m (a scene kind with a body); None: the kind's
     boundary_method: str = ""  # how a body's curved wall is modelled (solvers/bodies/); "": the default
     probes: tuple = ()  # points ((x, y), ...) m where a run records drho every few steps, beside the kind's own
-    open: str = ""  # the edges that are open ("x": both x edges), by an absorbing layer beyond the domain;
-    # "": the kind's (closed, but an open problem's: the cylinder's four edges)
-    layer_width: float | None = None  # the layer's width, m (whole rows of dx); None: the absorber's default
-    absorber: str = ""  # what damps the layer (solvers/absorbers/); "": the scene's (see absorber_used)
-    absorber_strength: float | None = None  # its strength, 1/s; None: the absorber's default for the scene
-    h_factor: float = 2.13  # h = h_factor * dx
-    cutoff_factor: float = 3.0  # cutoff = cutoff_factor * h (a truncated kernel's, the Gaussian; else the default)
-    kernel: str = DEFAULT_KERNEL  # a registered kernel's name (solvers/kernels/)
-    correction: str = DEFAULT_CORRECTION  # a registered kernel correction's name (solvers/corrections/)
-    cfl: float = 0.2  # dt = cfl * dx / c0 (lowered slightly to land on t_end)
+    edges: Edges = Edges()  # the open edges and their layer (solvers/edges.py); open "": the kind's
+    method: Method = DEFAULT_METHOD  # kernel, h/dx, truncation, CFL, integrator, correction (solvers/method.py)
     model: str = "lagrangian"
-    integrator: str = "verlet"
     precision: str = "float64"
     steps: int | None = None
     t_end: float | None = None
     blowup_factor: float = 4.0  # unstable once max|u| > blowup_factor * mach * c0
     memory_limit_bytes: int | None = field(default=None, compare=False)
+
+    # The scene's parameters, flat: its keywords, its record's columns and its options (pcabench/parameters.py),
+    # in this order; the method's and the edges' are read through from those values.
+    PARAMETERS: ClassVar[tuple] = (
+        "dx", "name", "x_min", "x_max", "y_min", "y_max", "strip_height", "rho0", "c0", "mach", "pulse_width",
+        "pulse_center", "cylinder_radius", "boundary_method", "probes", "open", "layer_width", "absorber",
+        "absorber_strength", "h_factor", "cutoff_factor", "kernel", "correction", "cfl", "model", "integrator",
+        "precision", "steps", "t_end", "blowup_factor",
+    )  # fmt: skip
+
+    def __init__(self, dx: float, name: str = DEFAULT_SCENE, *, method=None, edges=None, **given) -> None:
+        """A scene of lattice spacing ``dx`` (m) of the scene kind ``name``: every other parameter a keyword of
+        :data:`PARAMETERS`. ``method`` and ``edges`` give those values whole; a flat keyword (``kernel=``,
+        ``open=``) refines the value it belongs to."""
+        unknown = sorted(set(given) - set(self.PARAMETERS) - {"memory_limit_bytes"})
+        if unknown:
+            raise TypeError(f"Scene() got an unexpected keyword argument {unknown[0]!r}")
+        method = DEFAULT_METHOD if method is None else method
+        edges = Edges() if edges is None else edges
+        numerics = {k: given.pop(k) if k in given else getattr(method, k) for k in METHOD_FIELDS}
+        if numerics["cutoff_factor"] is None:  # a compact kernel's method: its cut is its support
+            numerics["cutoff_factor"] = DEFAULT_METHOD.cutoff_factor
+        try:
+            compact = kernel_named(numerics["kernel"]).support is not None
+        except (ValueError, TypeError):  # an unknown kernel: named by _validate
+            compact = False
+        if compact and numerics["cutoff_factor"] == DEFAULT_METHOD.cutoff_factor:
+            numerics["cutoff_factor"] = None  # no part of a compact kernel's method (another cut: refused below)
+        object.__setattr__(self, "method", Method(**numerics))
+        object.__setattr__(
+            self, "edges", Edges(**{k: given.pop(k) if k in given else getattr(edges, k) for k in Edges.names()})
+        )
+        object.__setattr__(self, "dx", dx)
+        object.__setattr__(self, "name", name)
+        for f in fields(self):
+            if f.name not in ("dx", "name", "method", "edges"):
+                object.__setattr__(self, f.name, given.pop(f.name, f.default))
+        self.__post_init__()
+
+    # ------------------------------------------------------------ the method's and the edges' parameters
+    @property
+    def kernel(self) -> str:
+        """A registered kernel's name (solvers/kernels/)."""
+        return self.method.kernel
+
+    @property
+    def h_factor(self) -> float:
+        """h / dx."""
+        return self.method.h_factor
+
+    @property
+    def cutoff_factor(self) -> float:
+        """cutoff / h of a truncated kernel (the Gaussian); a compact kernel's is the default, no part of it."""
+        cut = self.method.cutoff_factor
+        return DEFAULT_METHOD.cutoff_factor if cut is None else cut
+
+    @property
+    def cfl(self) -> float:
+        """dt c0 / dx (dt lowered slightly to land on t_end)."""
+        return self.method.cfl
+
+    @property
+    def integrator(self) -> str:
+        """The time integrator (INTEGRATORS)."""
+        return self.method.integrator
+
+    @property
+    def correction(self) -> str:
+        """A registered kernel correction's name (solvers/corrections/)."""
+        return self.method.correction
+
+    @property
+    def open(self) -> str:
+        """The open edges ("x": both x edges), each with an absorbing layer beyond the domain ("": closed)."""
+        return self.edges.open
+
+    @property
+    def layer_width(self) -> float | None:
+        """The layer's width asked for, m; None: the absorber's default."""
+        return self.edges.layer_width
+
+    @property
+    def absorber(self) -> str:
+        """What damps the layer (solvers/absorbers/); "": the scene's (:attr:`absorber_used`)."""
+        return self.edges.absorber
+
+    @property
+    def absorber_strength(self) -> float | None:
+        """The absorber's strength asked for, 1/s; None: the absorber's default for the scene."""
+        return self.edges.absorber_strength
 
     def __post_init__(self) -> None:
         if self.steps is None and self.t_end is None:
@@ -119,7 +204,7 @@ class Scene:
             if getattr(self, key) is None:
                 object.__setattr__(self, key, kind.defaults.get(key, PAPER_PULSE.get(key)))
         if not self.open:
-            object.__setattr__(self, "open", kind.defaults.get("open", ""))
+            object.__setattr__(self, "edges", replace(self.edges, open=kind.defaults.get("open", "")))
         try:
             points = tuple((float(p[0]), float(p[1])) for p in self.probes or ())
         except (TypeError, ValueError, IndexError):
@@ -344,73 +429,29 @@ class Scene:
         return self.boundary_method or DEFAULT_BOUNDARY_METHOD
 
     def _validate_open(self, need, finite) -> None:
-        """The open edges: free edges of the scene, a layer of positive width no wider than the domain, a known
-        absorber of positive strength; none of the layer's options on a closed scene."""
-        need(
-            self.open in OPEN_EDGES,
-            f"--open must be one of {', '.join(e for e in OPEN_EDGES if e)} (got {self.open!r})",
-        )
-        openable = self.kind.openable_edges()
-        for axis in ("x", "y"):
-            if axis in self.open and axis not in openable:
-                need(False, f"--open {axis}: {self.kind.closed_reason(axis)}")
-        if not self.open:  # a closed scene has no layer: its options would be stored as if they did something
-            for name, unset in LAYER_UNSET.items():
-                need(
-                    getattr(self, name) == unset,
-                    f"--{name.replace('_', '-')}: the scene's edges are closed (add --open x, y or xy)",
-                )
-            return
-        _ = self.absorber_model  # first: a known absorber, or one line (the default layer is the absorber's)
-        for name in ("layer_width", "absorber_strength"):
-            if getattr(self, name) is not None:
-                value = finite(name)
-                need(value > 0, f"--{name.replace('_', '-')} must be > 0 (got {value:g})")
-        if self.open:
-            span = min(
-                self.x_max - self.x_min if self.open_x else math.inf, self.height_span if self.open_y else math.inf
-            )
-            need(
-                self.layer <= span,
-                f"--layer-width must be at most the domain's "
-                f"{'width' if span == self.x_max - self.x_min else 'height'} {span:g} m (got {self.layer:g} m)",
-            )
-            need(
-                self.n_layer >= 1,
-                f"--layer-width must hold one column of dx = {self.dx:g} m (got {self.layer_asked:g} m)",
-            )
+        """The open edges (:meth:`solvers.edges.Edges.problems`): the first problem, in one line."""
+        for problem in self.edges.problems(self):
+            need(False, problem)
 
     # ------------------------------------------------------------ open edges
     @property
-    def open_x(self) -> bool:
-        """Whether the x edges are open: the lattice holds an absorbing layer beyond each."""
-        return "x" in self.open
-
-    @property
-    def open_y(self) -> bool:
-        """Whether the y edges are open: the lattice holds an absorbing layer beyond each."""
-        return "y" in self.open
-
-    @property
-    def layer_asked(self) -> float:
-        """The absorbing layer's width asked for, m: ``layer_width``, or the absorber's default (in pulse widths:
-        solvers/absorbers/)."""
-        return self.layer_width if self.layer_width is not None else self.absorber_model.default_width(self)
-
-    @property
     def n_layer(self) -> int:
-        """Columns (rows) of the absorbing layer beyond each open edge (0 where none is open)."""
-        return max(int(round(self.layer_asked / self.dx)), 0) if self.open else 0
+        """Columns (rows) of the absorbing layer beyond each open edge (0 where none is open); SceneError naming
+        --absorber and the choices if it is unknown (met wherever asked first: the lattice's size needs it)."""
+        try:
+            return self.edges.n_layer(self)
+        except ValueError as exc:
+            raise SceneError(str(exc)) from None
 
     @property
     def layer_columns(self) -> int:
         """Lattice columns of the layer beyond each x edge: n_layer where x is open, else 0."""
-        return self.n_layer if self.open_x else 0
+        return self.n_layer if self.edges.open_x else 0
 
     @property
     def layer_rows(self) -> int:
         """Lattice rows of the layer beyond each y edge: n_layer where y is open, else 0."""
-        return self.n_layer if self.open_y else 0
+        return self.n_layer if self.edges.open_y else 0
 
     @property
     def layer(self) -> float:
@@ -429,30 +470,15 @@ class Scene:
     @property
     def strength(self) -> float:
         """The absorber's strength, 1/s: the scene's, or the absorber's default for it."""
-        if self.absorber_strength is not None:
-            return float(self.absorber_strength)
-        return self.absorber_model.default_strength(self)
-
-    @property
-    def absorber_model(self):
-        """The absorber of :attr:`absorber_used` (solvers/absorbers/); SceneError naming --absorber and the choices
-        if it is unknown (met wherever asked first: a walled scene's places need the layer's width)."""
-        from solvers.absorbers import absorber_named
-
         try:
-            return absorber_named(self.absorber_used)
+            return self.edges.strength(self)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
 
     @property
     def absorber_used(self) -> str:
-        """The absorber that damps the layer: ``absorber``, or by default the split-field PML, except on a
-        strip (a plane wave along x), where the sponge gives the PML's answer (measured: the same to three
-        digits; there is no y part to split) for less work (no x part of the rate to compute and carry) and a
-        thinner default layer (docs/accuracy.md)."""
-        if self.absorber:
-            return self.absorber
-        return "sponge" if self.kind.strip else "pml"
+        """The absorber that damps the layer (:meth:`solvers.edges.Edges.absorber_used`)."""
+        return self.edges.absorber_used(self)
 
     # ------------------------------------------------------------ geometry
     @property
@@ -464,13 +490,13 @@ class Scene:
     def periodic_x(self) -> bool:
         """Whether the lattice is periodic in x (else its left and right edges are free or walls): the scene
         kind's periodic x, unless its x edges are open."""
-        return "x" in self.kind.periodic and not self.open_x
+        return "x" in self.kind.periodic and not self.edges.open_x
 
     @property
     def periodic_y(self) -> bool:
         """Whether the lattice is periodic in y (else its bottom and top edges are free): the scene kind's
         periodic y, unless its y edges are open."""
-        return "y" in self.kind.periodic and not self.open_y
+        return "y" in self.kind.periodic and not self.edges.open_y
 
     @property
     def boundaries(self) -> frozenset:
@@ -616,7 +642,21 @@ class Scene:
             return PAPER_DOMAIN[name]
         if name in PAPER_PULSE:
             return PAPER_PULSE[name]
+        return cls.keyword_default(name)
+
+    @classmethod
+    def keyword_default(cls, name: str):
+        """The constructor's default of keyword ``name`` (None where the scene kind's or the paper's is resolved
+        when the scene is built: the domain, the pulse, the body)."""
+        if name in METHOD_FIELDS:
+            return getattr(DEFAULT_METHOD, name)
+        if name in Edges.names():
+            return getattr(Edges(), name)
         return cls.__dataclass_fields__[name].default
+
+    def parameters(self) -> dict:
+        """{name: value} of :data:`PARAMETERS`: the scene as stored (no derived quantities, no machine limit)."""
+        return {name: getattr(self, name) for name in self.PARAMETERS}
 
     def default_of(self, name: str):
         """The default of parameter ``name`` for this scene's kind (its domain, pulse or edges may differ from the
@@ -651,8 +691,7 @@ class Scene:
         return replace(self, **changes)
 
     def as_dict(self) -> dict:
-        d = asdict(self)
-        d.pop("memory_limit_bytes")
+        d = self.parameters()
         d.update(
             n_particles=self.n_particles,
             dt=self.dt,

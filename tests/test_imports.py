@@ -190,7 +190,7 @@ LAYERS = (
         "solvers.jitcache",
     ),  # registries, kernels, absorbers, corrections, boundary methods, sampling between particles
     ("solvers.physics",),  # the rates per pair and the integrators, for every backend
-    ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method"),  # the problem
+    ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method", "solvers.edges"),
     ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops
     ("solvers.allpair_cpu", "solvers.linkedlist_cpu", "solvers.linkedlist_gpu", "solvers.registry"),  # solvers
     ("solvers",),  # the package's face

@@ -32,7 +32,7 @@ from solvers import (
     registry,
     scene_names,
 )
-from solvers.scene import OPEN_EDGES
+from solvers.edges import OPEN_EDGES
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -74,10 +74,11 @@ def _limits(
     from solvers.kernels import truncated
     from solvers.method import Method
     from solvers.reference.dispersion import largest_symbol, unit_scene
+    from solvers.reference.dispersion import stable_cfl as lattice_limit
 
     method = Method(kernel, h_factor, cutoff_factor if truncated(kernel) else None, 1.0, integrator, correction)
     scene = unit_scene(**method.scene_fields())
-    return method.stable_cfl(), scene.dx * largest_symbol(scene)
+    return lattice_limit(method), scene.dx * largest_symbol(scene)
 
 
 def method_of(r) -> tuple[str, float, float, str, str]:

@@ -420,10 +420,9 @@ def validate(row) -> str:
     why = schema.check(row)
     if why:
         return why
-    fields = Scene.__dataclass_fields__
     try:
         scene = Scene(
-            **{k: v for k, v in row["scene"].items() if k in fields and fields[k].compare},
+            **{k: v for k, v in row["scene"].items() if k in Scene.PARAMETERS},
             memory_limit_bytes=sys.maxsize,
         )
     except (SceneError, TypeError, ValueError, OverflowError) as exc:

@@ -21,10 +21,11 @@ import math
 import re
 from dataclasses import dataclass
 
+from solvers.edges import OPEN_EDGES
 from solvers.interface import STAGES
 from solvers.kernels.registry import KERNEL_NAME
 from solvers.registry import SOLVER_NAME
-from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, OPEN_EDGES, PRECISIONS
+from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, PRECISIONS
 
 STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
 STEP_STAGES = ("snp", "pi", "su")  # the stages of a time step; input, init and output happen once per run
