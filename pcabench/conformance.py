@@ -291,12 +291,10 @@ def lattice_neighbours(scene: Scene) -> float:
     ids = np.arange(scene.n_particles)
     column, y = ids % scene.nx, (ids // scene.nx) * scene.dx
     if scene.body is not None:
-        from solvers.bodies import Body, boundary_method_named
+        from solvers.boundaries.body import RigidBody
 
         x = scene.x_lo + (column + 0.5) * scene.dx
-        _role, sx, sy = Body(boundary_method_named(scene.boundary_method_used), scene).place(
-            x, scene.y_lo + y + 0.5 * scene.dx
-        )
+        _role, sx, sy = RigidBody(scene).place(x, scene.y_lo + y + 0.5 * scene.dx)
         px, py = x + sx, y + sy
         d2 = (px[:, None] - px[None, :]) ** 2 + (py[:, None] - py[None, :]) ** 2
         return float(((d2 < scene.cutoff**2).sum() - scene.n_particles) / scene.n_particles)

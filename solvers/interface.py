@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solvers.absorbers import absorber_named
+from solvers.boundaries import OpenLayer, RigidBody, Walls, across, boundary_models
 from solvers.corrections import correction_names
 from solvers.kernels import constants as kernel
 from solvers.kernels import kernel_names
@@ -161,9 +161,17 @@ class Solver(abc.ABC):
         self.dtype = np.dtype(scene.precision)
         self.k = kernel.constants(scene, self.dtype)
         self.moving = scene.model == "lagrangian"
-        self.absorber = absorber_named(scene.absorber_used) if scene.open else None
         self.correction = scene.sph_correction
-        self.split = bool(self.absorber is not None and self.absorber.split)
+        # the scene's walls, open layer and body (solvers/boundaries/), each called at its points of a step
+        self.boundary_models = boundary_models(scene)
+        self.walls, self.layer, self.body = (
+            next((m for m in self.boundary_models if isinstance(m, kind)), None)
+            for kind in (Walls, OpenLayer, RigidBody)
+        )
+        self.absorber = self.layer.absorber if self.layer is not None else None
+        self.split = bool(self.layer is not None and self.layer.split)
+        self.boundary_state = sum((m.state for m in self.boundary_models), ())  # saved and restored with drho
+        self.boundary_rates = sum((m.rates for m in self.boundary_models), ())  # summed over RK stages
 
     def check_scene(self, scene: Scene) -> None:
         """Solver-specific limits; raise SceneError naming the parameter."""
@@ -191,28 +199,13 @@ class Solver(abc.ABC):
         }
         for name in RATES + ("vol", "pr"):
             a[name] = xp.zeros(s.n_particles, dt)
-        self.body = None
-        if s.body is not None:  # a rigid body: its particles' roles and places (solvers/bodies/)
-            from solvers.bodies import Body, boundary_method_named
-            from solvers.bodies.base import INERT
-
-            self.body = Body(boundary_method_named(s.boundary_method_used), s)
-            role, shift_x, shift_y = (xp.asarray(v) for v in self.body.place(self.to_host(x), self.to_host(y)))
-            a["role"] = role.astype(dt)
-            a["sx"], a["sy"] = shift_x.astype(dt), shift_y.astype(dt)
-            for name in ("u", "v", "drho"):
-                a[name][role != 0] = 0
-            a["mass"][role == INERT] = 0  # no volume: no sum counts the inert particles
-        if self.split:  # a split absorber's x parts of drho and of its rate (drho_y = drho - drho_x)
-            a["drho_x"] = (0.5 * drho).astype(dt)
-            a["ddx"] = xp.zeros(s.n_particles, dt)
-            self.no_velocity = xp.zeros(s.n_particles, dt)  # v = 0 for the x part's sweep (never permuted)
         self.arrays = a
+        for model in self.boundary_models:  # a body's particles' roles and places, a split layer's parts of drho
+            model.start(self, x, y, drho)
         self.saved = {}
         self.t = 0.0
         self.reordered = 0  # how many times the arrays were put in a new order (a body's indices follow it)
         self.moves = 0  # how many times moving particles moved (an advance, a restore)
-        self.layer_key, self.layer_sigma, self.layer_cache = None, (), {}  # the open edges' layer: layer_factors
         self.correction_factors = None  # a kernel correction's factors and the positions they are of
         self.after_init()
 
@@ -229,7 +222,7 @@ class Solver(abc.ABC):
     def rates(self, continuity: bool, momentum: bool) -> None:
         """PI: fill dd (continuity) and/or ax, ay (momentum) from the current state (and ddx, the x part of dd,
         for a split absorber), through the scene's kernel correction (solvers/corrections/: none, the sweeps)."""
-        self.fill_body()
+        self.prepare_boundaries()
         vol, pr = self.correction.coefficients(continuity, momentum)
         self.coefficients(vol or continuity, pr or momentum)
         self.correction.sweep(self, continuity, momentum)
@@ -253,15 +246,13 @@ class Solver(abc.ABC):
         self.launch("moments", *self.geometry(), self.arrays["vol"], *out, self.k)
         return out
 
-    def fill_body(self) -> None:
-        """A body's ghost particles take the fluid's values mirrored across its wall (solvers/bodies/)."""
-        if self.body is not None:
-            self.body.fill(self)
-
-    def pin_body(self) -> None:
-        """A body's particles back at their places after an advance that moved particles."""
-        if self.body is not None and self.moving:
-            self.body.pin(self)
+    def prepare_boundaries(self) -> bool:
+        """Each boundary model before the pair sums (a body's ghosts take the fluid's values mirrored across its
+        wall); True where one changed drho."""
+        changed = False
+        for model in self.boundary_models:
+            changed = model.before_sweep(self) or changed
+        return changed
 
     def coefficients(self, continuity: bool, momentum: bool) -> None:
         """Per-particle coefficients of the sweeps: vol = m / rho (continuity), pr = c0^2 drho / rho^2 (momentum)."""
@@ -298,10 +289,13 @@ class Solver(abc.ABC):
         an open edge's layer: :meth:`absorb`)."""
         self.absorb(f, "density")
         self.advance_launch(f)
-        self.advance_split(f)
+        for model in self.boundary_models:  # a split layer's x part of drho, with drho
+            model.advanced(self, f)
         self.absorb(f, "density")
         self.moved()
-        self.pin_body()
+        if self.moving:  # a body's particles back at their places
+            for model in self.boundary_models:
+                model.moved(self)
         self.t += f * self.scene.dt
 
     def advance_launch(self, f: float) -> None:
@@ -324,50 +318,12 @@ class Solver(abc.ABC):
         if self.moving:
             self.moves += 1
 
-    def advance_split(self, f: float) -> None:
-        """drho_x += f dt ddx: a split absorber's x part of drho, updated with drho."""
-        if self.split:
-            a = self.arrays
-            a["drho_x"] += self.dtype.type(f * self.scene.dt) * a["ddx"]
-
     def absorb(self, f: float, fields: str) -> None:
         """The open edges' absorbing layers (solvers/absorbers/): ``fields`` ("velocity" or "density") damped by
         half of an update of f dt, called before and after that update, so that the damping is a term of the
         update (stable at the closed scene's CFL: solvers/absorbers/base.py); nothing on a closed scene."""
-        if self.absorber is not None:
-            self.absorber.damp(self.arrays, *self.layer_factors(f), fields)
-
-    def layer_factors(self, f: float) -> tuple:
-        """(fx, fy): exp(-sigma f dt / 2) of each axis, sigma from each particle's depth beyond the domain's edges
-        (0 inside the domain; 1 on a closed axis), kept until the particles move or are put in a new order."""
-        key = (self.reordered, self.moves)
-        if self.layer_key != key:
-            self.layer_key, self.layer_sigma, self.layer_cache = key, self.layer_rates(), {}
-        factors = self.layer_cache.get(f)
-        if factors is None:
-            h = 0.5 * f * self.scene.dt
-            factors = tuple(
-                self.dtype.type(1.0) if sigma is None else self.xp.exp(-sigma * h).astype(self.dtype)
-                for sigma in self.layer_sigma
-            )
-            self.layer_cache[f] = factors
-        return factors
-
-    def layer_rates(self) -> tuple:
-        """(sigma_x, sigma_y) in 1/s at each particle's current position (None on a closed axis)."""
-        s, xp, a = self.scene, self.xp, self.arrays
-        rates = []
-        for axis, lo, near, far, lattice, shift in (
-            ("x", s.x_lo, s.x_min, s.x_max, "lx", "sx"),
-            ("y", s.y_lo, s.y_min, s.y_max, "ly", "sy"),
-        ):
-            if axis not in s.open:
-                rates.append(None)
-                continue
-            pos = lo + (a[lattice].astype(xp.float64) + 0.5) * s.dx + a[shift]
-            depth = xp.maximum(xp.maximum(near - pos, pos - far), 0.0)
-            rates.append(self.absorber.sigma(depth, s.layer, s.strength, xp))
-        return tuple(rates)
+        for model in self.boundary_models:
+            model.damp(self, f, fields)
 
     def continuity_x(self) -> None:
         """The x part of the continuity rate into ``ddx`` (a split absorber's: the PML): the same sweep with
@@ -382,14 +338,14 @@ class Solver(abc.ABC):
 
     def save(self) -> None:
         """Keep a copy of the state (for two-stage integrators)."""
-        for name in ("sx", "sy", "u", "v", "drho") + (("drho_x",) if self.split else ()):
+        for name in ("sx", "sy", "u", "v", "drho") + self.boundary_state:
             self.saved[name] = self.arrays[name].copy()
         self.saved_t = self.t
 
     def restore(self, names) -> None:
         """Put back the saved copies of ``names`` (time goes back with drho, and drho's x part with it)."""
-        if self.split and "drho" in names:
-            names = (*names, "drho_x")
+        if "drho" in names:
+            names = (*names, *self.boundary_state)
         for name in names:
             self.arrays[name][...] = self.saved[name]
         if "sx" in names:
@@ -422,7 +378,7 @@ class Solver(abc.ABC):
 
     def summed(self) -> tuple:
         """The fields a Runge-Kutta step sums over its stages."""
-        return RATES + (("ddx",) if self.split else ()) + (("u", "v") if self.moving else ())
+        return RATES + self.boundary_rates + (("u", "v") if self.moving else ())
 
     def permute(self, order) -> None:
         """Reorder every per-particle array (state, rates, saved copies) by ``order``."""
@@ -526,16 +482,15 @@ def cell_grid(scene: Scene) -> tuple:
         cw = scene.width / inside
         if scene.periodic_x:
             return cw, ch, inside, ncy, 0.0, scene.width, height
-        spare_left, spare_right = "x_min" not in scene.walls, "x_max" not in scene.walls
+        spare_left, spare_right = Walls.spare_cells(scene)
         return cw, ch, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0, height
     ncx = int(math.ceil(scene.width / scene.cutoff)) + 2  # the lattice's width: an open edge's layer included
     return scene.cutoff, ch, ncx, ncy, -scene.cutoff, 0.0, height
 
 
 def across_x(scene: Scene) -> bool:
-    """Whether the pair sums of ``scene`` reach across an x edge: a periodic seam or a rigid wall
-    (the pair functions' compile-time ``across``, solvers/physics/pairs.py)."""
-    return bool(scene.periodic_x or scene.walls)
+    """Whether the pair sums of ``scene`` reach across an x edge (solvers/boundaries/walls.py ``across``)."""
+    return across(scene)
 
 
 def tiny_scene(scene: Scene) -> Scene:

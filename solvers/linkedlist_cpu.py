@@ -151,8 +151,8 @@ class LinkedListCPU(CellListSolver):
             use_threads(self.threads)
         a = self.arrays
         out = self.pairs.moments(a["lx"], a["ly"], a["sx"], a["sy"], a["vol"], self.k)
-        if self.scene.walls:
-            self.launch("wall_moments", *self.geometry(), a["vol"], *out, self.k)
+        if self.walls is not None:
+            self.walls.mirror_moments(self, out)
         return out
 
     def _sweep(self, continuity: bool, momentum: bool) -> None:
@@ -161,7 +161,6 @@ class LinkedListCPU(CellListSolver):
         if self.threads > 1:
             use_threads(self.threads)
         a = self.arrays
-        walls = bool(self.scene.walls)  # the list holds the real pairs; the mirrors' part is added at the walls
         if continuity:
             parts = [(a["v"], a["dd"])]  # (v, the rate): the whole rate, and a split absorber's x part (v = 0)
             if self.split and a["dd"] is not a["ddx"]:  # the x part in the same pass (continuity_x: nothing left)
@@ -169,9 +168,7 @@ class LinkedListCPU(CellListSolver):
                 self.pairs.continuity_split(a["u"], a["v"], a["vol"], a["drho"], a["dd"], a["ddx"], self.k)
             else:
                 self.pairs.continuity(a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
-            for v, out in parts if walls else ():
-                self.launch("wall_continuity", *self.geometry(), a["u"], v, a["vol"], a["drho"], out, self.k)
         if momentum:
             self.pairs.momentum(a["mass"], a["pr"], a["ax"], a["ay"])
-            if walls:
-                self.launch("wall_momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
+        if self.walls is not None:  # the list holds the real pairs; the mirrors' part is added at the walls
+            self.walls.mirror_sweeps(self, parts if continuity else (), momentum)

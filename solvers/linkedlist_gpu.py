@@ -130,8 +130,7 @@ class LinkedListGPU(CellListSolver):
     def rates(self, continuity: bool, momentum: bool) -> None:
         """PI; the coefficients only when drho changed since the system update last wrote them (a body's
         ghosts take new values first: then always)."""
-        if self.body is not None:
-            self.fill_body()
+        if self.prepare_boundaries():  # a body's ghosts took new values
             self.coefficients_fresh = False
         if not self.coefficients_fresh:
             self.coefficients(True, True)

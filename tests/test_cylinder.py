@@ -97,7 +97,7 @@ def test_the_ghosts_hold_the_walls_conditions_and_stay_put(method):
         assert np.allclose(depth, np.round(depth), atol=1e-9)
     assert not (ghosts & inert).any() and r[inert].max(initial=0.0) < r0
     body = solver.body
-    solver.fill_body()  # the ghosts' values as the next sweep sees them
+    solver.prepare_boundaries()  # the ghosts' values as the next sweep sees them
     n = body.normal
     sampled = {k: body.weights @ np.asarray(a[k])[body.fluid_idx] for k in ("drho", "u", "v")}
     assert np.abs(sampled["drho"]).max() > 1e-4 * scene.rho0 * scene.mach  # the pulse is at the wall by now
@@ -171,9 +171,9 @@ def test_a_probe_reads_a_linear_field_exactly():
 
 
 def test_a_particle_inside_the_body_fails_the_run_at_its_step(monkeypatch):
-    from solvers.bodies import base
+    from solvers.boundaries.body import RigidBody
 
-    real = base.Body.locate
+    real = RigidBody.locate
     calls = {"n": 0}
 
     def locate(self, solver):
@@ -182,7 +182,7 @@ def test_a_particle_inside_the_body_fails_the_run_at_its_step(monkeypatch):
             raise BodyEntered("1 fluid particle(s) inside the cylinder (test)")
         return real(self, solver)
 
-    monkeypatch.setattr(base.Body, "locate", locate)
+    monkeypatch.setattr(RigidBody, "locate", locate)
     scene = Scene(name="cylinder", dx=0.1, steps=6, model="lagrangian", cfl=0.5)
     record = run(RunSpec("linkedlist-cpu", scene))
     assert record.status == "error" and record.failed_step == 3
@@ -210,8 +210,8 @@ def test_a_solver_that_skips_the_ghosts_fails_check_solver_on_the_cylinder():
 
         name = "skips-ghosts"
 
-        def fill_body(self):
-            pass
+        def prepare_boundaries(self):
+            return False
 
     (result,) = check_solver(SkipsGhosts, quick=True, only=("agreement",))
     assert result.failed and "cylinder" in result.message and "differs" in result.message, result.line()

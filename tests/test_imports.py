@@ -186,6 +186,7 @@ LAYERS = (
         "solvers.absorbers",
         "solvers.corrections",
         "solvers.bodies",
+        "solvers.boundaries",
         "solvers.sampling",
         "solvers.jitcache",
     ),  # registries, kernels, absorbers, corrections, boundary methods, sampling between particles

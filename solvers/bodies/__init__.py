@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from solvers.bodies.base import GHOST, INERT, Body, BodyEntered, BoundaryMethod
+from solvers.bodies.base import GHOST, INERT, BodyEntered, BoundaryMethod
 from solvers.bodies.registry import (
     BOUNDARY_METHODS,
     DEFAULT_BOUNDARY_METHOD,
@@ -14,7 +14,6 @@ from solvers.bodies.registry import (
 __all__ = [
     "GHOST",
     "INERT",
-    "Body",
     "BodyEntered",
     "BoundaryMethod",
     "BOUNDARY_METHODS",

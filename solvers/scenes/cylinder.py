@@ -54,7 +54,8 @@ class Cylinder(SceneKind):
     body = True
     window = WINDOW  # s: where the probes are scored
     # a rigid cylinder with its ghost particles (solvers/bodies/: the default boundary method), the pulse's flank
-    # at its wall from the first step (a solver that skips the ghosts' values, Solver.fill_body, fails agreement):
+    # at its wall from the first step (a solver that skips the ghosts' values, Solver.prepare_boundaries, fails
+    # agreement):
     # the body and the pulse with 3 widths about it (1,376 particles with the layer)
     smallest = {
         "dx": 0.125,

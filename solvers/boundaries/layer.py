@@ -1,0 +1,83 @@
+"""Open edges: an absorbing layer beyond each, damping what leaves the domain (the absorber: solvers/absorbers/).
+
+``Scene.edges`` (solvers/edges.py) says which edges are open and the layer's width and strength; the lattice
+holds the layer's columns (rows) beyond the domain (``Scene.n_layer``), whose particles are not scored. Around
+each kick and advance the layer damps its fields by half of the update's decay, before and after it (stable at
+the closed scene's CFL: solvers/absorbers/base.py), with a rate sigma rising with each particle's depth beyond the
+domain's edges (:meth:`OpenLayer.factors`). A split absorber (the PML) carries drho's x part ``drho_x`` and its
+rate ``ddx`` (the continuity sweep with v = 0: ``Solver.continuity_x``) as arrays of the state.
+"""
+
+from __future__ import annotations
+
+from solvers.boundaries.base import Boundary
+
+
+class OpenLayer(Boundary):
+    """The absorbing layer beyond the scene's open edges."""
+
+    name = "open layer"
+
+    def __init__(self, scene):
+        from solvers.absorbers import absorber_named
+
+        super().__init__(scene)
+        self.absorber = absorber_named(scene.absorber_used)
+        self.split = bool(self.absorber.split)
+        self.state = ("drho_x",) if self.split else ()
+        self.rates = ("ddx",) if self.split else ()
+        self.key, self.sigma, self.cache = None, (), {}
+
+    @classmethod
+    def applies(cls, scene) -> bool:
+        return bool(scene.open)
+
+    def start(self, solver, x, y, drho) -> None:
+        """A split absorber's x parts of drho (half of it) and of its rate (drho_y = drho - drho_x)."""
+        self.key, self.sigma, self.cache = None, (), {}
+        if self.split:
+            xp, dt, n = solver.xp, solver.dtype, self.scene.n_particles
+            solver.arrays["drho_x"] = (0.5 * drho).astype(dt)
+            solver.arrays["ddx"] = xp.zeros(n, dt)
+            solver.no_velocity = xp.zeros(n, dt)  # v = 0 for the x part's sweep (never permuted)
+
+    def damp(self, solver, f: float, fields: str) -> None:
+        self.absorber.damp(solver.arrays, *self.factors(solver, f), fields)
+
+    def advanced(self, solver, f: float) -> None:
+        """drho_x += f dt ddx: a split absorber's x part of drho, updated with drho."""
+        if self.split:
+            a = solver.arrays
+            a["drho_x"] += solver.dtype.type(f * self.scene.dt) * a["ddx"]
+
+    def factors(self, solver, f: float) -> tuple:
+        """(fx, fy): exp(-sigma f dt / 2) of each axis, sigma from each particle's depth beyond the domain's edges
+        (0 inside the domain; 1 on a closed axis), kept until the particles move or are put in a new order."""
+        key = (solver.reordered, solver.moves)
+        if self.key != key:
+            self.key, self.sigma, self.cache = key, self.rates_now(solver), {}
+        factors = self.cache.get(f)
+        if factors is None:
+            h = 0.5 * f * self.scene.dt
+            factors = tuple(
+                solver.dtype.type(1.0) if sigma is None else solver.xp.exp(-sigma * h).astype(solver.dtype)
+                for sigma in self.sigma
+            )
+            self.cache[f] = factors
+        return factors
+
+    def rates_now(self, solver) -> tuple:
+        """(sigma_x, sigma_y) in 1/s at each particle's current position (None on a closed axis)."""
+        s, xp, a = self.scene, solver.xp, solver.arrays
+        rates = []
+        for axis, lo, near, far, lattice, shift in (
+            ("x", s.x_lo, s.x_min, s.x_max, "lx", "sx"),
+            ("y", s.y_lo, s.y_min, s.y_max, "ly", "sy"),
+        ):
+            if axis not in s.open:
+                rates.append(None)
+                continue
+            pos = lo + (a[lattice].astype(xp.float64) + 0.5) * s.dx + a[shift]
+            depth = xp.maximum(xp.maximum(near - pos, pos - far), 0.0)
+            rates.append(self.absorber.sigma(depth, s.layer, s.strength, xp))
+        return tuple(rates)
