@@ -7,7 +7,21 @@ import sys
 
 import pytest
 
-from tests.benchmarks.check_ratios import check
+
+def ci_module(name: str):
+    """benchmarks/ci/<name>.py, loaded from its file (a folder of scripts and pytest-benchmark's suite, no
+    package, so that asv never imports it)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "ci" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"ci_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+check = ci_module("check_ratios").check
 
 
 def medians(ll_step=1.0, ap_step=3.0, parts=(0.1, 0.8, 0.1)):
@@ -49,7 +63,8 @@ def test_every_builtin_scene_is_benchmarked_and_each_walled_one_beside_a_free_tw
     from pcabench.conformance import SCENES
     from solvers import Scene
     from solvers.scenes import scenes
-    from tests.benchmarks.test_stages import SCENE_CASES
+
+    SCENE_CASES = ci_module("test_stages").SCENE_CASES
 
     builtin = {name for name, kind in scenes().items() if type(kind).__module__.startswith("solvers.scenes.")}
     assert builtin <= set(TrackSceneError.params[0]) and builtin <= set(SCENE_CASES) and builtin <= set(SCENES)
@@ -69,8 +84,8 @@ def test_every_builtin_scene_is_benchmarked_and_each_walled_one_beside_a_free_tw
 
 
 def test_the_step_guard_warns_past_its_threshold_and_fails_only_when_asked(monkeypatch, capsys):
-    """tests/benchmarks/step_guard.py's verdict on each side's best run (the runs themselves faked here)."""
-    from tests.benchmarks import step_guard as guard
+    """benchmarks/ci/step_guard.py's verdict on each side's best run (the runs themselves faked here)."""
+    guard = ci_module("step_guard")
 
     if guard.commit_of("HEAD~1") is None:
         pytest.skip("no earlier commit in this checkout")
@@ -98,11 +113,11 @@ def test_the_step_guard_warns_past_its_threshold_and_fails_only_when_asked(monke
 
 def test_the_step_guard_runs_each_side_from_its_own_tree(tmp_path):
     """End to end at 400 particles against HEAD exported by git archive: each side imports its own tree."""
-    from tests.benchmarks import step_guard as guard
+    guard = ci_module("step_guard")
 
     if guard.commit_of("HEAD") is None:
         pytest.skip("not a git checkout")
-    cmd = [sys.executable, "tests/benchmarks/step_guard.py", "--against", "HEAD", "--pairs", "1", "--dx", "1"]
+    cmd = [sys.executable, "benchmarks/ci/step_guard.py", "--against", "HEAD", "--pairs", "1", "--dx", "1"]
     out = subprocess.run(cmd + ["--steps", "2"], capture_output=True, text=True, cwd=guard.ROOT, timeout=600)
     assert out.returncode == 0, out.stdout + out.stderr
     assert "pair 1: then" in out.stdout and "now/then" in out.stdout

@@ -207,7 +207,6 @@ LAYERS = (
     # the report's frame, tables and figure toolkit; each study's sections and what they draw (every other module
     # of a study's folder)
     ("pcabench.reports", "pcabench.studies.*.*"),
-    ("pcabench.bench",),  # asv
     ("pcabench.gpu", "pcabench.studies.*.gpu"),  # the GPU check, and each study's stage of it
     ("pcabench.cli", "pcabench.console"),  # the command line, and the console script that imports it
 )

@@ -6,6 +6,7 @@ from __future__ import annotations
 import io
 import json
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -206,12 +207,18 @@ def test_runs_compare_takes_a_machine_prefix_and_prints_no_index(tmp_path, capsy
 # ---------------------------------------------------------------- asv's smoke run
 def test_asv_smoke_config_writes_only_to_ignored_scratch_and_selects_few_benchmarks(tmp_path):
     asv_util = pytest.importorskip("asv.util")
-    from pcabench.bench import asv_smoke
+    import importlib.util
 
-    root = asv_smoke.ROOT
+    from pcabench.machine import asv
+
+    root = Path(__file__).resolve().parents[1]
     if not (root / ".git").exists():
         pytest.skip("not a git checkout")
-    config = asv_smoke.scratch_config(asv_smoke.SCRATCH, name="pytest")
+    spec = importlib.util.spec_from_file_location("asv_smoke", root / "benchmarks" / "ci" / "asv_smoke.py")
+    asv_smoke = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(asv_smoke)  # a script in benchmarks/ci/, not a module of the asv suite
+    assert asv_smoke.ROOT == root
+    config = asv.scratch_config(asv.SCRATCH, root, name="pytest")
     try:
         conf = asv_util.load_json(str(config), js_comments=True)
         git = ["git", "-C", str(root)]
@@ -242,3 +249,15 @@ def test_asv_smoke_config_writes_only_to_ignored_scratch_and_selects_few_benchma
     picked = [[n for n in names if re.search(pattern, n)] for pattern in asv_smoke.SELECTION]
     assert all(picked) and sum(map(len, picked)) <= 6, picked
     assert asv_smoke.main(["--results", str(root / "reports/asv/results")]) == 2
+
+
+def test_asv_imports_its_suite_and_never_the_ci_folder(monkeypatch):
+    """asv imports every module of the benchmarks package (asv_runner's discovery, an import error fatal): the
+    asv suite's modules, and not benchmarks/ci/ (pytest-benchmark's suite and CI's scripts, no package)."""
+    discovery = pytest.importorskip("asv_runner.discovery")
+    root = Path(__file__).resolve().parents[1]
+    monkeypatch.syspath_prepend(str(root))
+    names = [m.__name__ for m in discovery.disc_modules("benchmarks")]
+    assert "benchmarks.bench_step" in names and "benchmarks.common" in names
+    assert not [n for n in names if n.startswith("benchmarks.ci")], names
+    assert (root / "benchmarks" / "ci" / "test_stages.py").exists()  # there, and not imported

@@ -16,9 +16,9 @@ def cmd_profile(args) -> int:
 
     profile = profiles.capture(with_gpu=not args.no_gpu)
     if args.asv:
-        from pcabench.bench import asv_machine
+        from pcabench.machine import asv
 
-        print(asv_machine.write(profile))
+        print(asv.write(profile))
         return 0
     if args.save:
         out = check_folder(args.out, "--out") if args.out else check_folder(paths.user_profiles(), home_option())

@@ -119,7 +119,7 @@ def run_asv_gpu(
         return rows
     # asv writes machine.json and benchmarks.json into its results folder: a scratch copy of the config points
     # it under ``out``, so the committed reports/asv/results stay as they are (as in the smoke run)
-    from pcabench.bench.asv_smoke import scratch_config
+    from pcabench.machine.asv import scratch_config
 
     scratch = Path(out).resolve() / "asv-results"
     config = scratch_config(scratch, root, "gpu-check")

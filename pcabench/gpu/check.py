@@ -158,7 +158,7 @@ def bench(c: Check) -> bool:
         "addopts=",
         "-p",
         "no:cacheprovider",
-        "tests/benchmarks",
+        "benchmarks/ci",
         "--benchmark-only",
         f"--benchmark-json={json_path}",
         "-q",

@@ -1,9 +1,17 @@
-"""asv's machine description, taken from the hardware profile (GPU included, which asv does not record).
+"""asv's view of this machine: its machine description, from the hardware profile (GPU included, which asv does
+not record), and a scratch copy of the config for runs that must leave the committed results alone.
 
 asv reads ``~/.asv-machine.json``; every key of a machine's entry lands in the
 ``machine.json`` of its results. ``write`` adds or replaces this profile's
 entry: the machine name is the profile id, ``cpu`` and ``ram`` come from the
-profile, and ``gpu`` and ``pcabench_profile`` are extra keys.
+profile, and ``gpu`` and ``pcabench_profile`` are extra keys (``pcabench profile --asv``).
+
+asv writes ``machine.json`` and ``benchmarks.json`` into its results folder
+even on a dry run, and the committed ``reports/asv/results`` hold real
+measurements. :func:`scratch_config` writes a copy of ``asv.conf.json`` (an
+ignored ``.asv-*.conf.json`` at the root, so the config's relative paths still
+hold) whose results folder is a scratch one; the smoke run
+(benchmarks/ci/asv_smoke.py) and the GPU check's asv stage run asv through it.
 """
 
 from __future__ import annotations
@@ -12,6 +20,19 @@ import json
 import os
 import platform
 from pathlib import Path
+
+RESULTS_LINE = '"results_dir": "reports/asv/results"'
+SCRATCH = Path(".asv") / "smoke" / "results"  # under the ignored .asv/
+
+
+def scratch_config(results: Path, root: Path, name: str = "smoke") -> Path:
+    """``root/.asv-<name>.conf.json``: ``root``'s asv.conf.json with its results in ``results`` (made absolute)."""
+    text = (root / "asv.conf.json").read_text()
+    if RESULTS_LINE not in text:
+        raise RuntimeError(f"{root / 'asv.conf.json'} has no line {RESULTS_LINE}: update pcabench/machine/asv.py")
+    config = root / f".asv-{name}.conf.json"
+    config.write_text(text.replace(RESULTS_LINE, json.dumps({"results_dir": str(Path(root, results).resolve())})[1:-1]))
+    return config
 
 
 def entry(profile: dict) -> dict:

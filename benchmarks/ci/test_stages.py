@@ -1,7 +1,7 @@
 """The stages of a step on small scenes, for every solver and precision (pytest-benchmark).
 
-    python -m pytest -o addopts="" tests/benchmarks --benchmark-only --benchmark-json=reports/pytest-benchmark/run.json
-    python tests/benchmarks/check_ratios.py reports/pytest-benchmark/run.json
+    python -m pytest -o addopts="" benchmarks/ci --benchmark-only --benchmark-json=reports/pytest-benchmark/run.json
+    python benchmarks/ci/check_ratios.py reports/pytest-benchmark/run.json
 
 Each benchmark records the particle count, solver, precision, the errors
 against the analytic pulse after the timed steps, and the hardware profile

@@ -1,6 +1,6 @@
 """Check same-run ratios in a pytest-benchmark JSON file; exit 1 naming any that fails.
 
-    python tests/benchmarks/check_ratios.py reports/pytest-benchmark/run.json
+    python benchmarks/ci/check_ratios.py reports/pytest-benchmark/run.json
 
 The ratios hold on any machine, however fast or noisy, because both sides
 were measured in the same run, each as its best round (a neighbour's job can

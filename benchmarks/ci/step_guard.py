@@ -1,9 +1,9 @@
 """The paper's scene's step, this checkout against an earlier commit, alternating in one run: a warning
 (exit 0), or with ``--fail`` exit 1, when this checkout's step is more than ``--threshold`` slower.
 
-    python tests/benchmarks/step_guard.py                      # against HEAD~1, 4 pairs, warn past 10 %
-    python tests/benchmarks/step_guard.py --against f13fa50 --fail
-    python tests/benchmarks/step_guard.py -- --pair-loop gather  # options after -- go to pcabench run
+    python benchmarks/ci/step_guard.py                      # against HEAD~1, 4 pairs, warn past 10 %
+    python benchmarks/ci/step_guard.py --against f13fa50 --fail
+    python benchmarks/ci/step_guard.py -- --pair-loop gather  # options after -- go to pcabench run
 
 Each side is ``pcabench run --solver linkedlist-cpu --dx 0.05 --steps 10 --json`` (400K particles on the
 paper's full domain, serial float64, the scene's default model) in a fresh interpreter of its own

@@ -1,1 +1,0 @@
-"""asv across commits: the machine description asv records and its smoke run."""
