@@ -120,3 +120,22 @@ def test_the_paper_method_is_named_in_words_from_scenes_defaults():
     studies = Path(__file__).resolve().parents[1] / "pcabench" / "studies"
     typed = [p for p in studies.rglob("*.py") if "h = 2.13 dx, 3h" in p.read_text() or "h 2.13dx, 3h" in p.read_text()]
     assert typed == []
+
+
+def test_a_scene_holds_its_method_and_edges_and_its_parameters_are_one_list():
+    """Scene.PARAMETERS is the scene as stored (every keyword, every record column the schema checks, every
+    option's field), read back through the Method and Edges values it holds; the values round-trip."""
+    from pcabench.parameters import PARAMETERS
+    from pcabench.store.schema import SCENE_FIELDS
+    from solvers.edges import Edges
+
+    s = Scene(dx=0.5, kernel="wendland-c2", h_factor=1.5, open="x", absorber="sponge", layer_width=2.0, cfl=0.3)
+    assert list(s.parameters()) == list(Scene.PARAMETERS)
+    assert set(Scene.PARAMETERS) <= set(SCENE_FIELDS) and {p.field for p in PARAMETERS} <= set(Scene.PARAMETERS)
+    assert s.method == Method.of(s.parameters()) == Method("wendland-c2", 1.5, None, 0.3, "verlet", "none")
+    assert s.edges == Edges(open="x", layer_width=2.0, absorber="sponge") and s.n_layer == 4
+    assert Scene(**s.parameters()) == s == Scene(0.5, method=s.method, edges=s.edges)
+    gaussian = Scene(0.5, method=s.method, kernel="gaussian")  # a flat keyword refines the value it belongs to
+    assert gaussian.method == Method("gaussian", 1.5, 3.0, 0.3, "verlet", "none") and gaussian.cutoff == 4.5 * 0.5
+    assert s.replace(open="").edges == Edges()  # closing the edges lets go of the layer's options
+    assert Scene(dx=0.5).method == Method.paper() and Scene.default("cutoff_factor") == 3.0
