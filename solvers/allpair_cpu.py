@@ -10,7 +10,8 @@ from __future__ import annotations
 import time
 from functools import lru_cache
 
-from solvers.interface import Solver, across_x, tiny_scene
+from solvers.boundaries import across
+from solvers.interface import Solver, tiny_scene
 from solvers.physics.backend import COMPILED, cpu_loops, cpu_updates
 from solvers.search.allpairs import AllPairs
 
@@ -40,7 +41,7 @@ class AllPairCPU(Solver):
         """Nothing to build: the all-pair search happens inside the interaction loop."""
 
     def launch(self, name: str, *args):
-        return sweeps(self.scene.precision, self.scene.kernel, across_x(self.scene))[name](*args)
+        return sweeps(self.scene.precision, self.scene.kernel, across(self.scene))[name](*args)
 
     def warmup(self) -> float:
         t0 = time.perf_counter()

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solvers.boundaries import OpenLayer, RigidBody, Walls, across, boundary_models
+from solvers.boundaries import OpenLayer, RigidBody, Walls, boundary_models
 from solvers.corrections import correction_names
 from solvers.kernels import constants as kernel
 from solvers.kernels import kernel_names
@@ -486,11 +486,6 @@ def cell_grid(scene: Scene) -> tuple:
         return cw, ch, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0, height
     ncx = int(math.ceil(scene.width / scene.cutoff)) + 2  # the lattice's width: an open edge's layer included
     return scene.cutoff, ch, ncx, ncy, -scene.cutoff, 0.0, height
-
-
-def across_x(scene: Scene) -> bool:
-    """Whether the pair sums of ``scene`` reach across an x edge (solvers/boundaries/walls.py ``across``)."""
-    return across(scene)
 
 
 def tiny_scene(scene: Scene) -> Scene:

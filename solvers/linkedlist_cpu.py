@@ -28,7 +28,7 @@ from functools import lru_cache
 import numba
 import numpy as np
 
-from solvers.interface import across_x
+from solvers.boundaries import across
 from solvers.physics.backend import COMPILED, cpu_loops, cpu_sorting, cpu_updates, use_threads
 from solvers.scene import SceneError
 from solvers.search import pairlist
@@ -110,7 +110,7 @@ class LinkedListCPU(CellListSolver):
         if self.threads > 1:
             use_threads(self.threads)  # a call into numba only if another solver set another count since
         s = self.scene
-        return sweeps(s.precision, s.kernel, self.threads > 1, across_x(s))[name](*args)
+        return sweeps(s.precision, s.kernel, self.threads > 1, across(s))[name](*args)
 
     def sort_cells(self) -> None:
         """SNP: the search bins the particles (``self.nnps.bin``: particleIndex, cellParticleOrder,

@@ -46,7 +46,7 @@ SCRIPT = textwrap.dedent("""
     import json
     import numba, numpy as np
     from solvers import Scene
-    from solvers.interface import across_x
+    from solvers.boundaries import across
     from solvers.linkedlist_cpu import LinkedListCPU, sweeps
 
     @numba.njit(parallel=True)
@@ -62,7 +62,7 @@ SCRIPT = textwrap.dedent("""
     for s in solvers.values():
         s.input(scene)
         s.init()
-        sweeps(scene.precision, scene.kernel, True, across_x(scene))["probe"] = probe
+        sweeps(scene.precision, scene.kernel, True, across(scene))["probe"] = probe
     seen = []
     for _ in range(3):
         for n, s in solvers.items():
