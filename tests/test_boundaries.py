@@ -22,7 +22,7 @@ def kind_cases():
                 yield pytest.param(Scene(name=name, **case), id=f"{name}{'-open' if case.get('open') else ''}")
 
 
-@pytest.mark.parametrize("scene", kind_cases())
+@pytest.mark.parametrize("scene", list(kind_cases()))
 def test_each_scene_kind_gets_the_models_of_its_boundaries(scene):
     models = {type(m) for m in boundary_models(scene)}
     assert (Walls in models) == ("wall-x" in scene.boundaries) == bool(scene.walls)
