@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from solvers.interface import STAGES, Fields, Solver, SolverUnavailable
 from solvers.kernels import DEFAULT_KERNEL, Kernel, kernel_named, kernel_names
+from solvers.method import INTEGRATORS
 from solvers.registry import (
     DEFAULT_SOLVER,
     ENTRY_POINT_GROUP,
@@ -20,7 +21,7 @@ from solvers.registry import (
     solver_class,
     solver_names,
 )
-from solvers.scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
+from solvers.scene import MODELS, PRECISIONS, Scene, SceneError
 from solvers.scenes import DEFAULT_SCENE, SceneKind, scene_kind, scene_names, scenes
 
 __all__ = [

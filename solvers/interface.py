@@ -33,7 +33,8 @@ from solvers.boundaries import OpenLayer, RigidBody, Walls, boundary_models
 from solvers.corrections import correction_names
 from solvers.kernels import constants as kernel
 from solvers.kernels import kernel_names
-from solvers.scene import INTEGRATORS, MODELS, PRECISIONS, Scene, SceneError
+from solvers.method import INTEGRATORS
+from solvers.scene import MODELS, PRECISIONS, Scene, SceneError
 
 STAGES = ("input", "init", "snp", "pi", "su", "output")
 STATE = ("lx", "ly", "sx", "sy", "u", "v", "drho")

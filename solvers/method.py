@@ -16,6 +16,7 @@ from solvers.corrections import DEFAULT_CORRECTION
 from solvers.kernels import DEFAULT_KERNEL
 
 FIELDS = ("kernel", "h_factor", "cutoff_factor", "cfl", "integrator", "correction")  # Scene's parameters it holds
+INTEGRATORS = ("verlet", "kdk1", "euler", "rk2", "rk4")
 # The paper's method, every Scene's default: a Gaussian at h = 2.13 dx cut at 3h, dt = 0.2 dx / c0, Verlet.
 PAPER = {
     "kernel": DEFAULT_KERNEL,
@@ -25,6 +26,10 @@ PAPER = {
     "integrator": "verlet",
     "correction": DEFAULT_CORRECTION,
 }
+
+
+def _finite(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def _close(a: float, b: float) -> bool:
@@ -67,6 +72,46 @@ class Method:
             integrator=str(get("integrator")),
             correction=str(get("correction")),
         )
+
+    def problems(self):
+        """Why this method cannot run (one line each, naming the parameter and its range; none where it can): h/dx
+        in [0.5, 10], a truncation in [1, 5] h, a registered kernel and correction, no truncation of a compact
+        kernel but its support, a cutoff past the nearest particles, a known integrator. (The CFL's range is the
+        scene's: it bounds the steps a run takes.)"""
+        from solvers.corrections import correction_named
+        from solvers.kernels import kernel_named
+
+        cut = self.cutoff_factor
+        for name, value in (("h_factor", self.h_factor), ("cutoff_factor", cut)):
+            if value is not None and not _finite(value):
+                yield f"{name} must be a finite number (got {value!r})"
+                return
+        if not 0.5 <= self.h_factor <= 10:
+            yield f"h_factor (h/dx) must be in [0.5, 10] (got {self.h_factor})"
+        elif cut is not None and cut < 1.0:
+            yield f"cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core (got {cut})"
+        elif cut is not None and cut > 5.0:
+            yield f"cutoff_factor (cutoff/h) must be <= 5 (got {cut}); beyond 4 the Gaussian is below 1e-7"
+        else:
+            try:
+                support = kernel_named(self.kernel).support
+                correction_named(self.correction)
+            except ValueError as exc:
+                yield str(exc)
+                return
+            reach = support if support is not None else PAPER["cutoff_factor"] if cut is None else cut
+            if support is not None and cut is not None:
+                yield (
+                    f"cutoff_factor applies to the truncated Gaussian only: {self.kernel} is cut at its compact "
+                    f"support {support:g}h (got cutoff_factor {cut:g})"
+                )
+            elif not self.h_factor * reach > 1:
+                yield (
+                    f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
+                    f"(got {reach:g} * {self.h_factor:g} = {reach * self.h_factor:g})"
+                )
+            elif self.integrator not in INTEGRATORS:
+                yield f"integrator must be one of {', '.join(INTEGRATORS)} (got {self.integrator!r})"
 
     @classmethod
     def paper(cls) -> "Method":

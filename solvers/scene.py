@@ -30,7 +30,6 @@ from solvers.method import Method
 from solvers.scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
-INTEGRATORS = ("verlet", "kdk1", "euler", "rk2", "rk4")
 # Arrays per particle an integrator keeps beyond FLOAT_ARRAYS_PER_PARTICLE: rk4's sums of its stages' rates (the
 # rates, the velocity and a split absorber's x part) and the temporary of each sum.
 INTEGRATOR_ARRAYS = {"rk4": 7}
@@ -237,8 +236,6 @@ class Scene:
             "mach",
             "pulse_width",
             "pulse_center",
-            "h_factor",
-            "cutoff_factor",
             "cfl",
             "blowup_factor",
         ):
@@ -274,32 +271,8 @@ class Scene:
         need(self.c0 > 0, f"c0 must be > 0 m/s (got {self.c0})")
         need(0 < self.mach < 1, f"mach must be in (0, 1) (got {self.mach})")
         need(self.pulse_width > 0, f"pulse_width must be > 0 m (got {self.pulse_width})")
-        need(0.5 <= self.h_factor <= 10, f"h_factor (h/dx) must be in [0.5, 10] (got {self.h_factor})")
-        need(
-            self.cutoff_factor >= 1.0,
-            "cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core "
-            f"(got {self.cutoff_factor})",
-        )
-        need(
-            self.cutoff_factor <= 5.0,
-            f"cutoff_factor (cutoff/h) must be <= 5 (got {self.cutoff_factor}); beyond 4 the Gaussian is below 1e-7",
-        )
-        try:
-            support = kernel_named(self.kernel).support
-            correction_named(self.correction)
-        except ValueError as exc:
-            raise SceneError(str(exc)) from None
-        need(
-            support is None or self.cutoff_factor == self.default("cutoff_factor"),
-            f"cutoff_factor applies to the truncated Gaussian only: {self.kernel} is cut at its compact support "
-            f"{support or 0:g}h (got cutoff_factor {self.cutoff_factor:g})",
-        )
-        reach = self.cutoff_ratio(self.kernel, self.cutoff_factor)
-        need(
-            self.h_factor * reach > 1,
-            f"cutoff_factor * h_factor (cutoff/dx) must be > 1 to reach the nearest particles, dx away "
-            f"(got {reach:g} * {self.h_factor:g} = {reach * self.h_factor:g})",
-        )
+        for problem in self.method.problems():  # kernel, h/dx, truncation, correction, integrator
+            need(False, problem)
         need(
             MIN_CFL <= self.cfl <= 50,
             f"cfl (dt*c0/dx) must be in [{MIN_CFL:g}, 50] (got {self.cfl:g}): below it a run of "
@@ -307,10 +280,6 @@ class Scene:
         )
         need(self.blowup_factor > 1, f"blowup_factor must be > 1 (got {self.blowup_factor})")
         need(self.model in MODELS, f"model must be one of {', '.join(MODELS)} (got {self.model!r})")
-        need(
-            self.integrator in INTEGRATORS,
-            f"integrator must be one of {', '.join(INTEGRATORS)} (got {self.integrator!r})",
-        )
         need(self.precision in PRECISIONS, f"precision must be one of {', '.join(PRECISIONS)} (got {self.precision!r})")
         need(self.steps is None or self.t_end is None, "give steps or t_end, not both")
         if self.steps is not None:

@@ -3,6 +3,7 @@ answer to "is this the paper's method"."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,7 @@ from pcabench.spec import RunSpec, scene_from_row
 from pcabench.store.record import RunRecord
 from pcabench.store.rows import default_numerics, is_paper_method, numerics_label
 from pcabench.studies.stability.rows import long_run_limits
-from solvers import Scene
+from solvers import Scene, SceneError
 from solvers.method import Method
 
 
@@ -139,3 +140,21 @@ def test_a_scene_holds_its_method_and_edges_and_its_parameters_are_one_list():
     assert gaussian.method == Method("gaussian", 1.5, 3.0, 0.3, "verlet", "none") and gaussian.cutoff == 4.5 * 0.5
     assert s.replace(open="").edges == Edges()  # closing the edges lets go of the layer's options
     assert Scene(dx=0.5).method == Method.paper() and Scene.default("cutoff_factor") == 3.0
+
+
+def test_a_method_names_why_it_cannot_run_and_a_scene_refuses_it_with_that_line():
+    ok = [Method.paper(), Method("wendland-c4", 1.3, None, 2.0, "rk4", "gradient")]
+    assert all(list(m.problems()) == [] for m in ok)
+    bad = {
+        Method("gaussian", 0.3, 3.0, 0.2, "verlet"): "h_factor (h/dx) must be in [0.5, 10]",
+        Method("gaussian", 2.13, 0.5, 0.2, "verlet"): "cutoff_factor (cutoff/h) must be >= 1",
+        Method("wendland-c2", 2.13, 4.0, 0.2, "verlet"): "cutoff_factor applies to the truncated Gaussian only",
+        Method("wendland-c2", 0.5, None, 0.2, "verlet"): "must be > 1 to reach the nearest particles",
+        Method("gaussian", 2.13, 3.0, 0.2, "leapfrog"): "integrator must be one of",
+        Method("nope", 2.13, 3.0, 0.2, "verlet"): "nope",
+    }
+    for method, words in bad.items():
+        (line,) = method.problems()  # one line each
+        assert words in line, line
+        with pytest.raises(SceneError, match=re.escape(words)):
+            Scene(0.5, method=method)

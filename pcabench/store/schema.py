@@ -24,8 +24,9 @@ from dataclasses import dataclass
 from solvers.edges import OPEN_EDGES
 from solvers.interface import STAGES
 from solvers.kernels.registry import KERNEL_NAME
+from solvers.method import INTEGRATORS
 from solvers.registry import SOLVER_NAME
-from solvers.scene import INTEGRATORS, MAX_STEPS, MODELS, PRECISIONS
+from solvers.scene import MAX_STEPS, MODELS, PRECISIONS
 
 STATUSES = ("ok", "unstable", "out-of-memory", "timeout", "error", "skipped")
 STEP_STAGES = ("snp", "pi", "su")  # the stages of a time step; input, init and output happen once per run
