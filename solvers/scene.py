@@ -8,6 +8,13 @@ Gaussian pulse of Mach 0.05, a Gaussian kernel with h = 2.13 dx truncated at
 (solvers/kernels/); one of compact support (the Wendland kernels: 2h) is cut
 there instead.
 
+A scene holds its numerical method as a value (:class:`~solvers.method.Method`:
+kernel, h/dx, truncation, CFL, integrator, correction; the paper's its default)
+and its edges as another (:class:`~solvers.edges.Edges`: which are open, and the
+absorbing layer beyond them). Its parameters are one flat list
+(:data:`Scene.PARAMETERS`: its keywords, its record's columns, its options), the
+method's and the edges' read through from those values.
+
 A scene states its particle count and memory before anything is allocated
 (:meth:`Scene.memory_bytes`) and rejects nonsense with a message that names
 the parameter and the allowed range (:class:`SceneError`). It is a pure value:
