@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from solvers.method import is_finite_number
+
 OPEN_EDGES = ("", "x", "y", "xy")  # none, the x edges, the y edges, all four
 
 
@@ -105,7 +107,7 @@ class Edges:
             value = getattr(self, name)
             if value is None:
                 continue
-            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)):
+            if not is_finite_number(value):
                 yield f"{name} must be a finite number (got {value!r})"
                 return
             if not value > 0:

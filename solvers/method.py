@@ -28,7 +28,8 @@ PAPER = {
 }
 
 
-def _finite(value) -> bool:
+def is_finite_number(value) -> bool:
+    """Whether ``value`` is a finite int or float (not a bool): the test every numeric scene parameter meets."""
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
@@ -83,7 +84,7 @@ class Method:
 
         cut = self.cutoff_factor
         for name, value in (("h_factor", self.h_factor), ("cutoff_factor", cut)):
-            if value is not None and not _finite(value):
+            if value is not None and not is_finite_number(value):
                 yield f"{name} must be a finite number (got {value!r})"
                 return
         if not 0.5 <= self.h_factor <= 10:

@@ -33,7 +33,7 @@ from solvers.corrections import DEFAULT_CORRECTION, Correction, correction_named
 from solvers.edges import Edges
 from solvers.kernels import Kernel, kernel_named
 from solvers.method import FIELDS as METHOD_FIELDS
-from solvers.method import Method
+from solvers.method import Method, is_finite_number
 from solvers.scenes import DEFAULT_SCENE, scene_kind
 
 MODELS = ("lagrangian", "fixed", "linear")
@@ -226,10 +226,7 @@ class Scene:
 
         def finite(name: str) -> float:
             value = getattr(self, name)
-            need(
-                isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value),
-                f"{name} must be a finite number (got {value!r})",
-            )
+            need(is_finite_number(value), f"{name} must be a finite number (got {value!r})")
             return float(value)
 
         for name in (

@@ -17,6 +17,7 @@ from typing import Any, Callable
 import numpy as np
 import pandas as pd
 
+from pcabench.reports.md import fmt
 from solvers.plugins import Registry
 
 ENTRY_POINT_GROUP = "pcabench.sections"
@@ -102,3 +103,14 @@ def stored_measure(r, name: str) -> float | None:
 
 def limit_words(stable_cfl: float) -> str:
     return f"{stable_cfl:.3g}" if stable_cfl > 0 else "none (grows at every CFL)"
+
+
+def outcome_cells(r) -> list[str]:
+    """A long-run row's outcome in a table's cells: bounded to (the largest CFL that stayed bounded), blew up at
+    (each CFL, with its step), the e-foldings of the growth."""
+    blew = "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in r["blew_up_at"]) or "none"
+    return [
+        fmt(r["bounded_to"], "g") if r["bounded_to"] is not None else "none",
+        blew,
+        fmt(r["e_foldings"], ".2g") if r["e_foldings"] is not None else "-",
+    ]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.section import Section, limit_words
+from pcabench.reports.section import Section, limit_words, outcome_cells
 from pcabench.studies.stability.rows import long_run_limits
 
 
@@ -12,7 +12,6 @@ def text(rows, ctx) -> list[str]:
         return []
     table = []
     for r in rows:
-        blew = "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in r["blew_up_at"]) or "none"
         method = f"{r['kernel']}, h = {r['h_factor']:g} dx, {r['integrator']}"
         table.append(
             [
@@ -24,9 +23,7 @@ def text(rows, ctx) -> list[str]:
                 f"{r['protocol']} (up to {r['steps']} steps)",
                 ", ".join(f"{c:g}" for c in r["cfls"]),
                 limit_words(r["predicted"]),
-                fmt(r["bounded_to"], "g") if r["bounded_to"] is not None else "none",
-                blew,
-                fmt(r["e_foldings"], ".2g") if r["e_foldings"] is not None else "-",
+                *outcome_cells(r),
                 fmt(r["held"], "g") if r["held"] is not None else "prediction",
             ]
         )

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.section import Section, stored_measure
+from pcabench.reports.section import Section, outcome_cells, stored_measure
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import is_paper_method, latest
 from pcabench.studies.front.scenes import T_FINAL
@@ -348,7 +348,6 @@ def _stability_text(rows) -> list[str]:
         return []
     table = []
     for r in rows:
-        blew = "; ".join(f"{c:g}" + (f" (step {st})" if st else "") for c, st in r["blew_up_at"]) or "none"
         table.append(
             [
                 r["scene"],
@@ -357,9 +356,7 @@ def _stability_text(rows) -> list[str]:
                 f"{r['kernel']}, h = {r['h_factor']:g} dx",
                 ", ".join(f"{c:g}" for c in r["cfls"]),
                 f"{r['predicted']:.3g}",
-                fmt(r["bounded_to"], "g") if r["bounded_to"] is not None else "none",
-                blew,
-                fmt(r["e_foldings"], ".2g") if r["e_foldings"] is not None else "-",
+                *outcome_cells(r),
                 _free_words(r),
                 fmt(r["held"], "g") if r["held"] is not None else "prediction",
             ]
