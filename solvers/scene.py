@@ -124,6 +124,9 @@ class Scene:
             raise TypeError(f"Scene() got an unexpected keyword argument {unknown[0]!r}")
         method = DEFAULT_METHOD if method is None else method
         edges = Edges() if edges is None else edges
+        for keyword, value, kind in (("method", method, Method), ("edges", edges, Edges)):
+            if not isinstance(value, kind):
+                raise SceneError(f"{keyword} must be a {kind.__name__} value (got {type(value).__name__} {value!r})")
         numerics = {k: given.pop(k) if k in given else getattr(method, k) for k in METHOD_FIELDS}
         if numerics["cutoff_factor"] is None:  # a compact kernel's method: its cut is its support
             numerics["cutoff_factor"] = DEFAULT_METHOD.cutoff_factor

@@ -158,3 +158,6 @@ def test_a_method_names_why_it_cannot_run_and_a_scene_refuses_it_with_that_line(
         assert words in line, line
         with pytest.raises(SceneError, match=re.escape(words)):
             Scene(0.5, method=method)
+    for bad in ({"method": "gaussian"}, {"edges": "x"}):  # a value of the wrong kind: one line naming it
+        with pytest.raises(SceneError, match=f"{next(iter(bad))} must be a"):
+            Scene(0.5, **bad)
