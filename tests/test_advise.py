@@ -96,6 +96,30 @@ def test_advise_takes_a_machine_prefix_as_runs_does(results, capsys):
     assert rc == 2 and "--machine 'zz'" in err and len(err.strip().splitlines()) == 1
 
 
+def test_a_host_whose_runs_do_not_answer_is_answered_from_a_machine_whose_do(results, capsys, monkeypatch):
+    """Issue 66: a new host (no rows) or one whose rows miss the error is answered from the machine whose rows
+    reach it, named as the answer's machine and in words; this host's rows win where they answer."""
+    from pcabench.machine import profiles
+
+    here = results / store.store_name("this-host", "h")
+    _row(here, 0.5, 0.05, kernel="wendland-c4", h_factor=1.3, cfl=1.0)  # this host's one run: not accurate enough
+    for r in store.read_rows(here):
+        store.append(dict(r, profile_id="this-host", run_id=r["run_id"] + "-h"), here)
+    for host in ("this-host", "fresh-host-1"):
+        monkeypatch.setenv(profiles.MACHINE_ID_ENV, host)
+        profiles.machine_id.cache_clear()
+        rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), "--json", capsys=capsys)
+        data = json.loads(out)
+        assert rc == 0 and data["machine"] == "m" and data["host_machine"] == host and data["seconds"] == 2.0, err
+        rc, out, err = cli_main("advise", "--error", "0.01", "--results", str(results), capsys=capsys)
+        assert rc == 0 and f"this host is {host}, whose stored runs do not answer" in out and "on m:" in out
+        rc, out, err = cli_main("advise", "--error", "0.06", "--results", str(results), "--json", capsys=capsys)
+        data = json.loads(out)
+        assert rc == 0 and data["machine"] == (host if host == "this-host" else "m"), out  # its own rows answer
+        assert ("host_machine" in data) is (host != "this-host")
+    profiles.machine_id.cache_clear()
+
+
 def _refuse(name):
     raise ValueError(f"not strict JSON: {name}")
 

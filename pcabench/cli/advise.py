@@ -48,6 +48,11 @@ def advice_text(out: dict, error: float, t_end: float, model: str, domain, scene
         f"{scene_words}{model} to a {scene_kind(scene).headline(t_end)} <= {error:g} "
         f"(against {against}) on {out['machine']}" + (f", {domain} domain" if domain else "")
     )
+    if out.get("host_machine"):  # answered from another machine's runs: say so before anything else
+        lines.append(
+            f"(this host is {out['host_machine']}, whose stored runs do not answer: the answer is {out['machine']}'s "
+            "runs; --machine names one)"
+        )
     if not out["found"]:
         s = out["suggestion"]
         lines.append(
@@ -184,6 +189,23 @@ def check_problem(name: str, mach: float, edges: str) -> None:
         raise OptionError(f"--mach: {text}" if text.startswith("mach ") else text) from None
 
 
+def answering_machine(df, machines, asked: tuple) -> tuple[str, dict]:
+    """The machine whose stored runs answer and the answer (:func:`advise` of ``asked``): this host's machine
+    where its runs reach the error, else the first of the other machines (most stored runs first) whose runs
+    do; where none does, this host's machine (or the one with the most runs) with the prediction's study. So
+    a new host (a machine id with no rows, or rows that do not reach the error) is answered from the runs that
+    do, and the answer names their machine."""
+    from pcabench.machine.profiles import machine_id
+
+    here = machine_id()
+    order = ([here] if here in machines.index else []) + [m for m in machines.index if m != here]
+    for machine in order:
+        answer = advise(df[df.machine == machine], *asked, suggest_missing=False)
+        if answer["found"]:
+            return machine, answer
+    return order[0], advise(df[df.machine == order[0]], *asked)
+
+
 def cmd_advise(args) -> int:
     from pcabench.machine.profiles import machine_id
     from pcabench.reports.frame import load as load_frame
@@ -213,19 +235,18 @@ def cmd_advise(args) -> int:
             f"{f' with --open {args.open}' if args.open else ''} in {results}: {make}, or use --reference"
         )
     machines = df.machine.value_counts()
+    asked = (args.error, args.t_end, args.model, args.domain, args.scene, problem)
     if args.machine:
         named = runs.machines(machines.index, args.machine)  # a machine's name, or a prefix of one
         if len(named) != 1:
             why = f"names {', '.join(named)}" if named else f"is none of {', '.join(sorted(machines.index))}"
             raise OptionError(f"--machine {args.machine!r} {why}: give one machine (or a prefix of one)")
-        machine = named[0]
+        machine, answer = named[0], advise(df[df.machine == named[0]], *asked)
     else:
-        machine = machine_id() if machine_id() in machines else machines.index[0]
-    out = {
-        "machine": machine,
-        "scene": args.scene,
-        **advise(df[df.machine == machine], args.error, args.t_end, args.model, args.domain, args.scene, problem),
-    }
+        machine, answer = answering_machine(df, machines, asked)
+    out = {"machine": machine, "scene": args.scene, **answer}
+    if not args.machine and machine != machine_id():
+        out["host_machine"] = machine_id()  # this host's machine, whose stored runs do not answer
     if args.json:  # the numbers the text prints, rounded as it prints them
         shown = {key: jsonout.significant(out[key]) for key in ROUNDED_AS_PRINTED if out.get(key) is not None}
         if out.get("cfl_fraction") is not None:

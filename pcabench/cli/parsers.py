@@ -194,7 +194,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
     p.add_argument("--results", help=results_help)
-    p.add_argument("--machine", help="a machine (profile id) of the stores; default this one, else the first")
+    p.add_argument(
+        "--machine",
+        help="a machine (profile id) of the stores, or a prefix of one; default this one where its runs answer, "
+        "else the machine whose runs do (named in the answer)",
+    )
     p.add_argument(
         "--domain",
         choices=("strip", "full"),

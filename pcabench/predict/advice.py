@@ -91,6 +91,7 @@ def advise(
     domain: str | None = None,
     scene: str = Scene.default("name"),
     problem: tuple[str, ...] = (),
+    suggest_missing: bool = True,
 ) -> dict:
     """The fastest stored run of ``scene`` reaching ``error`` at ``t_end`` (on ``domain``, ``strip`` or ``full``,
     if given) within the margin of its stable CFL, the fastest run of the paper's configuration reaching it that
@@ -100,7 +101,8 @@ def advise(
     (pcabench/predict/stability.py ``MARGIN``, the one rule: at or past the limit it is unstable by prediction) is
     never advised, whatever its error: ``not_advised`` lists those faster than the advice (or all of them,
     fastest first, where none within the margin reaches the error). ``problem``: the study options of the problem
-    asked about (``--open x``), for the study command :func:`suggest` names."""
+    asked about (``--open x``), for the study command :func:`suggest` names; ``suggest_missing`` False leaves
+    the search out where no run answers (``suggestion`` None: the caller asks another machine's runs first)."""
     runs = reaching(df, t_end, model)
     if domain is not None and not runs.empty:
         runs = runs[runs.domain == domain]
@@ -124,7 +126,7 @@ def advise(
     if hits.empty:
         out["found"] = False
         out["not_advised"] = unstable_rows(unstable, column)
-        out["suggestion"] = suggest(error, t_end, model, scene, problem, domain)
+        out["suggestion"] = suggest(error, t_end, model, scene, problem, domain) if suggest_missing else None
         return out
     best = hits.iloc[0]
     faster = unstable[unstable.t_solution < best.t_solution]
