@@ -17,10 +17,13 @@ from solvers.search.allpairs import AllPairs
 
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str, kernel: str, across: bool = True) -> dict:
+def sweeps(precision: str, kernel: str, across: bool = True, dims: int = 2) -> dict:
     """The all-pair interaction loops for ``precision`` and ``kernel``, with or without the mirrors across a
     wall (``across``; serial, as in the paper; solvers/loops/allpair.py, compiled once per machine), and
-    the per-particle updates."""
+    the per-particle updates; in 3D solvers/loops/allpair3d.py's."""
+    if dims == 3:
+        loops = cpu_loops("allpair3d", precision, kernel, False, across)
+        return {**cpu_updates(precision, False), **{name: getattr(loops, name) for name in COMPILED["allpair3d"]}}
     loops = cpu_loops("allpair", precision, kernel, False, across)
     return {**{name: getattr(loops, name) for name in COMPILED["allpair"]}, **cpu_updates(precision, False)}
 
@@ -35,13 +38,14 @@ class AllPairCPU(Solver):
     search = "all-pair"
     neighbour_search = AllPairs
     order = 2.0
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")  # periodic: the minimum image
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "body")  # the minimum image
 
     def snp(self) -> None:
         """Nothing to build: the all-pair search happens inside the interaction loop."""
 
     def launch(self, name: str, *args):
-        return sweeps(self.scene.precision, self.scene.kernel, across(self.scene))[name](*args)
+        s = self.scene
+        return sweeps(s.precision, s.kernel, across(s), s.dims)[name](*args)
 
     def warmup(self) -> float:
         t0 = time.perf_counter()

@@ -39,11 +39,18 @@ from solvers.scene import MODELS, PRECISIONS, Scene, SceneError
 STAGES = ("input", "init", "snp", "pi", "su", "output")
 STATE = ("lx", "ly", "sx", "sy", "u", "v", "drho")
 RATES = ("ax", "ay", "dd")
+# a 3D scene's (its dimension is the scene kind's): the z lattice coordinate, displacement, velocity and rate too
+STATE_3D = ("lx", "ly", "lz", "sx", "sy", "sz", "u", "v", "w", "drho")
+RATES_3D = ("ax", "ay", "az", "dd")
+POSITIONS = {2: ("lx", "ly", "sx", "sy"), 3: ("lx", "ly", "lz", "sx", "sy", "sz")}  # what a search bins
+VELOCITY = {2: ("u", "v"), 3: ("u", "v", "w")}
+ACCELERATION = {2: ("ax", "ay"), 3: ("ax", "ay", "az")}
 
 
 @dataclass
 class Fields:
-    """Final particle fields in particle-id order (id = ly * nx + lx). SI units."""
+    """Final particle fields in particle-id order (id = (lz * ny + ly) * nx + lx). SI units. A 3D scene's carry
+    ``z`` and ``w`` too (None in 2D)."""
 
     x: np.ndarray
     y: np.ndarray
@@ -52,9 +59,12 @@ class Fields:
     drho: np.ndarray
     t: float
     probes: dict | None = None  # {"t": times (s), name: drho there (kg/m^3)} recorded at the scene's probe points
+    z: np.ndarray | None = None
+    w: np.ndarray | None = None
 
     def save(self, path) -> None:
-        np.savez(path, x=self.x, y=self.y, u=self.u, v=self.v, drho=self.drho, t=self.t)
+        third = {} if self.z is None else {"z": self.z, "w": self.w}
+        np.savez(path, x=self.x, y=self.y, u=self.u, v=self.v, drho=self.drho, t=self.t, **third)
 
 
 class SolverUnavailable(RuntimeError):
@@ -121,6 +131,11 @@ class Solver(abc.ABC):
         """Raise SolverUnavailable (one line: what to install or where to run) unless it can run here."""
 
     @classmethod
+    def pair_loops_for(cls, scene: Scene) -> tuple:
+        """The pair loops this solver runs ``scene`` with (of ``pair_loops``; a 3D scene's may be fewer)."""
+        return tuple(cls.pair_loops)
+
+    @classmethod
     def choose_pair_loop(cls, scene: Scene, requested: str = "auto") -> str:
         """The pair loop for ``scene``: ``requested``, or for ``auto`` the solver's choice (its first)."""
         return cls.pair_loops[0] if requested == "auto" else requested
@@ -179,6 +194,8 @@ class Solver(abc.ABC):
 
     def init(self) -> None:
         """Allocate and place the particles on the lattice with the analytic pulse."""
+        if self.scene.dims == 3:
+            return self.init_3d()
         s, xp, dt = self.scene, self.xp, self.dtype
         ids = xp.arange(s.n_particles, dtype=xp.int64)
         lx = (ids % s.nx).astype(dt)
@@ -209,6 +226,32 @@ class Solver(abc.ABC):
         self.moves = 0  # how many times moving particles moved (an advance, a restore)
         self.correction_factors = None  # a kernel correction's factors and the positions they are of
         self.after_init()
+
+    def init_3d(self) -> None:
+        """:meth:`init` on a 3D lattice: particle id (lz ny + ly) nx + lx, mass rho_j(0) dx^3."""
+        s, xp, dt = self.scene, self.xp, self.dtype
+        ids = xp.arange(s.n_particles, dtype=xp.int64)
+        lx, ly, lz = ((ids % s.nx).astype(dt), (ids // s.nx % s.ny).astype(dt), (ids // (s.nx * s.ny)).astype(dt))
+        x, y, z = (lo + (c.astype(xp.float64) + 0.5) * s.dx for lo, c in ((s.x_lo, lx), (s.y_lo, ly), (s.z_lo, lz)))
+        u, v, w, drho = s.kind.initial_fields(s, x, y, xp, z=z)
+        rho_init = s.rho0 + (0.0 if s.model == "linear" else 1.0) * drho
+        a = {"lx": lx, "ly": ly, "lz": lz, "u": u.astype(dt), "v": v.astype(dt), "w": w.astype(dt)}
+        a.update(drho=drho.astype(dt), mass=(rho_init * s.dx**3).astype(dt))
+        for name in ("sx", "sy", "sz", *RATES_3D, "vol", "pr"):
+            a[name] = xp.zeros(s.n_particles, dt)
+        self.arrays = a
+        self.saved = {}
+        self.t = 0.0
+        self.reordered = 0
+        self.moves = 0
+        self.correction_factors = None
+        self.after_init()
+
+    @property
+    def positions(self) -> tuple:
+        """The names of the position arrays a search bins and a pair loop takes (lattice coordinates, then
+        displacements): 2D or 3D by the scene."""
+        return POSITIONS[self.scene.dims]
 
     def after_init(self) -> None:
         """The neighbour search for the scene (``self.nnps``), once the arrays exist; a hook for device-specific
@@ -243,7 +286,8 @@ class Solver(abc.ABC):
     def moments(self) -> tuple:
         """The moment matrix (M_xx, M_xy, M_yy) and Gamma (x, y) of every particle at the current positions and
         volumes (the kernel gradient correction's, solvers/corrections/gradient.py), as new arrays."""
-        out = tuple(self.xp.zeros(self.scene.n_particles, self.dtype) for _ in range(5))
+        count = 9 if self.scene.dims == 3 else 5  # in 3D (M_xx, M_xy, M_xz, M_yy, M_yz, M_zz) and Gamma (x, y, z)
+        out = tuple(self.xp.zeros(self.scene.n_particles, self.dtype) for _ in range(count))
         self.launch("moments", *self.geometry(), self.arrays["vol"], *out, self.k)
         return out
 
@@ -267,11 +311,12 @@ class Solver(abc.ABC):
 
     def _sweep(self, continuity: bool, momentum: bool) -> None:
         """The neighbour loops themselves, over the search's arguments (``self.nnps``)."""
-        a = self.arrays
+        a, dims = self.arrays, self.scene.dims
+        velocity, acceleration = (a[name] for name in VELOCITY[dims]), (a[name] for name in ACCELERATION[dims])
         if continuity:
-            self.launch("continuity", *self.geometry(), a["u"], a["v"], a["vol"], a["drho"], a["dd"], self.k)
+            self.launch("continuity", *self.geometry(), *velocity, a["vol"], a["drho"], a["dd"], self.k)
         if momentum:
-            self.launch("momentum", *self.geometry(), a["mass"], a["pr"], a["ax"], a["ay"], self.k)
+            self.launch("momentum", *self.geometry(), a["mass"], a["pr"], *acceleration, self.k)
 
     def geometry(self) -> tuple:
         """What every pair loop takes first, from the neighbour search: cells (if any) and positions."""
@@ -280,9 +325,10 @@ class Solver(abc.ABC):
     # ------------------------------------------------------------ system update
     def kick(self, f: float) -> None:
         """u += f dt a (damped before and after in an open edge's layer: :meth:`absorb`)."""
-        a = self.arrays
+        a, dims = self.arrays, self.scene.dims
         self.absorb(f, "velocity")
-        self.launch("kick", a["u"], a["v"], a["ax"], a["ay"], self.dtype.type(f * self.scene.dt))
+        velocity, acceleration = (a[name] for name in VELOCITY[dims]), (a[name] for name in ACCELERATION[dims])
+        self.launch("kick", *velocity, *acceleration, self.dtype.type(f * self.scene.dt))
         self.absorb(f, "velocity")
 
     def advance(self, f: float) -> None:
@@ -302,6 +348,12 @@ class Solver(abc.ABC):
     def advance_launch(self, f: float) -> None:
         """The advance's kernel: drho += f dt D and, for moving particles, x += f dt u."""
         a = self.arrays
+        if self.scene.dims == 3:
+            displacement, velocity = (a[n] for n in ("sx", "sy", "sz")), (a[n] for n in ("u", "v", "w"))
+            self.launch(
+                "advance", a["drho"], a["dd"], *displacement, *velocity, self.dtype.type(f * self.scene.dt), self.moving
+            )
+            return
         self.launch(
             "advance",
             a["drho"],
@@ -339,7 +391,8 @@ class Solver(abc.ABC):
 
     def save(self) -> None:
         """Keep a copy of the state (for two-stage integrators)."""
-        for name in ("sx", "sy", "u", "v", "drho") + self.boundary_state:
+        kept = ("sx", "sy", "sz", "u", "v", "w", "drho") if self.scene.dims == 3 else ("sx", "sy", "u", "v", "drho")
+        for name in kept + self.boundary_state:
             self.saved[name] = self.arrays[name].copy()
         self.saved_t = self.t
 
@@ -347,6 +400,8 @@ class Solver(abc.ABC):
         """Put back the saved copies of ``names`` (time goes back with drho, and drho's x part with it)."""
         if "drho" in names:
             names = (*names, *self.boundary_state)
+        if self.scene.dims == 3:  # the z components with the x and y the integrator names
+            names = (*names, *(third for name, third in (("sx", "sz"), ("u", "w")) if name in names))
         for name in names:
             self.arrays[name][...] = self.saved[name]
         if "sx" in names:
@@ -379,7 +434,8 @@ class Solver(abc.ABC):
 
     def summed(self) -> tuple:
         """The fields a Runge-Kutta step sums over its stages."""
-        return RATES + self.boundary_rates + (("u", "v") if self.moving else ())
+        dims = self.scene.dims
+        return (RATES_3D if dims == 3 else RATES) + self.boundary_rates + (VELOCITY[dims] if self.moving else ())
 
     def permute(self, order) -> None:
         """Reorder every per-particle array (state, rates, saved copies) by ``order``."""
@@ -396,6 +452,8 @@ class Solver(abc.ABC):
     def output(self) -> Fields:
         """Copy the fields back to the host in particle-id order."""
         s = self.scene
+        if s.dims == 3:
+            return self.output_3d()
         h = {name: self.to_host(self.arrays[name]) for name in STATE}
         column = np.rint(h["lx"]).astype(np.int64) % s.nx
         ids = (np.rint(h["ly"]).astype(np.int64) % s.ny) * s.nx + column
@@ -412,6 +470,19 @@ class Solver(abc.ABC):
             drho=h["drho"][order].astype(np.float64),
             t=self.t,
         )
+
+    def output_3d(self) -> Fields:
+        """:meth:`output` of a 3D scene: every particle in particle-id order, z and w with them."""
+        s = self.scene
+        h = {name: self.to_host(self.arrays[name]) for name in STATE_3D}
+        c = [np.rint(h[name]).astype(np.int64) % n for name, n in (("lx", s.nx), ("ly", s.ny), ("lz", s.nz))]
+        order = np.argsort((c[2] * s.ny + c[1]) * s.nx + c[0], kind="stable")
+        place = {
+            axis: lo + (h["l" + axis].astype(np.float64) + 0.5) * s.dx + h["s" + axis]
+            for axis, lo in (("x", s.x_lo), ("y", s.y_lo), ("z", s.z_lo))
+        }
+        out = {name: h[name][order].astype(np.float64) for name in ("u", "v", "w", "drho")}
+        return Fields(x=place["x"][order], y=place["y"][order], z=place["z"][order], t=self.t, **out)
 
     def to_host(self, arr) -> np.ndarray:
         return np.asarray(arr)
@@ -444,7 +515,7 @@ class Solver(abc.ABC):
     def amplitude(self) -> float:
         """max |u|, |v| over particles (NaN or inf if the state is not finite), m/s."""
         a = self.arrays
-        m = max(float(abs(a["u"]).max()), float(abs(a["v"]).max()), 0.0)
+        m = max(*(float(abs(a[name]).max()) for name in VELOCITY[self.scene.dims]), 0.0)
         if not np.isfinite(float(self.xp.sum(a["drho"]))):
             return float("nan")
         return m
@@ -487,6 +558,27 @@ def cell_grid(scene: Scene) -> tuple:
         return cw, ch, inside + spare_left + spare_right, ncy, -cw if spare_left else 0.0, 0.0, height
     ncx = int(math.ceil(scene.width / scene.cutoff)) + 2  # the lattice's width: an open edge's layer included
     return scene.cutoff, ch, ncx, ncy, -scene.cutoff, 0.0, height
+
+
+def cell_grid_3d(scene: Scene) -> tuple:
+    """(cw, ch, cd, ncx, ncy, ncz, x_grid, width, height, depth) of a 3D scene: along each periodic axis a whole
+    number of cells at least a cutoff wide filling the period (the period, m, given), along a free one cells a
+    cutoff wide with a spare one each side in x (particles past a free edge are clamped into the edge cells in y
+    and z, as in 2D: :func:`cell_grid`)."""
+    sizes, counts, periods = [], [], []
+    for span, periodic in (
+        (scene.width, scene.periodic_x),
+        (scene.height, scene.periodic_y),
+        (scene.depth, scene.periodic_z),
+    ):
+        n = max(int(math.floor(span / scene.cutoff + 1e-9)), 1)
+        sizes.append(span / n)
+        counts.append(n)
+        periods.append(span if periodic else 0.0)
+    x_grid = 0.0
+    if not scene.periodic_x:  # one cutoff wide with one spare each side, as the 2D free x edges
+        sizes[0], counts[0], x_grid = scene.cutoff, int(math.ceil(scene.width / scene.cutoff)) + 2, -scene.cutoff
+    return (*sizes, *counts, x_grid, *periods)
 
 
 def tiny_scene(scene: Scene) -> Scene:

@@ -36,10 +36,13 @@ from solvers.search.celllist import CellListSolver
 
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str, kernel: str, parallel: bool, across: bool = True) -> dict:
+def sweeps(precision: str, kernel: str, parallel: bool, across: bool = True, dims: int = 2) -> dict:
     """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool, with or
     without the pairs across an x seam or wall (``across``; solvers/loops/cells.py, compiled once per
-    machine), and the per-particle updates."""
+    machine), and the per-particle updates; in 3D the 27-cell loops and their updates (solvers/loops/cells3d.py)."""
+    if dims == 3:
+        loops = cpu_loops("cells3d", precision, kernel, parallel, across)
+        return {**cpu_updates(precision, parallel), **{name: getattr(loops, name) for name in COMPILED["cells3d"]}}
     loops = cpu_loops("cells", precision, kernel, parallel, across)
     return {**{name: getattr(loops, name) for name in COMPILED["cells"]}, **cpu_updates(precision, parallel)}
 
@@ -54,7 +57,7 @@ class LinkedListCPU(CellListSolver):
     )
     pair_loops = ("list", "gather")
     threaded = True
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "body")
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         super().__init__(threads=threads or 1, pair_loop=pair_loop)
@@ -80,16 +83,28 @@ class LinkedListCPU(CellListSolver):
         return scene.memory_bytes() + (pairlist.list_bytes(scene) if lists else 0)
 
     @classmethod
+    def pair_loops_for(cls, scene) -> tuple:
+        """Both loops in 2D; a 3D scene's pairs (hundreds a particle) are summed on the fly: gather only."""
+        return ("gather",) if scene.dims == 3 else tuple(cls.pair_loops)
+
+    @classmethod
     def choose_pair_loop(cls, scene, requested: str = "auto") -> str:
         """``auto``: ``list`` where the arrays and the pair list fit in the scene's memory limit, else ``gather``."""
         if requested != "auto":
             return requested
+        if "list" not in cls.pair_loops_for(scene):
+            return "gather"
         return "list" if "list" in cls.pair_loops and cls.list_fits(scene) else "gather"
 
     def check_scene(self, scene) -> None:
         if not isinstance(self.threads, int) or not 1 <= self.threads <= numba.config.NUMBA_NUM_THREADS:
             raise SceneError(
                 f"threads must be between 1 and {numba.config.NUMBA_NUM_THREADS} on this machine (got {self.threads!r})"
+            )
+        if self.requested_pair_loop == "list" and "list" not in self.pair_loops_for(scene):
+            raise SceneError(
+                f"pair_loop list: the {scene.name} scene is 3D, whose pairs are summed on the fly (no list of "
+                "every pair); use --pair-loop gather (or auto)"
             )
         if self.requested_pair_loop == "list" and not self.list_fits(scene):
             arrays, pairs = scene.memory_bytes(), pairlist.list_bytes(scene)
@@ -110,14 +125,14 @@ class LinkedListCPU(CellListSolver):
         if self.threads > 1:
             use_threads(self.threads)  # a call into numba only if another solver set another count since
         s = self.scene
-        return sweeps(s.precision, s.kernel, self.threads > 1, across(s))[name](*args)
+        return sweeps(s.precision, s.kernel, self.threads > 1, across(s), s.dims)[name](*args)
 
     def sort_cells(self) -> None:
         """SNP: the search bins the particles (``self.nnps.bin``: particleIndex, cellParticleOrder,
         cellBegin), every per-particle array goes into that order (:meth:`permute`), then the pair list if
         used (x-sorted within each cell first: the list scans x-sorted stencil rows)."""
         a, nnps = self.arrays, self.nnps
-        order = nnps.bin(a["lx"], a["ly"], a["sx"], a["sy"])
+        order = nnps.bin(*(a[name] for name in nnps.positions))
         if self.pairs is not None:
             cpu_sorting().sort_cells_by_x(order, nnps.begin, a["lx"], a["sx"], self.scene.dx)
         self.permute(order)

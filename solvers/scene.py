@@ -59,6 +59,11 @@ MIN_CFL = 1e-3  # the smallest cfl: 1e7 steps of it cross 1e4 cells, a step smal
 # The domain: the scene kind's default (solvers/scenes/) where not given.
 DOMAIN = ("x_min", "x_max", "y_min", "y_max")
 PAPER_DOMAIN = {"x_min": -10.0, "x_max": 40.0, "y_min": -10.0, "y_max": 10.0}
+DEPTH = ("z_min", "z_max")  # a 3D scene's z extent (a 2D scene's stays None)
+PAPER_DEPTH = {"z_min": -10.0, "z_max": 10.0}  # a 3D kind's where it states none
+# Arrays a 3D particle holds beyond a 2D one's: its z lattice coordinate and displacement, w, the z rate (and their
+# copies and sums), counted generously like FLOAT_ARRAYS_PER_PARTICLE
+FLOAT_ARRAYS_3D = 8
 # Parameters whose default is the scene kind's where it states one (SceneKind.defaults), else these (the paper's;
 # a body's radius only where the kind has a body).
 PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
@@ -88,6 +93,8 @@ class Scene:
     x_max: float | None = None
     y_min: float | None = None
     y_max: float | None = None
+    z_min: float | None = None  # a 3D scene's depth, m (None: the kind's; a 2D scene has none)
+    z_max: float | None = None
     strip_height: float | None = None  # replaces [y_min, y_max] by a centred strip
     rho0: float = 1.0
     c0: float = 1.0
@@ -109,10 +116,10 @@ class Scene:
     # The scene's parameters, flat: its keywords, its record's columns and its options (pcabench/parameters.py),
     # in this order; the method's and the edges' are read through from those values.
     PARAMETERS: ClassVar[tuple] = (
-        "dx", "name", "x_min", "x_max", "y_min", "y_max", "strip_height", "rho0", "c0", "mach", "pulse_width",
-        "pulse_center", "cylinder_radius", "boundary_method", "probes", "open", "layer_width", "absorber",
-        "absorber_strength", "h_factor", "cutoff_factor", "kernel", "correction", "cfl", "model", "integrator",
-        "precision", "steps", "t_end", "blowup_factor",
+        "dx", "name", "x_min", "x_max", "y_min", "y_max", "z_min", "z_max", "strip_height", "rho0", "c0", "mach",
+        "pulse_width", "pulse_center", "cylinder_radius", "boundary_method", "probes", "open", "layer_width",
+        "absorber", "absorber_strength", "h_factor", "cutoff_factor", "kernel", "correction", "cfl", "model",
+        "integrator", "precision", "steps", "t_end", "blowup_factor",
     )  # fmt: skip
 
     def __init__(self, dx: float, name: str = DEFAULT_SCENE, *, method=None, edges=None, **given) -> None:
@@ -209,6 +216,9 @@ class Scene:
         for key in DOMAIN:
             if getattr(self, key) is None:
                 object.__setattr__(self, key, kind.domain.get(key, PAPER_DOMAIN[key]))
+        for key in DEPTH:
+            if getattr(self, key) is None and kind.dims == 3:
+                object.__setattr__(self, key, kind.domain.get(key, PAPER_DEPTH[key]))
         for key in PER_KIND:
             if getattr(self, key) is None:
                 object.__setattr__(self, key, kind.defaults.get(key, PAPER_PULSE.get(key)))
@@ -220,6 +230,11 @@ class Scene:
             raise SceneError(f"--probe takes points x,y in m (got {self.probes!r})") from None
         object.__setattr__(self, "probes", points)
         self._validate()
+
+    @property
+    def dims(self) -> int:
+        """The scene's dimension, 2 or 3: its kind's (solvers/scenes/)."""
+        return self.kind.dims
 
     # ------------------------------------------------------------ validation
     def _validate(self) -> None:
@@ -255,11 +270,12 @@ class Scene:
             )
         need(self.x_max > self.x_min, f"x_max must be > x_min (got {self.x_min}..{self.x_max})")
         need(self.y_max > self.y_min, f"y_max must be > y_min (got {self.y_min}..{self.y_max})")
+        self._validate_depth(need, finite)
         if self.strip_height is not None:
             finite("strip_height")
             need(self.strip_height > 0, f"strip_height must be > 0 m (got {self.strip_height})")
         # the particle count in floating point first: a tiny dx must not overflow an integer
-        count = (self.x_max - self.x_min) / self.dx * (self.height_span / self.dx)
+        count = (self.x_max - self.x_min) / self.dx * (self.height_span / self.dx) * self.layers_span
         if not count <= 2**31 - 1:
             limit, smallest = self.memory_limit(), self.dx_for_particles(2**31 - 1)
             if limit is None:
@@ -314,7 +330,12 @@ class Scene:
             f"3 cutoffs = {least:.6g} m at dx = {self.dx} (the kernel support plus the 3x3 cell "
             f"stencil; got {self.height:.6g} m after rounding to whole rows of dx)",
         )
-        need(self.nx >= 1 and self.ny >= 1, f"dx = {self.dx} m is larger than the domain")
+        need(self.nx >= 1 and self.ny >= 1 and self.nz >= 1, f"dx = {self.dx} m is larger than the domain")
+        need(
+            not self.periodic_z or self.depth >= least * (1 - 1e-9),
+            f"z_max - z_min must be at least 3 cutoffs = {least:.6g} m at dx = {self.dx} for the z-periodic "
+            f"{self.name} scene (got {self.depth:.6g} m)",
+        )
         if self.periodic_x or self.kind.walls:
             need(
                 self.width >= least * (1 - 1e-9),
@@ -342,6 +363,23 @@ class Scene:
                 f"{self.memory_bytes() / 2**30:.3g} GiB, more than the {limit / 2**30:.3g} GiB available; "
                 f"the smallest dx that fits is about {self.smallest_dx_fitting(limit):.3g} m",
             )
+
+    def _validate_depth(self, need, finite) -> None:
+        """A 3D scene's z extent (and its kernel normalised in 3D, a solver-free method it can run); a 2D
+        scene's none."""
+        if self.dims == 2:
+            for key in DEPTH:
+                need(getattr(self, key) is None, f"{key}: the {self.name} scene is 2D (it has no z extent)")
+            return
+        for key in DEPTH:
+            finite(key)
+        need(self.z_max > self.z_min, f"z_max must be > z_min (got {self.z_min}..{self.z_max})")
+        need(self.strip_height is None, f"--strip-height: the {self.name} scene is 3D (a strip is a 2D scene's)")
+        need(not self.probes, f"--probe: the {self.name} scene is 3D, whose probes are not built yet")
+        try:
+            self.sph_kernel.in_dims(3)
+        except ValueError as exc:
+            need(False, str(exc))
 
     def probe_points(self) -> dict:
         """{name: (x, y)}: where a run records drho (the scene kind's points, then ``probes`` as P1, P2, ...), m."""
@@ -475,6 +513,11 @@ class Scene:
         return "y" in self.kind.periodic and not self.edges.open_y
 
     @property
+    def periodic_z(self) -> bool:
+        """Whether a 3D lattice is periodic in z (False for a 2D scene)."""
+        return self.dims == 3 and "z" in self.kind.periodic
+
+    @property
     def boundaries(self) -> frozenset:
         """The boundary kinds a solver needs for this scene (free-x, periodic-x, wall-x, free-y, periodic-y)."""
         return self.kind.boundaries(self)
@@ -517,6 +560,23 @@ class Scene:
         return max(int(round(span / self.dx)), 0) + 2 * self.layer_rows
 
     @property
+    def nz(self) -> int:
+        """Lattice layers in z: a 3D scene's (the periodic depth is nz * dx), 1 for a 2D scene."""
+        if self.dims == 2:
+            return 1
+        return max(int(round((self.z_max - self.z_min) / self.dx)), 0)
+
+    @property
+    def depth(self) -> float:
+        """Depth of a 3D lattice in z, m (the period where z is periodic); 0 for a 2D scene."""
+        return self.nz * self.dx if self.dims == 3 else 0.0
+
+    @property
+    def z_lo(self) -> float:
+        """Front of a 3D lattice in z, m (0 for a 2D scene)."""
+        return self.z_min if self.dims == 3 else 0.0
+
+    @property
     def height(self) -> float:
         """Height of the lattice in y, m (a whole number of rows; the period where y is periodic)."""
         return self.ny * self.dx
@@ -546,12 +606,12 @@ class Scene:
 
     @property
     def n_particles(self) -> int:
-        return self.nx * self.ny
+        return self.nx * self.ny * self.nz
 
     @property
     def n_scored(self) -> int:
         """The particles of the scored domain: all of them, but an open edge's layers (the run's output)."""
-        return (self.nx - 2 * self.layer_columns) * (self.ny - 2 * self.layer_rows)
+        return (self.nx - 2 * self.layer_columns) * (self.ny - 2 * self.layer_rows) * self.nz
 
     # ------------------------------------------------------------ time
     @property
@@ -584,30 +644,54 @@ class Scene:
 
     def memory_bytes(self) -> int:
         """Upper bound of the memory the particle arrays need, bytes (a pair list, where used, comes on top)."""
-        return self.n_particles * bytes_per_particle(self.precision, self.extra_arrays)
+        return self.n_particles * bytes_per_particle(self.precision, self.extra_arrays + self.arrays_3d)
+
+    @property
+    def arrays_3d(self) -> int:
+        """Arrays per particle a 3D scene holds beyond a 2D one's (FLOAT_ARRAYS_3D; 0 in 2D)."""
+        return FLOAT_ARRAYS_3D if self.dims == 3 else 0
 
     @property
     def extra_arrays(self) -> int:
         """Arrays per particle the method keeps beyond the standard solver's: its correction's and its
         integrator's (INTEGRATOR_ARRAYS)."""
         try:
-            corrected = int(correction_named(self.correction).arrays)
+            correction = correction_named(self.correction)
+            corrected = int(
+                getattr(correction, "arrays_3d", correction.arrays) if self.dims == 3 else correction.arrays
+            )
         except ValueError:
             corrected = 0
         return corrected + INTEGRATOR_ARRAYS.get(self.integrator, 0)
 
     def smallest_dx_fitting(self, limit_bytes: float) -> float:
         """The smallest lattice spacing whose arrays fit in ``limit_bytes``, m."""
-        area = (self.x_max - self.x_min) * self.height_span
-        return math.sqrt(area * bytes_per_particle(self.precision, self.extra_arrays) / max(limit_bytes, 1))
+        extent = (self.x_max - self.x_min) * self.height_span * self.depth_span
+        per = bytes_per_particle(self.precision, self.extra_arrays + self.arrays_3d)
+        return (
+            math.sqrt(extent * per / max(limit_bytes, 1))
+            if self.dims == 2
+            else math.cbrt(extent * per / max(limit_bytes, 1))
+        )
 
     def dx_for_particles(self, n: float) -> float:
         """The lattice spacing that gives about ``n`` particles on this domain, m."""
-        return math.sqrt((self.x_max - self.x_min) * self.height_span / n)
+        extent = (self.x_max - self.x_min) * self.height_span * self.depth_span
+        return math.sqrt(extent / n) if self.dims == 2 else math.cbrt(extent / n)
 
     @property
     def height_span(self) -> float:
         return self.strip_height if self.strip_height is not None else self.y_max - self.y_min
+
+    @property
+    def layers_span(self) -> float:
+        """The z layers of a 3D scene's domain, (z_max - z_min) / dx, before rounding; 1 for a 2D scene."""
+        return (self.z_max - self.z_min) / self.dx if self.dims == 3 else 1.0
+
+    @property
+    def depth_span(self) -> float:
+        """z_max - z_min of a 3D scene, m; 1 for a 2D scene (a factor of its particle count)."""
+        return self.z_max - self.z_min if self.dims == 3 else 1.0
 
     # ------------------------------------------------------------ defaults and rules
     @classmethod
@@ -616,6 +700,8 @@ class Scene:
         are the paper's here, a scene kind's own in :meth:`default_of`)."""
         if name in PAPER_DOMAIN:
             return PAPER_DOMAIN[name]
+        if name in DEPTH:
+            return None  # a 2D scene's; a 3D kind states its own (default_of)
         if name in PAPER_PULSE:
             return PAPER_PULSE[name]
         return cls.keyword_default(name)
@@ -689,7 +775,8 @@ class Scene:
             else ""
         )
         return (
-            f"{scene}{edges}{self.n_particles:,} particles ({self.nx} x {self.ny}), dx = {self.dx:g} m, "
+            f"{scene}{edges}{self.n_particles:,} particles ({self.nx} x {self.ny}"
+            f"{f' x {self.nz}' if self.dims == 3 else ''}), dx = {self.dx:g} m, "
             f"{self.kernel} kernel{corrected}, "
             f"h = {self.h:.4g} m, cutoff = {self.cutoff:.4g} m, dt = {self.dt:.4g} s, "
             f"{self.n_steps} steps to t = {self.t_final:.4g} s, "

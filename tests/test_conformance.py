@@ -192,6 +192,7 @@ def test_a_solver_without_walls_is_refused_a_walled_scene_in_one_line_and_confor
         "plane-pulse-open",
         "acoustic-pulse",
         "acoustic-pulse-open",
+        "acoustic-pulse-3d",
         "cylinder",
     ]
 

@@ -127,6 +127,8 @@ SCENE_FIELDS: dict[str, Field] = {
     "steps": Field(("int", "null"), True, low=1, high=MAX_STEPS),
     "t_end": Field(("number", "null"), True, low=0, high=1e12),
     "strip_height": Field(("number", "null"), low=0, high=1e12),
+    "z_min": Field(("number", "null"), low=-1e12, high=1e12),  # a 3D scene's depth (a 2D one's: null, or absent)
+    "z_max": Field(("number", "null"), low=-1e12, high=1e12),
     "n_particles": Field(("int",), low=0, high=2**31 - 1),
     "n_steps": Field(("int",), True, low=0, high=MAX_STEPS),
     "cutoff": _SCENE_NUMBER,

@@ -48,12 +48,15 @@ class GradientCorrection(Correction):
     name = "gradient"
     summary = "kernel gradient correction (Bonet & Lok): exact for linear fields, energy-keeping form"
     arrays = 14  # M's inverse (3), Gamma (2), w (2), and the moments sweep's and inversion's temporaries
+    arrays_3d = 24  # in 3D: M's inverse (6), Gamma (3), w (3), and the temporaries
 
     def coefficients(self, continuity: bool, momentum: bool) -> tuple:
         """Both sweeps need the volumes (momentum sums drho itself, c0^2 after)."""
         return True, False
 
     def sweep(self, solver, continuity: bool, momentum: bool) -> None:
+        if solver.scene.dims == 3:
+            return self.sweep_3d(solver, continuity, momentum)
         a, k = solver.arrays, solver.k
         lxx, lxy, lyy, gx, gy = self.factors(solver)
         wx, wy = self.scratch(solver)
@@ -72,6 +75,44 @@ class GradientCorrection(Correction):
                 solver._sweep(False, True)
             solver.launch("corrected_momentum", a["ax"], a["ay"], a["drho"], lxx, lxy, lyy, gx, gy, k)
 
+    def sweep_3d(self, solver, continuity: bool, momentum: bool) -> None:
+        """:meth:`sweep` in 3D: L (six components) and Gamma (three) from :meth:`factors_3d` (no split absorber)."""
+        a, k = solver.arrays, solver.k
+        lxx, lxy, lxz, lyy, lyz, lzz, gx, gy, gz = factors = self.factors_3d(solver)
+        wx, wy, wz = self.scratch(solver, 3)
+        if continuity:
+            solver.launch("corrected_velocity", a["u"], a["v"], a["w"], *factors[:6], wx, wy, wz)
+            with solver.swapped(u=wx, v=wy, w=wz):
+                solver._sweep(True, False)
+            solver.launch("corrected_continuity", a["dd"], a["drho"], wx, wy, wz, gx, gy, gz, k)
+        if momentum:
+            with solver.swapped(mass=a["vol"], pr=a["drho"]):
+                solver._sweep(False, True)
+            solver.launch("corrected_momentum", a["ax"], a["ay"], a["az"], a["drho"], *factors, k)
+
+    def factors_3d(self, solver) -> tuple:
+        """(L_xx, L_xy, L_xz, L_yy, L_yz, L_zz, Gamma_x, Gamma_y, Gamma_z) at the current positions, kept as in 2D
+        (:meth:`factors`): L = M^-1 by its adjugate, M's smallest eigenvalue checked first."""
+        key = (solver.reordered, solver.moves)
+        kept = getattr(solver, "correction_factors", None)
+        if kept is not None and kept[0] == key:
+            return kept[1]
+        solver.correction_factors = None
+        xx, xy, xz, yy, yz, zz, gx, gy, gz = solver.moments()
+        xp = solver.xp
+        m = xp.stack([xp.stack([xx, xy, xz], -1), xp.stack([xy, yy, yz], -1), xp.stack([xz, yz, zz], -1)], -2)
+        smallest = xp.linalg.eigvalsh(m.astype(xp.float64))[:, 0]
+        del m
+        bad = ~(smallest >= SMALLEST_MOMENT)
+        if bool(bad.any()):
+            self.refuse(solver, int(xp.argmax(bad)), float(smallest[int(xp.argmax(bad))]))
+        cxx, cxy, cxz = yy * zz - yz * yz, xz * yz - xy * zz, xy * yz - xz * yy  # the adjugate's (symmetric)
+        cyy, cyz, czz = xx * zz - xz * xz, xy * xz - xx * yz, xx * yy - xy * xy
+        det = xx * cxx + xy * cxy + xz * cxz
+        factors = (cxx / det, cxy / det, cxz / det, cyy / det, cyz / det, czz / det, gx, gy, gz)
+        solver.correction_factors = (key, factors)
+        return factors
+
     def unused(self, solver):
         """A one-element array of the solver's type: the x part's slot where there is none."""
         kept = getattr(solver, "correction_unused", None)
@@ -80,13 +121,13 @@ class GradientCorrection(Correction):
             solver.correction_unused = kept
         return kept
 
-    def scratch(self, solver) -> tuple:
-        """(w_x, w_y): what the corrected continuity sweep sums, made anew from the state at every PI (so never
-        reordered), kept from one PI to the next."""
+    def scratch(self, solver, count: int = 2) -> tuple:
+        """(w_x, w_y) (and w_z: ``count`` 3): what the corrected continuity sweep sums, made anew from the state at
+        every PI (so never reordered), kept from one PI to the next."""
         kept = getattr(solver, "correction_scratch", None)
         n = solver.scene.n_particles
-        if kept is None or kept[0].shape[0] != n or kept[0].dtype != solver.dtype:
-            kept = tuple(solver.xp.zeros(n, solver.dtype) for _ in range(2))
+        if kept is None or len(kept) != count or kept[0].shape[0] != n or kept[0].dtype != solver.dtype:
+            kept = tuple(solver.xp.zeros(n, solver.dtype) for _ in range(count))
             solver.correction_scratch = kept
         return kept
 
@@ -125,8 +166,9 @@ class GradientCorrection(Correction):
         s, a = solver.scene, solver.arrays
         x = s.x_lo + (float(a["lx"][i]) + 0.5) * s.dx + float(a["sx"][i])
         y = s.y_lo + (float(a["ly"][i]) + 0.5) * s.dx + float(a["sy"][i])
+        z = f", {s.z_lo + (float(a['lz'][i]) + 0.5) * s.dx + float(a['sz'][i]):.6g}" if s.dims == 3 else ""
         raise SingularMoments(
-            f"--correction gradient: the particle at ({x:.6g}, {y:.6g}) m has a moment matrix with smallest "
+            f"--correction gradient: the particle at ({x:.6g}, {y:.6g}{z}) m has a moment matrix with smallest "
             f"eigenvalue {smallest:.3g} (at least {SMALLEST_MOMENT:g}; 1 inside the lattice): too few neighbours "
             f"within the cutoff ({s.cutoff / s.dx:.3g} dx at h = {s.h_factor:g} dx) to correct its gradient"
         )

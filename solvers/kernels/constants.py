@@ -32,6 +32,8 @@ WALL_HI = 11  # 1 where a rigid wall is the lattice's right edge, else 0
 MIRROR_HI = 12  # 2 nx - 1: the right wall mirrors lattice column lx onto column MIRROR_HI - lx (the left: -1 - lx)
 ONE = 13  # 1 in the solver's float type
 SLOTS = 14
+NZ = 14  # a 3D scene's lattice layers in the periodic depth, 0 where the z faces are free (2D tuples stop at SLOTS)
+SLOTS_3D = 15
 
 
 def constants(scene, dtype) -> tuple:
@@ -42,7 +44,7 @@ def constants(scene, dtype) -> tuple:
         SPACING: scene.dx,
         NY: float(scene.ny) if scene.periodic_y else 0.0,
         INV_H2: 1.0 / (h * h),
-        GRAD0: scene.sph_kernel.grad0(h),
+        GRAD0: scene.sph_kernel.grad0(h, **scene.sph_kernel.in_dims(scene.dims)),
         RC2: scene.cutoff**2,
         RHO0: scene.rho0,
         C0SQ: scene.c0**2,
@@ -54,8 +56,11 @@ def constants(scene, dtype) -> tuple:
         MIRROR_HI: float(2 * scene.nx - 1),
         ONE: 1.0,
     }
+    slots = SLOTS
+    if scene.dims == 3:
+        values[NZ], slots = (float(scene.nz) if scene.periodic_z else 0.0), SLOTS_3D
     t = np.dtype(dtype).type
-    return tuple(t(values[i]) for i in range(SLOTS))
+    return tuple(t(values[i]) for i in range(slots))
 
 
 def exp_neg_math(x):

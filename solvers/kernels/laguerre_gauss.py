@@ -6,6 +6,8 @@ Fourier transform is 1 + O(k^4 h^4) (the Gaussian's exp(-k^2 h^2 / 4) is second 
 gradient correction (solvers/corrections/), h >= 1.5 dx and a 4 h cutoff the lattice operator is fourth
 order. It is negative beyond q = sqrt(2), a known source of the tensile instability once particles move.
 G(r) = W'(r) / r = -2 (3 - q^2) exp(-q^2) / (pi h^4) (1/m^4), G(0) = -6 / (pi h^4).
+In d dimensions W = (d/2 + 1 - q^2) exp(-q^2) / (pi^(d/2) h^d), G = -2 (d/2 + 2 - q^2) exp(-q^2) /
+(pi^(d/2) h^(d+2)): in 3D (5/2 - q^2) exp(-q^2) / (pi^1.5 h^3), G(0) = -7 / (pi^1.5 h^5).
 """
 
 from __future__ import annotations
@@ -25,19 +27,25 @@ class LaguerreGauss(Kernel):
     summary = "fourth-order Laguerre-Gauss (2 - q^2) exp(-q^2), truncated at --cutoff (in h; 4 for fourth order)"
     support = None
     norm = 2.0 / math.pi  # W = norm / h^2 (1 - q^2 / 2) exp(-q^2)
-    negative_lobe = True  # beyond q = sqrt(2)
+    negative_lobe = True  # beyond q = sqrt(2) (2D), sqrt(5/2) (3D)
+    dimensions = (2, 3)
+    norms = {2: 2.0 / math.pi, 3: 2.5 * math.pi**-1.5}  # W(0) h^d
 
-    def value(self, r, h: float):
+    def value(self, r, h: float, dims: int = 2):
         q2 = (np.asarray(r, dtype=np.float64) / h) ** 2
+        if dims == 3:
+            return (2.5 - q2) * np.exp(-q2) / (math.pi**1.5 * h**3)
         return (2.0 - q2) * np.exp(-q2) / (math.pi * h * h)
 
-    def gradient(self, r, h: float):
+    def gradient(self, r, h: float, dims: int = 2):
         q2 = (np.asarray(r, dtype=np.float64) / h) ** 2
+        if dims == 3:
+            return -2.0 * (3.5 - q2) * np.exp(-q2) / (math.pi**1.5 * h**5)
         return -2.0 * (3.0 - q2) * np.exp(-q2) / (math.pi * h**4)
 
-    def compiled_gradient(self, dtype, exp_neg):
-        """G(0) (1 - q^2 / 3) exp(-q^2) through the caller's ``exp_neg``."""
-        one, third = np.dtype(dtype).type(1.0), np.dtype(dtype).type(1.0 / 3.0)
+    def compiled_gradient(self, dtype, exp_neg, dims: int = 2):
+        """G(0) (1 - q^2 / (d/2 + 2)) exp(-q^2) through the caller's ``exp_neg`` (1/3 in 2D, 2/7 in 3D)."""
+        one, third = np.dtype(dtype).type(1.0), np.dtype(dtype).type(1.0 / 3.0 if dims == 2 else 2.0 / 7.0)
 
         def gradient(r2, k):
             q2 = r2 * k[INV_H2]

@@ -35,12 +35,28 @@ def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True)
     return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision, across)
 
 
-def pair_sources(kernel: str = DEFAULT_KERNEL) -> tuple:
+@lru_cache(maxsize=None)
+def cpu_pairs3d(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True):
+    """The 3D pair functions (solvers/physics/pairs3d.py) for numba's CPU target, as :func:`cpu_pairs`."""
+    import numba
+
+    from solvers.kernels.constants import make_exp_neg_table
+    from solvers.physics.pairs3d import make_pairs3d
+
+    return make_pairs3d(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision, across)
+
+
+def pair_sources(kernel: str = DEFAULT_KERNEL, dims: int = 2) -> tuple:
     """What the compiled pair functions are made of, for the cache's key (solvers/jitcache.py): the pair
     physics, the constant tuple and exp(-x), this module, and the kernel's own file (a plug-in's too)."""
     from solvers.kernels import kernel_named
 
-    return ("solvers.physics.pairs", "solvers.kernels.constants", "solvers.physics.backend", type(kernel_named(kernel)))
+    return (
+        "solvers.physics.pairs3d" if dims == 3 else "solvers.physics.pairs",
+        "solvers.kernels.constants",
+        "solvers.physics.backend",
+        type(kernel_named(kernel)),
+    )
 
 
 def cpu_loops(
@@ -56,12 +72,13 @@ def cpu_loops(
     options = {"nogil": True} if parallel is None else {"nogil": True, "parallel": parallel}
     options.update(LOOP_OPTIONS.get(template, {}))
     names = COMPILED[template]
+    pairs = "cpu_pairs3d" if template.endswith("3d") else "cpu_pairs"  # a 3D template's pair functions are 3D
     return jitcache.specialise(
         module,
-        bind={"P": f"cpu_pairs({precision!r}, {kernel!r}, {across!r})", **{k: repr(v) for k, v in bind.items()}},
+        bind={"P": f"{pairs}({precision!r}, {kernel!r}, {across!r})", **{k: repr(v) for k, v in bind.items()}},
         functions={name: ("numba.njit", options) for name in names},
-        imports=("import numba", "from solvers.physics.backend import cpu_pairs"),
-        depends=pair_sources(kernel),
+        imports=("import numba", f"from solvers.physics.backend import {pairs}"),
+        depends=pair_sources(kernel, 3 if pairs == "cpu_pairs3d" else 2),
     )
 
 
@@ -89,6 +106,29 @@ COMPILED = {
         "cell_ids",
     ),
     "allpair": ("continuity", "momentum", "moments", "neighbours"),
+    "cells3d": (
+        "continuity",
+        "momentum",
+        "moments",
+        "neighbours",
+        "cell_ids",
+        "kick",
+        "advance",
+        "corrected_velocity",
+        "corrected_continuity",
+        "corrected_momentum",
+    ),
+    "allpair3d": (
+        "continuity",
+        "momentum",
+        "moments",
+        "neighbours",
+        "kick",
+        "advance",
+        "corrected_velocity",
+        "corrected_continuity",
+        "corrected_momentum",
+    ),
     "pairlist": ("build", "continuity", "continuity_split", "momentum", "moments"),
 }
 LOOP_OPTIONS = {"pairlist": {"error_model": "numpy"}}

@@ -4,7 +4,8 @@ A scene kind is one class (one file in solvers/scenes/, or a plug-in through
 the entry-point group ``pcabench.scenes``) with a ``name``. It states
 
 * ``summary``: one line for --help;
-* ``periodic``: the axes that are periodic ("x", "y"); the others have free
+* ``dims``: 2 (a plane) or 3 (a volume: z too, ``periodic-z`` for a solver);
+* ``periodic``: the axes that are periodic ("x", "y", "z"); the others have free
   edges, except the x edges named in ``walls`` ("x_min", "x_max"), which are
   rigid walls (mirror particles, solvers/physics/pairs.py). :meth:`boundaries` turns
   them into the boundary kinds a solver must support (``free-x``,
@@ -33,7 +34,7 @@ from __future__ import annotations
 
 import math
 
-BOUNDARY_KINDS = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")
+BOUNDARY_KINDS = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "body")
 MACH_RANGE = (1e-6, 0.3)  # amplitudes a scene accepts: acoustic (linear) to weakly nonlinear
 PULSE_WIDTH_RANGE = (0.1, 20.0)  # m
 # Pulse widths about a peak that count as the pulse: beyond them a Gaussian pulse is below 1e-4 of its peak
@@ -109,6 +110,7 @@ class SceneKind:
 
     name: str = ""
     summary: str = ""
+    dims: int = 2  # the dimension of its space: 2, or 3 (z_min, z_max, a z lattice coordinate and velocity)
     periodic: tuple = ("y",)
     walls: tuple = ()  # the x edges that are rigid walls: "x_min", "x_max" (the others free, or periodic)
     domain: dict = {}  # {x_min, x_max, y_min, y_max}: where the kind's default domain differs from Scene's
@@ -144,7 +146,8 @@ class SceneKind:
             if len(self.walls) < 2:
                 x.add("free-x")
         periodic_y = "y" in self.periodic and "y" not in open_edges
-        return frozenset(x | {"periodic-y" if periodic_y else "free-y"} | ({"body"} if self.body else set()))
+        z = {"periodic-z"} if self.dims == 3 and "z" in self.periodic else set()
+        return frozenset(x | {"periodic-y" if periodic_y else "free-y"} | z | ({"body"} if self.body else set()))
 
     def headline(self, t_end: float) -> str:
         """What the headline error (``mse``) of a run to ``t_end`` (s) measures, in words."""

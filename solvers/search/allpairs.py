@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from solvers.interface import POSITIONS
+
 
 class AllPairs:
     """No cells: the pair loops take the positions alone and test every pair against the cutoff (the minimum
@@ -16,7 +18,7 @@ class AllPairs:
 
     def arguments(self, arrays) -> tuple:
         """What every pair loop takes first: the positions."""
-        return arrays["lx"], arrays["ly"], arrays["sx"], arrays["sy"]
+        return tuple(arrays[name] for name in POSITIONS[self.scene.dims])
 
     def count(self, arrays, k) -> int:
         """Neighbours within the cutoff summed over particles (nothing is changed)."""

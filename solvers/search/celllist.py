@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from solvers.interface import Solver, cell_grid, tiny_scene
+from solvers.interface import POSITIONS, Solver, cell_grid, cell_grid_3d, tiny_scene
 from solvers.physics.backend import cpu_sorting
 
 
@@ -55,6 +55,46 @@ class CellGrid:
         the grid."""
         return dx, self.x_grid, self.width, self.height, self.cw, self.ch, self.ncx, self.ncy
 
+    @property
+    def shape(self) -> tuple:
+        """The cell counts along each axis (what the stencil loops take after cellBegin)."""
+        return self.ncx, self.ncy
+
+
+@dataclass(frozen=True)
+class CellGrid3D:
+    """The uniform grid of a 3D scene (solvers.interface.cell_grid_3d): cells ``cw`` x ``ch`` x ``cd`` m,
+    ``ncx`` x ``ncy`` x ``ncz`` of them, numbered (cz ncy + cy) ncx + cx; ``x_grid`` and the periods as in 2D
+    (``depth``: z's, 0 where z is not periodic)."""
+
+    cw: float
+    ch: float
+    cd: float
+    ncx: int
+    ncy: int
+    ncz: int
+    x_grid: float
+    width: float
+    height: float
+    depth: float
+
+    @classmethod
+    def of(cls, scene) -> CellGrid3D:
+        return cls(*cell_grid_3d(scene))
+
+    @property
+    def ncells(self) -> int:
+        return self.ncx * self.ncy * self.ncz
+
+    def index_arguments(self, dx: float) -> tuple:
+        """:meth:`CellGrid.index_arguments` with z's."""
+        g = self
+        return dx, g.x_grid, g.width, g.height, g.depth, g.cw, g.ch, g.cd, g.ncx, g.ncy, g.ncz
+
+    @property
+    def shape(self) -> tuple:
+        return self.ncx, self.ncy, self.ncz
+
 
 class CellList:
     """The paper's cell list on the CPU: particleIndex (``cell``), cellParticleOrder (``order``) and cellBegin
@@ -67,7 +107,8 @@ class CellList:
 
     def __init__(self, scene, launch, xp=np):
         self.scene, self.launch, self.xp = scene, launch, xp
-        self.grid = CellGrid.of(scene)
+        self.grid = CellGrid3D.of(scene) if scene.dims == 3 else CellGrid.of(scene)
+        self.positions = POSITIONS[scene.dims]  # the arrays it bins: lattice coordinates, then displacements
         self.ncells = self.grid.ncells
         self.valid = False  # whether the cells are those of the current positions
         self.allocate()
@@ -81,10 +122,10 @@ class CellList:
         # neighbour load (measured 20-25 % faster sweeps)
         self.begin = np.zeros(self.ncells + 1, np.uint32)
 
-    def bin(self, lx, ly, sx, sy):
-        """particleIndex, cellParticleOrder and cellBegin for particles at lattice sites ``lx, ly`` shifted by
-        ``sx, sy`` (m); returns cellParticleOrder, the order to put the particle arrays in."""
-        self.cell_ids(lx, ly, sx, sy)
+    def bin(self, *positions):
+        """particleIndex, cellParticleOrder and cellBegin for particles at lattice sites ``lx, ly`` (and ``lz``)
+        shifted by ``sx, sy`` (and ``sz``, m); returns cellParticleOrder, the order to put the particle arrays in."""
+        self.cell_ids(*positions)
         order, begin = self.cell_order()
         if begin is not self.begin:
             self.begin[:] = begin
@@ -93,10 +134,11 @@ class CellList:
             np.take(self.cell, self.order, out=self.sorted_cell)
         return self.order
 
-    def cell_ids(self, lx, ly, sx, sy) -> None:
-        """particleIndex of every particle, into ``self.cell`` (a particle past a periodic seam has its lattice
-        coordinates moved by a period first: the same position)."""
-        self.launch("cell_ids", lx, ly, sx, sy, self.cell, *self.grid.index_arguments(self.scene.dx))
+    def cell_ids(self, *positions) -> None:
+        """particleIndex of every particle at ``positions`` (lx, ly, sx, sy; in 3D lz and sz too), into
+        ``self.cell`` (a particle past a periodic seam has its lattice coordinates moved by a period first: the
+        same position)."""
+        self.launch("cell_ids", *positions, self.cell, *self.grid.index_arguments(self.scene.dx))
 
     def cell_order(self) -> tuple:
         """(cellParticleOrder, cellBegin) for the cells in ``self.cell`` (particleIndex): the permutation
@@ -113,17 +155,16 @@ class CellList:
 
     def arguments(self, arrays) -> tuple:
         """What every stencil loop takes first: the cells, cellBegin, the grid's shape and the positions."""
-        a = arrays
-        return self.cell, self.begin, self.grid.ncx, self.grid.ncy, a["lx"], a["ly"], a["sx"], a["sy"]
+        return (self.cell, self.begin, *self.grid.shape, *(arrays[name] for name in self.positions))
 
     def count(self, arrays, k) -> int:
         """Neighbours within the cutoff summed over particles at the positions in ``arrays``, on a search of
         its own over copies of the positions: ``arrays`` and this search are left as they are."""
         fresh = type(self)(self.scene, self.launch, self.xp)
-        copies = [arrays[name].copy() for name in ("lx", "ly", "sx", "sy")]  # the kernel may wrap them
+        copies = [arrays[name].copy() for name in self.positions]  # the kernel may wrap them
         order = fresh.bin(*copies)
         fresh.settle()
-        positions = dict(zip(("lx", "ly", "sx", "sy"), (arr[order] for arr in copies)))
+        positions = dict(zip(self.positions, (arr[order] for arr in copies)))
         return int(self.launch("neighbours", *fresh.arguments(positions), k))
 
 
