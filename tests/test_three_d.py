@@ -143,3 +143,81 @@ def test_the_gradient_correction_in_3d_agrees_across_solvers_and_removes_the_lat
         for name, s in (("corrected", scene), ("standard", standard))
     }
     assert error["corrected"] < 0.9 * error["standard"], error
+
+
+@pytest.mark.parametrize(
+    "scene_words",
+    [
+        ("--scene", "acoustic-pulse-3d", "--dx", "1", "--kernel", "wendland-c2", "--h-factor", "1.3"),
+        ("--scene", "acoustic-pulse", "--dx", "1"),
+    ],
+    ids=["3d", "2d"],
+)
+def test_fields_as_vtu_read_back_by_meshio_hold_the_npz_values(tmp_path, capsys, scene_words):
+    """``--fields NAME.vtu`` writes the particles as a VTK unstructured grid (meshio): its points, drho and the
+    velocity vector are the .npz's (z and w zero in 2D)."""
+    meshio = pytest.importorskip("meshio")
+    from pcabench.execute.run import load_fields
+
+    common = ("run", "--solver", "linkedlist-cpu", *scene_words, "--steps", "3", "--model", "linear", "--quiet")
+    for name in ("f.npz", "f.vtu"):
+        rc, out, err = cli_main(*common, "--fields", str(tmp_path / name), capsys=capsys)
+        assert rc == 0, err
+    npz, mesh = load_fields(tmp_path / "f.npz"), meshio.read(tmp_path / "f.vtu")
+    third = np.zeros_like(npz.x) if npz.z is None else npz.z
+    assert np.array_equal(mesh.points, np.column_stack([npz.x, npz.y, third]))
+    assert np.array_equal(mesh.point_data["drho"], npz.drho) and np.abs(npz.drho).max() > 0
+    w = np.zeros_like(npz.u) if npz.w is None else npz.w
+    assert np.array_equal(mesh.point_data["velocity"], np.column_stack([npz.u, npz.v, w]))
+    assert mesh.cells[0].type == "vertex" and len(mesh.cells[0].data) == npz.x.size
+
+
+@pytest.mark.parametrize(
+    "method",
+    [dict(), dict(correction="gradient", integrator="rk4")],
+    ids=["standard-verlet", "corrected-rk4"],
+)
+def test_a_linear_3d_run_is_its_dispersion_prediction(method):
+    """The cubic lattice's symbol D(k) with the integrator's own step matrices, mode by mode (no simulation), is
+    the `linear` run's exact discrete solution on the periodic cube: fields and error equal to round-off. Two
+    independent codes (a particle solver, an FFT of the symbol) that agree to 1e-16 check each other."""
+    from solvers.reference.dispersion3d import predicted_fields
+
+    scene = small(model="linear", **method)
+    run = evolve(make_solver("linkedlist-cpu"), scene).output()
+    drho, u, v, w, t = predicted_fields(scene)
+    assert t == pytest.approx(run.t, rel=1e-12)
+    for name, predicted in (("drho", drho), ("u", u), ("v", v), ("w", w)):
+        field = getattr(run, name)
+        assert np.abs(predicted.ravel() - field).max() < 1e-10 * np.abs(field).max(), name
+    assert scene.kind.predict(scene).predicted_error == pytest.approx(scene.kind.errors(scene, run)["mse"], rel=1e-9)
+
+
+def test_the_3d_stable_cfl_is_the_cubic_lattices_and_a_step_past_it_blows_up():
+    """The largest |D| over the 3D Brillouin zone bounds the step: below the predicted stable CFL a long run holds,
+    past it the same run blows up and is recorded as such (not a crash)."""
+    from pcabench.execute.run import run as run_spec
+    from pcabench.spec import RunSpec
+    from solvers.reference.dispersion import stable_cfl
+
+    limit = stable_cfl(small())
+    assert 1.5 < limit < 3.0  # Wendland C2 at h 1.3 dx: 2.28 on the cube (2.35 on the square)
+    held = run_spec(RunSpec("linkedlist-cpu", small(model="linear", cfl=0.95 * limit, t_end=None, steps=150)))
+    blown = run_spec(RunSpec("linkedlist-cpu", small(model="linear", cfl=1.1 * limit, t_end=None, steps=150)))
+    assert held.status == "ok" and blown.status == "unstable" and 0 < blown.failed_step < 150, (held, blown)
+
+
+def test_the_periodic_pulse_is_smooth_across_the_cubes_faces():
+    """The initial field sums the pulse's periodic images: one period away it is the same to round-off, and its
+    slope across a face is continuous (cut at the faces, the 16 m cube's pulse kinks there at 0.7 % of its peak,
+    a wavenumber content a fourth-order method cannot resolve: the order falls from 4.5 to 2.5)."""
+    from solvers.scenes.acoustic_pulse_3d import periodic_pulse
+
+    scene = Scene(0.5, "acoustic-pulse-3d", pulse_center=1.0)
+    side, y, z = 16.0, np.array([0.3]), np.array([-2.0])
+    x = np.array([-8.0, 8.0])
+    assert np.allclose(*periodic_pulse(scene, x, y, z), rtol=1e-13)
+    e = 1e-5
+    slope = [(periodic_pulse(scene, x0 + e, y, z) - periodic_pulse(scene, x0 - e, y, z)) / (2 * e) for x0 in x]
+    assert np.allclose(*slope, rtol=1e-6) and abs(slope[0][0]) > 1e-6  # the same slope both sides of the seam
+    assert side == scene.x_max - scene.x_min

@@ -59,7 +59,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--fields",
-        help="write the final fields (x, y, u, v, drho, t) to this .npz (a folder: a file named by the run in it)",
+        help="write the final fields (x, y, u, v, drho, t; z, w in 3D) to this .npz (a folder: a file named by the "
+        "run in it), or NAME.vtu: a VTK unstructured grid of the particles with drho and the velocity vector, "
+        "which ParaView opens (meshio: the extra vtk)",
     )
     p.add_argument(
         "--store",

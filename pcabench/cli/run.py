@@ -26,8 +26,10 @@ def cmd_run(args) -> int:
     if args.fields is not None:
         if args.fields.strip() and (args.fields.endswith("/") or Path(args.fields).is_dir()):
             args.fields = str(Path(args.fields) / fields_name(spec))  # a folder: a file named by the run in it
-        elif args.fields.strip() and not args.fields.endswith(".npz"):
+        elif args.fields.strip() and not args.fields.endswith((".npz", ".vtu")):
             args.fields += ".npz"  # as numpy.savez names it
+        if args.fields.endswith(".vtu") and vtu_available():
+            raise OptionError(vtu_available())
         check_output_path(args.fields, "--fields")
     if args.run_budget is not None and not args.run_budget > 0:
         raise OptionError(f"--run-budget must be > 0 seconds (got {args.run_budget})")
@@ -60,6 +62,13 @@ def cmd_run(args) -> int:
     for what, path in went:  # where they went (on stderr beside --json's one object)
         print(f"{what:<17}{path}", file=sys.stderr if args.json else sys.stdout)
     return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
+
+
+def vtu_available() -> str:
+    """'' where a .vtu can be written here, else the one line that says how (pcabench/execute/vtu.py)."""
+    from pcabench.execute.vtu import available
+
+    return available()
 
 
 def fields_name(spec: RunSpec) -> str:

@@ -27,6 +27,14 @@ from solvers.reference.dispersion import predicted_primary
 from solvers.scenes.base import scored_axes
 
 FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.interface.Fields), each one per particle
+FIELD_NAMES_3D = ("z", "w")  # and a 3D run's
+
+
+def field_names(fields) -> tuple:
+    """The per-particle fields ``fields`` holds: FIELD_NAMES, and a 3D run's z and w."""
+    return FIELD_NAMES + (FIELD_NAMES_3D if getattr(fields, "z", None) is not None else ())
+
+
 PROBE_SAMPLES = 1000  # the most readings a run records at each probe point (every few steps, evenly)
 
 
@@ -38,7 +46,7 @@ def fields_problem(fields, n_particles: int, t_expected: float | None = None) ->
     scene's ``n_scored``: an open edge's layers are not in them): an array of another length, or values that
     are not finite, or a time that is not, or (``t_expected``: the steps taken x dt, s) another time than the
     steps reach: a solver's word for its own time is checked, never taken."""
-    for name in FIELD_NAMES:
+    for name in field_names(fields):
         values = np.asarray(getattr(fields, name))
         if values.shape != (n_particles,):
             return f"its field {name} has shape {values.shape}, not ({n_particles},) (one value per particle)"
@@ -118,14 +126,19 @@ def _measure(record: RunRecord, scene, fields) -> None:
 
 
 def save_fields(fields, path) -> None:
-    """Write a run's final fields to the .npz ``path`` (safeio: whole or not at all, no link followed)."""
+    """Write a run's final fields to the .npz ``path`` (safeio: whole or not at all, no link followed), or to a
+    VTK unstructured grid where ``path`` ends in .vtu (pcabench/execute/vtu.py: ParaView opens it)."""
     import io
 
     from pcabench.store.safeio import write_file
 
+    if str(path).endswith(".vtu"):
+        from pcabench.execute.vtu import write_vtu
+
+        return write_vtu(fields, path)
     buffer = io.BytesIO()
     probes = {f"probe.{k}": np.asarray(v, dtype=np.float64) for k, v in (fields.probes or {}).items()}
-    np.savez(buffer, **{name: getattr(fields, name) for name in FIELD_NAMES}, t=fields.t, **probes)
+    np.savez(buffer, **{name: getattr(fields, name) for name in field_names(fields)}, t=fields.t, **probes)
     write_file(path, buffer.getvalue())
 
 
@@ -136,7 +149,8 @@ def load_fields(path):
 
     with np.load(path, allow_pickle=False) as data:
         probes = {k[len("probe.") :]: data[k] for k in data.files if k.startswith("probe.")}
-        return Fields(**{name: data[name] for name in FIELD_NAMES}, t=float(data["t"]), probes=probes or None)
+        third = {name: data[name] for name in FIELD_NAMES_3D if name in data.files}
+        return Fields(**{name: data[name] for name in FIELD_NAMES}, **third, t=float(data["t"]), probes=probes or None)
 
 
 class Probes:

@@ -70,19 +70,32 @@ class Lattice3D:
 
 
 def periodic_linear(
-    n: tuple, dx: float, lo: tuple, centre: tuple, width: float, mach: float, rho0: float, c0: float, t: float
+    n: tuple,
+    dx: float,
+    lo: tuple,
+    centre: tuple,
+    width: float,
+    mach: float,
+    rho0: float,
+    c0: float,
+    t: float,
+    initial=None,
 ) -> Lattice3D:
     """The exact linear solution on the triply periodic lattice of ``n`` = (nx, ny, nz) sites from corner ``lo``
-    (m) at ``t`` (s): the sampled initial pulse (centred at ``centre``, m, by its nearest image) with every
-    Fourier mode advanced by w = c0 |k|."""
+    (m) at ``t`` (s): the sampled initial drho (``initial(x, y, z)``, kg/m^3; by default the pulse centred at
+    ``centre``, m, by its nearest image) with every Fourier mode advanced by w = c0 |k|."""
     axes = [lo[d] + (np.arange(n[d]) + 0.5) * dx for d in range(3)]
     periods = [n[d] * dx for d in range(3)]
-    offsets = []
-    for d in range(3):
-        o = axes[d] - centre[d]
-        offsets.append(o - periods[d] * np.round(o / periods[d]))
-    oz, oy, ox = np.meshgrid(offsets[2], offsets[1], offsets[0], indexing="ij")
-    drho0 = rho0 * mach * np.exp(-LN2 * (ox**2 + oy**2 + oz**2) / width**2)
+    if initial is not None:
+        z, y, x = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
+        drho0 = initial(x, y, z)
+    else:
+        offsets = []
+        for d in range(3):
+            o = axes[d] - centre[d]
+            offsets.append(o - periods[d] * np.round(o / periods[d]))
+        oz, oy, ox = np.meshgrid(offsets[2], offsets[1], offsets[0], indexing="ij")
+        drho0 = rho0 * mach * np.exp(-LN2 * (ox**2 + oy**2 + oz**2) / width**2)
     spectrum = np.fft.rfftn(drho0)
     kz = 2 * np.pi * np.fft.fftfreq(n[2], dx)[:, None, None]
     ky = 2 * np.pi * np.fft.fftfreq(n[1], dx)[None, :, None]

@@ -1,0 +1,150 @@
+"""The dispersion prediction on the cubic lattice (a 3D scene's), with no simulation.
+
+The 3D counterpart of solvers/reference/dispersion.py: the `linear` SPH sums act on a plane wave exp(i k.x) as
+i D(k), with
+
+    D(k) = -sum_j V sin(k.x_ij) x_ij G(r_ij)        (V = dx^3, G of the kernel normalised in 3D, r_ij < cutoff)
+
+over the lattice neighbours; each Fourier mode of the cube's initial fields is evolved by the integrator's own
+step matrices (dispersion.ModeSolver) with d = |D(k)|, the velocity's part along D(k) coupled to drho and the
+rest at rest. On the periodic cube this is the `linear` run's exact discrete solution (a run equals it to
+round-off: tests/test_three_d.py), and the largest |D| over the 3D Brillouin zone gives the stable CFL.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from solvers.reference.dispersion import ModeSolver, Prediction, evolve, largest_stable_z, step_phase_angle
+
+SYMBOL_CHUNK = 1 << 21  # wavenumbers x neighbours evaluated at once
+
+
+def lattice_offsets(scene) -> tuple:
+    """(a, b, c, G): the cubic lattice neighbours' offsets in units of dx within the cutoff (the particle itself
+    left out) and the 3D kernel's G(r) at each, 1/m^5."""
+    reach = int(math.ceil(scene.cutoff / scene.dx))
+    span = np.arange(-reach, reach + 1)
+    a, b, c = np.meshgrid(span, span, span, indexing="ij")
+    r = np.sqrt(a**2 + b**2 + c**2) * scene.dx
+    keep = (r < scene.cutoff) & (r > 0)
+    g = scene.sph_kernel.gradient(r[keep], scene.h, dims=3)
+    return a[keep].astype(float), b[keep].astype(float), c[keep].astype(float), g
+
+
+def lattice_factor(scene) -> float:
+    """1 / M_xx inside the cubic lattice for a corrected method (the correction's L is that scalar there), else 1."""
+    if scene.correction == "none":
+        return 1.0
+    a, _b, _c, g = lattice_offsets(scene)
+    moment = -(scene.dx**3) * float((g * (a * scene.dx) ** 2).sum())
+    return 1.0 / moment if math.isfinite(moment) and moment > 0 else 1.0
+
+
+def symbol(scene, kx, ky, kz) -> tuple:
+    """(D_x, D_y, D_z) at wavenumbers (kx, ky, kz), 1/m (arrays broadcast together), in chunks."""
+    a, b, c, g = lattice_offsets(scene)
+    kx, ky, kz = np.broadcast_arrays(*(np.asarray(k, float) for k in (kx, ky, kz)))
+    shape = kx.shape
+    kx, ky, kz = kx.ravel(), ky.ravel(), kz.ravel()
+    out = np.empty((3, kx.size))
+    step = max(1, SYMBOL_CHUNK // max(a.size, 1))
+    for lo in range(0, kx.size, step):
+        part = slice(lo, lo + step)
+        phase = sum(np.multiply.outer(k[part], o * scene.dx) for k, o in ((kx, a), (ky, b), (kz, c)))
+        weight = -(scene.dx**3) * np.sin(phase) * g
+        for i, o in enumerate((a, b, c)):
+            out[i, part] = weight @ (o * scene.dx)
+    scale = lattice_factor(scene)
+    return tuple(scale * row.reshape(shape) for row in out)
+
+
+def largest_symbol(scene, points: int = 33) -> float:
+    """max |D(k)| over the 3D Brillouin zone [0, pi/dx]^3 (the lattice's symmetry covers the rest), 1/m."""
+    k = np.linspace(0.0, math.pi / scene.dx, points)
+    kx, ky, kz = np.meshgrid(k, k, k, indexing="ij")
+    d = symbol(scene, kx.ravel(), ky.ravel(), kz.ravel())
+    return float(np.sqrt(sum(part**2 for part in d)).max())
+
+
+@lru_cache(maxsize=256)
+def lattice_stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str) -> float:
+    """The largest stable CFL of a method on the periodic cubic lattice (the same at every dx: D scales as 1/dx)."""
+    from solvers.scene import Scene
+
+    reach = h_factor * max(cutoff_factor, 2.0)
+    half = math.ceil(1.5 * reach) + 1.0
+    cube = {f"{axis}_{end}": sign * half for axis in "xyz" for end, sign in (("min", -1), ("max", 1))}
+    unit = Scene(
+        1.0, "acoustic-pulse-3d", pulse_width=0.1, model="linear", kernel=kernel, h_factor=h_factor,
+        cutoff_factor=cutoff_factor, integrator=integrator, correction=correction, **cube,
+    )  # fmt: skip
+    return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
+
+
+def stable_cfl(scene) -> float:
+    """:func:`lattice_stable_cfl` of a 3D scene's method."""
+    cut = scene.cutoff_factor
+    return lattice_stable_cfl(scene.kernel, float(scene.h_factor), float(cut), scene.integrator, scene.correction)
+
+
+def predicted_fields(scene) -> tuple:
+    """(drho, u, v, w, t) on the 3D scene's periodic lattice (arrays (nz, ny, nx)) at the run's final time: every
+    lattice Fourier mode evolved by the integrator's step matrices with d = |D(k)|."""
+    axes = [lo + (np.arange(n) + 0.5) * scene.dx for lo, n in ((scene.x_lo, scene.nx), (scene.y_lo, scene.ny),
+                                                                 (scene.z_lo, scene.nz))]  # fmt: skip
+    z, y, x = np.meshgrid(axes[2], axes[1], axes[0], indexing="ij")
+    u0, v0, w0, drho0 = scene.kind.initial_fields(scene, x, y, np, z=z)
+    kz, ky, kx = np.meshgrid(
+        *(2.0 * math.pi * np.fft.fftfreq(n, d=scene.dx) for n in (scene.nz, scene.ny, scene.nx)), indexing="ij"
+    )
+    d3 = symbol(scene, kx, ky, kz)
+    d = np.sqrt(sum(part**2 for part in d3))
+    safe = np.where(d > 0, d, 1.0)
+    e = [np.where(d > 0, part / safe, 0.0) for part in d3]
+    hats = [np.fft.fftn(f) for f in (u0, v0, w0)]
+    along = sum(ei * h for ei, h in zip(e, hats))
+    rest = [h - ei * along for ei, h in zip(e, hats)]  # the part across D(k): no rate, it stays
+    modes = ModeSolver(d.ravel(), np.fft.fftn(drho0).ravel(), along.ravel(), scene.rho0, scene.c0, scene.dt)
+    evolve(modes, scene.integrator, scene.n_steps)
+    along = modes.u.reshape(d.shape)
+    u, v, w = (np.fft.ifftn(r + ei * along).real for r, ei in zip(rest, e))
+    return np.fft.ifftn(modes.drho.reshape(d.shape)).real, u, v, w, modes.t
+
+
+def predict(scene, kind) -> Prediction:
+    """The error of a periodic 3D scene's `linear` run predicted with no simulation (exact), scored with the
+    scene's own measures; the phase errors along the lattice's axis and its body diagonal."""
+    from solvers.interface import Fields
+
+    linear = scene.replace(model="linear")
+    drho, u, v, w, t = predicted_fields(linear)
+    exact = kind.exact_fields(linear, t)
+    fields = Fields(x=exact.x, y=exact.y, z=exact.z, u=u.ravel(), v=v.ravel(), w=w.ravel(), drho=drho.ravel(), t=t)
+    measures = kind.errors(linear, fields)
+    axis, diagonal = phase_errors(scene, (1.0, 0.0, 0.0)), phase_errors(scene, (1.0, 1.0, 1.0))
+    return Prediction(
+        predicted_error=measures.pop("mse"),
+        predicted_me=measures.pop("me"),
+        stable_cfl=stable_cfl(scene),
+        t_end=t,
+        lattice_phase_error=axis[0],
+        step_phase_error=axis[1],
+        lattice_phase_error_diagonal=diagonal[0],
+        step_phase_error_diagonal=diagonal[1],
+        measures=measures,
+    )
+
+
+def phase_errors(scene, direction: tuple) -> tuple[float, float]:
+    """(lattice, with the step) phase speed errors, c / c0 - 1, for a plane wave of wavenumber 1 / pulse width
+    along ``direction``."""
+    k = 1.0 / scene.pulse_width
+    n = np.asarray(direction, float) / np.linalg.norm(direction)
+    parts = symbol(scene, *(np.array([k * c]) for c in n))
+    d = float(math.sqrt(sum(float(p[0]) ** 2 for p in parts)))
+    step = step_phase_angle(scene.integrator, scene.c0 * d * scene.dt) / (scene.c0 * k * scene.dt)
+    return d / k - 1.0, step - 1.0
