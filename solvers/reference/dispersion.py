@@ -223,10 +223,9 @@ def stable_cfl(scene) -> float:
     is this, or the lower limit long runs of its scene measured."""
     from solvers.scene import Scene
 
-    if getattr(scene, "dims", 2) == 3:  # a 3D scene: the cubic lattice's (solvers/reference/dispersion3d.py)
-        from solvers.reference.dispersion3d import stable_cfl as stable_cfl_3d
-
-        return stable_cfl_3d(scene)
+    own = scene.kind.stable_cfl(scene) if hasattr(scene, "kind") else None  # a 3D scene's: the cubic lattice's
+    if own is not None:
+        return own
     cut = getattr(scene, "cutoff_factor", None)
     cut = Scene.default("cutoff_factor") if cut is None else cut  # a compact kernel's: its support, whatever this
     return lattice_stable_cfl(scene.kernel, float(scene.h_factor), float(cut), scene.integrator, scene.correction)

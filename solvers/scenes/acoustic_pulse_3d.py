@@ -137,6 +137,12 @@ class AcousticPulse3D(SceneKind):
 
         return predict(scene, self)
 
+    def stable_cfl(self, scene) -> float:
+        """The cubic lattice's stable CFL of the scene's method (solvers/reference/dispersion3d.py)."""
+        from solvers.reference.dispersion3d import stable_cfl
+
+        return stable_cfl(scene)
+
     def sized_domain(self, size: float) -> dict:
         """A cube of side ``size`` m centred on the origin."""
         half = 0.5 * size

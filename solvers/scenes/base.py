@@ -266,6 +266,11 @@ class SceneKind:
         """The linear model's predicted errors from the dispersion relation (solvers/reference/dispersion.py)."""
         raise NotImplementedError
 
+    def stable_cfl(self, scene) -> float | None:
+        """The largest stable CFL of ``scene``'s method where this kind's lattice is not the square one (a 3D
+        kind's cube); None: the square lattice's (solvers/reference/dispersion.py ``stable_cfl``)."""
+        return None
+
     def predict_headline(self, scene):
         """:meth:`predict` where only its headline error is wanted (advise's search): a kind may skip the rest."""
         return self.predict(scene)
