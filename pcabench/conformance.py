@@ -228,25 +228,29 @@ def compare(got, ref, scene: Scene, tol: float) -> list[str]:
     displacement from the lattice (x, y, across a periodic seam by the nearest image) and drho."""
     ids = np.arange(scene.n_particles)
     column = ids % scene.nx
-    row = ids // scene.nx
-    scored = scene.scored(column, row)  # the output's particles: an open edge's layer left out
+    row = ids // scene.nx % scene.ny
+    if scene.dims == 3:  # the output's particles: an open face's layer left out
+        layer = ids // (scene.nx * scene.ny)
+        scored = scene.scored_3d(column, row, layer)
+    else:
+        scored = scene.scored(column, row)  # the output's particles: an open edge's layer left out
     x0 = (scene.x_lo + (column + 0.5) * scene.dx)[scored]
     y0 = (scene.y_lo + (row + 0.5) * scene.dx)[scored]
 
     def seam(d, period):
         return d - period * np.rint(d / period) if period else d
 
+    axes = [("x", x0, scene.width if scene.periodic_x else 0), ("y", y0, scene.height if scene.periodic_y else 0)]
+    velocity = ["u", "v"]
+    if scene.dims == 3:
+        z0 = (scene.z_lo + (layer + 0.5) * scene.dx)[scored]
+        axes.append(("z", z0, scene.depth if scene.periodic_z else 0))
+        velocity.append("w")
     groups = {
-        "velocity": ([got.u, got.v], [ref.u, ref.v]),
+        "velocity": ([getattr(got, c) for c in velocity], [getattr(ref, c) for c in velocity]),
         "displacement": (
-            [
-                seam(got.x - x0, scene.width if scene.periodic_x else 0),
-                seam(got.y - y0, scene.height if scene.periodic_y else 0),
-            ],
-            [
-                seam(ref.x - x0, scene.width if scene.periodic_x else 0),
-                seam(ref.y - y0, scene.height if scene.periodic_y else 0),
-            ],
+            [seam(getattr(got, c) - at, period) for c, at, period in axes],
+            [seam(getattr(ref, c) - at, period) for c, at, period in axes],
         ),
         "drho": ([got.drho], [ref.drho]),
     }

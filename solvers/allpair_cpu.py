@@ -38,7 +38,16 @@ class AllPairCPU(Solver):
     search = "all-pair"
     neighbour_search = AllPairs
     order = 2.0
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "body")  # the minimum image
+    boundaries = (
+        "free-x",
+        "periodic-x",
+        "wall-x",
+        "free-y",
+        "periodic-y",
+        "periodic-z",
+        "free-z",
+        "body",
+    )  # the minimum image
 
     def snp(self) -> None:
         """Nothing to build: the all-pair search happens inside the interaction loop."""

@@ -15,7 +15,7 @@ from dataclasses import dataclass, fields
 
 from solvers.method import is_finite_number
 
-OPEN_EDGES = ("", "x", "y", "xy")  # none, the x edges, the y edges, all four
+OPEN_EDGES = ("", "x", "y", "xy", "xyz")  # none, the x edges, the y edges, all four; a 3D scene's six faces
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,11 @@ class Edges:
         return "x" in self.open
 
     @property
+    def open_z(self) -> bool:
+        """Whether a 3D scene's z faces are open."""
+        return "z" in self.open
+
+    @property
     def open_y(self) -> bool:
         """Whether the y edges are open: the lattice holds an absorbing layer beyond each."""
         return "y" in self.open
@@ -57,7 +62,7 @@ class Edges:
         thinner default layer (docs/accuracy.md)."""
         if self.absorber:
             return self.absorber
-        return "sponge" if scene.kind.strip else "pml"
+        return "sponge" if scene.kind.strip or scene.kind.dims == 3 else "pml"
 
     def absorber_model(self, scene):
         """The absorber of :meth:`absorber_used` (solvers/absorbers/); ValueError naming --absorber and the
@@ -87,8 +92,14 @@ class Edges:
         if self.open not in OPEN_EDGES:
             yield f"--open must be one of {', '.join(e for e in OPEN_EDGES if e)} (got {self.open!r})"
             return
+        if (self.open == "xyz") != (scene.kind.dims == 3 and bool(self.open)):
+            yield (
+                f"--open {self.open}: the {scene.name} scene is {scene.kind.dims}D, whose edges open as "
+                + ("xyz (its six faces)" if scene.kind.dims == 3 else "x, y or xy")
+            )
+            return
         openable = scene.kind.openable_edges()
-        for axis in ("x", "y"):
+        for axis in ("x", "y", "z")[: scene.kind.dims]:
             if axis in self.open and axis not in openable:
                 yield f"--open {axis}: {scene.kind.closed_reason(axis)}"
                 return
@@ -99,9 +110,15 @@ class Edges:
                     return
             return
         try:
-            self.absorber_model(scene)  # first: a known absorber (the default layer is the absorber's)
+            split = self.absorber_model(scene).split  # first: a known absorber (the default layer is the absorber's)
         except ValueError as exc:
             yield str(exc)
+            return
+        if split and scene.kind.dims == 3:
+            yield (
+                f"--absorber {self.absorber_used(scene)}: a 3D scene's faces take --absorber sponge "
+                "(its PML is to come)"
+            )
             return
         for name in ("layer_width", "absorber_strength"):
             value = getattr(self, name)

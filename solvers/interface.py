@@ -240,6 +240,8 @@ class Solver(abc.ABC):
         for name in ("sx", "sy", "sz", *RATES_3D, "vol", "pr"):
             a[name] = xp.zeros(s.n_particles, dt)
         self.arrays = a
+        for model in self.boundary_models:  # an open layer (a sponge: nothing to start)
+            model.start(self, x, y, drho)
         self.saved = {}
         self.t = 0.0
         self.reordered = 0
@@ -477,6 +479,8 @@ class Solver(abc.ABC):
         h = {name: self.to_host(self.arrays[name]) for name in STATE_3D}
         c = [np.rint(h[name]).astype(np.int64) % n for name, n in (("lx", s.nx), ("ly", s.ny), ("lz", s.nz))]
         order = np.argsort((c[2] * s.ny + c[1]) * s.nx + c[0], kind="stable")
+        if s.n_layer:  # open faces: the scored domain's particles only (their home site inside it)
+            order = order[s.scored_3d(c[0][order], c[1][order], c[2][order])]
         place = {
             axis: lo + (h["l" + axis].astype(np.float64) + 0.5) * s.dx + h["s" + axis]
             for axis, lo in (("x", s.x_lo), ("y", s.y_lo), ("z", s.z_lo))

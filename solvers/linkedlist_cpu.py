@@ -57,7 +57,7 @@ class LinkedListCPU(CellListSolver):
     )
     pair_loops = ("list", "gather")
     threaded = True
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "body")
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "free-z", "body")
 
     def __init__(self, threads: int = 1, pair_loop: str = "auto"):
         super().__init__(threads=threads or 1, pair_loop=pair_loop)

@@ -468,6 +468,11 @@ class Scene:
         return self.n_layer if self.edges.open_y else 0
 
     @property
+    def layer_depth(self) -> int:
+        """Lattice layers of the absorbing layer beyond each z face: n_layer where z is open, else 0."""
+        return self.n_layer if self.edges.open_z else 0
+
+    @property
     def layer(self) -> float:
         """The absorbing layer's width, m: whole columns of dx (0 where no edge is open)."""
         return self.n_layer * self.dx
@@ -480,6 +485,12 @@ class Scene:
         if r and row is not None:
             inside &= (row >= r) & (row < self.ny - r)
         return inside
+
+    def scored_3d(self, column, row, layer):
+        """:meth:`scored` of a 3D lattice: all sites but the open faces' layers."""
+        c, r, d = self.layer_columns, self.layer_rows, self.layer_depth
+        inside = (column >= c) & (column < self.nx - c) & (row >= r) & (row < self.ny - r)
+        return inside & (layer >= d) & (layer < self.nz - d)
 
     @property
     def strength(self) -> float:
@@ -514,8 +525,8 @@ class Scene:
 
     @property
     def periodic_z(self) -> bool:
-        """Whether a 3D lattice is periodic in z (False for a 2D scene)."""
-        return self.dims == 3 and "z" in self.kind.periodic
+        """Whether a 3D lattice is periodic in z (False for a 2D scene), unless its z faces are open."""
+        return self.dims == 3 and "z" in self.kind.periodic and not self.edges.open_z
 
     @property
     def boundaries(self) -> frozenset:
@@ -564,7 +575,7 @@ class Scene:
         """Lattice layers in z: a 3D scene's (the periodic depth is nz * dx), 1 for a 2D scene."""
         if self.dims == 2:
             return 1
-        return max(int(round((self.z_max - self.z_min) / self.dx)), 0)
+        return max(int(round((self.z_max - self.z_min) / self.dx)), 0) + 2 * self.layer_depth
 
     @property
     def depth(self) -> float:
@@ -574,7 +585,7 @@ class Scene:
     @property
     def z_lo(self) -> float:
         """Front of a 3D lattice in z, m (0 for a 2D scene)."""
-        return self.z_min if self.dims == 3 else 0.0
+        return self.z_min - self.layer_depth * self.dx if self.dims == 3 else 0.0
 
     @property
     def height(self) -> float:
@@ -611,7 +622,7 @@ class Scene:
     @property
     def n_scored(self) -> int:
         """The particles of the scored domain: all of them, but an open edge's layers (the run's output)."""
-        return (self.nx - 2 * self.layer_columns) * (self.ny - 2 * self.layer_rows) * self.nz
+        return (self.nx - 2 * self.layer_columns) * (self.ny - 2 * self.layer_rows) * (self.nz - 2 * self.layer_depth)
 
     # ------------------------------------------------------------ time
     @property

@@ -66,7 +66,7 @@ def reflected(scene, fields) -> dict:
     difference over the initial pulse's peak) and ``reflected_energy`` (the sum of its squares over the initial
     primary field's, per site). Nothing for a closed scene, or for the moving models, whose prediction is their
     linear part only. The run's scorer adds it (:func:`score`), so that a prediction is never scored by itself."""
-    if scene.model != "linear" or not scene.open or scene.body is not None:  # a body: no prediction
+    if scene.model != "linear" or not scene.open or scene.body is not None or scene.dims == 3:  # no prediction
         return {}
     primary = fields.drho if scene.kind.primary == "drho" else fields.u
     d = np.asarray(primary, float) - predicted_primary(scene, fields)

@@ -22,7 +22,7 @@ outer (free) end and back.
 
 from __future__ import annotations
 
-FIELDS = {"velocity": ("u", "v"), "density": ("drho",)}  # what each update changes, by the name damp takes
+FIELDS = {"velocity": ("u", "v", "w"), "density": ("drho",)}  # what each update changes (w: a 3D scene's)
 
 
 class Absorber:
@@ -52,4 +52,5 @@ class Absorber:
         """The fields times fx fy: every field damped at the rate of both axes together."""
         factor = fx * fy
         for name in FIELDS[fields]:
-            arrays[name] *= factor
+            if name in arrays:
+                arrays[name] *= factor

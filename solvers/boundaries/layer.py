@@ -42,7 +42,10 @@ class OpenLayer(Boundary):
             solver.no_velocity = xp.zeros(n, dt)  # v = 0 for the x part's sweep (never permuted)
 
     def damp(self, solver, f: float, fields: str) -> None:
-        self.absorber.damp(solver.arrays, *self.factors(solver, f), fields)
+        factors = self.factors(solver, f)
+        if len(factors) == 3:  # a 3D scene's faces (a sponge: y and z damp together)
+            factors = (factors[0], factors[1] * factors[2])
+        self.absorber.damp(solver.arrays, *factors, fields)
 
     def advanced(self, solver, f: float) -> None:
         """drho_x += f dt ddx: a split absorber's x part of drho, updated with drho."""
@@ -70,10 +73,10 @@ class OpenLayer(Boundary):
         """(sigma_x, sigma_y) in 1/s at each particle's current position (None on a closed axis)."""
         s, xp, a = self.scene, solver.xp, solver.arrays
         rates = []
-        for axis, lo, near, far, lattice, shift in (
-            ("x", s.x_lo, s.x_min, s.x_max, "lx", "sx"),
-            ("y", s.y_lo, s.y_min, s.y_max, "ly", "sy"),
-        ):
+        axes = [("x", s.x_lo, s.x_min, s.x_max, "lx", "sx"), ("y", s.y_lo, s.y_min, s.y_max, "ly", "sy")]
+        if s.dims == 3:
+            axes.append(("z", s.z_lo, s.z_min, s.z_max, "lz", "sz"))
+        for axis, lo, near, far, lattice, shift in axes:
             if axis not in s.open:
                 rates.append(None)
                 continue

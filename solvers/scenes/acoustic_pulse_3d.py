@@ -12,6 +12,11 @@ closed form r p = [(r - c0 t) g(r - c0 t) + (r + c0 t) g(r + c0 t)] / 2 while th
 Error measures (the primary field is drho): relative RMS and max error of drho and of the velocity vector over the
 cube, and the relative RMS of drho along the lattice's axes through the centre and along its body diagonals,
 apart (the lattice's phase error depends on the direction of travel).
+
+With ``--open xyz`` its six faces open onto a sponge layer (solvers/absorbers/sponge.py; the PML's 3D split is
+to come): the pulse is alone in open space (no images), scored against the closed form at the scored sites
+while it is inside the cube (``rms_drho``), then by what the faces left behind (``left_energy``, the error's
+acoustic energy over the initial pulse's, and ``left_amplitude``).
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ import math
 
 import numpy as np
 
-from solvers.scenes.base import SceneKind
+from solvers.scenes.base import PULSE_REACH, SceneKind
 
 LN2 = math.log(2.0)
 FIT_WIDTHS = 5.0  # the cube's side in pulse widths, at least: the initial pulse below 1.3 % of its peak at a face
@@ -53,6 +58,7 @@ class AcousticPulse3D(SceneKind):
     summary = "the 3D acoustic pulse: a Gaussian pressure pulse at rest in a triply periodic cube (--domain-size)"
     dims = 3
     periodic = ("x", "y", "z")
+    images = ("x", "y", "z")  # the cube's seams are the open pulse's images: --open xyz opens them
     domain = {"x_min": -8.0, "x_max": 8.0, "y_min": -8.0, "y_max": 8.0, "z_min": -8.0, "z_max": 8.0}
     fields = ("drho", "velocity")
     primary = "drho"
@@ -61,12 +67,18 @@ class AcousticPulse3D(SceneKind):
         "dx": 1.0, "pulse_width": 1.5, "pulse_center": 1.0, "h_factor": 1.0,
         "x_min": -4.5, "x_max": 4.5, "y_min": -4.5, "y_max": 4.5, "z_min": -4.5, "z_max": 4.5,
     }  # fmt: skip
+    smallest_open = {**smallest, "open": "xyz", "layer_width": 2.0}  # the six faces open onto a sponge
     card = {"dx": 0.25}
 
     def initial_fields(self, scene, x, y, xp, z=None):
         """(u, v, w, drho) at the lattice positions ``x``, ``y``, ``z`` (m) at t = 0: the pulse and its periodic
-        images (:func:`periodic_pulse`)."""
-        drho = periodic_pulse(scene, x, y, z, xp)
+        images (:func:`periodic_pulse`), or with open faces the pulse alone."""
+        if scene.open:
+            xc, yc, zc = centre(scene)
+            r2 = (x - xc) ** 2 + (y - yc) ** 2 + (z - zc) ** 2
+            drho = scene.rho0 * scene.mach * xp.exp(-LN2 * r2 / scene.pulse_width**2)
+        else:
+            drho = periodic_pulse(scene, x, y, z, xp)
         zero = xp.zeros_like(drho)
         return zero, zero.copy(), zero.copy(), drho
 
@@ -90,12 +102,62 @@ class AcousticPulse3D(SceneKind):
     def exact_fields(self, scene, t: float):
         from solvers.interface import Fields
 
+        if scene.open:
+            return self.open_fields(scene, t)
         ref = self.reference(scene, t)
         z, y, x = np.meshgrid(ref.z, ref.y, ref.x, indexing="ij")
         return Fields(
             x=x.ravel(), y=y.ravel(), z=z.ravel(), u=ref.u.ravel(), v=ref.v.ravel(), w=ref.w.ravel(),
             drho=ref.drho.ravel(), t=t,
         )  # fmt: skip
+
+    def open_fields(self, scene, t: float):
+        """The open-space pulse (the closed form, solvers/reference/pulse3d.py) at the scored domain's sites at
+        ``t``, in a run's output order, as Fields."""
+        from solvers.interface import Fields
+        from solvers.reference.pulse3d import open_pulse
+
+        axes = [
+            lo + (np.arange(d, n - d) + 0.5) * scene.dx
+            for lo, n, d in (
+                (scene.x_lo, scene.nx, scene.layer_columns),
+                (scene.y_lo, scene.ny, scene.layer_rows),
+                (scene.z_lo, scene.nz, scene.layer_depth),
+            )
+        ]
+        z, y, x = (a.ravel() for a in np.meshgrid(axes[2], axes[1], axes[0], indexing="ij"))
+        xc, yc, zc = centre(scene)
+        p = np.stack([x - xc, y - yc, z - zc])
+        r = np.sqrt(np.sum(p**2, axis=0))
+        drho, ur = open_pulse(r, t, scene.pulse_width, scene.mach, scene.rho0, scene.c0)
+        radial = np.where(r > 0, ur / np.where(r > 0, r, 1.0), 0.0) * p
+        return Fields(x=x, y=y, z=z, u=radial[0], v=radial[1], w=radial[2], drho=drho, t=t)
+
+    def pulse_inside(self, scene, t: float) -> bool:
+        """The spherical shell (radius c0 t and PULSE_REACH half-widths) has not reached an open face."""
+        if not scene.open:
+            return True
+        xc, yc, zc = centre(scene)
+        gaps = (xc - scene.x_min, scene.x_max - xc, yc - scene.y_min, scene.y_max - yc, zc - scene.z_min)
+        return scene.c0 * t + PULSE_REACH * scene.pulse_width <= min(*gaps, scene.z_max - zc)
+
+    def left_behind(self, scene, fields, ref) -> dict:
+        """What the open faces left: the largest error of drho over the initial peak (``left_amplitude``) and the
+        error's acoustic energy over the initial pulse's (``left_energy``), at the scored sites."""
+        d = {c: np.asarray(getattr(fields, c), float) - getattr(ref, c) for c in ("drho", "u", "v", "w")}
+        start = self.open_fields(scene, 0.0)
+
+        def energy(f):
+            kinetic = sum(np.asarray(f[c], float) ** 2 for c in ("u", "v", "w"))
+            return float(
+                np.mean(0.5 * scene.rho0 * kinetic + 0.5 * scene.c0**2 * np.asarray(f["drho"]) ** 2 / scene.rho0)
+            )
+
+        initial = {c: getattr(start, c) for c in ("drho", "u", "v", "w")}
+        return {
+            "left_amplitude": float(np.max(np.abs(d["drho"])) / (scene.rho0 * scene.mach)),
+            "left_energy": energy(d) / energy(initial),
+        }
 
     def errors(self, scene, fields) -> dict:
         """Relative RMS (``mse``) and max error (``me``) of drho, the velocity's, and drho's along the axes and
@@ -104,9 +166,11 @@ class AcousticPulse3D(SceneKind):
         ref = self.exact_fields(scene, fields.t)
         d = np.asarray(fields.drho, float) - ref.drho
         du = np.stack([np.asarray(getattr(fields, c), float) - getattr(ref, c) for c in ("u", "v", "w")])
+        left = self.left_behind(scene, fields, ref) if scene.open else {}
         if not (np.all(np.isfinite(d)) and np.all(np.isfinite(du))):
             nan = float("nan")
             return {
+                **dict.fromkeys(left, nan),
                 "mse": nan,
                 "me": nan,
                 "velocity_rms": nan,
@@ -123,6 +187,7 @@ class AcousticPulse3D(SceneKind):
         speed = np.sqrt(np.sum(du**2, axis=0))
         ref_speed = np.sqrt(ref.u**2 + ref.v**2 + ref.w**2)
         return {
+            **left,
             "mse": _relative(d, ref.drho),
             "me": float(np.max(np.abs(d))),
             "velocity_rms": _relative(speed, ref_speed),

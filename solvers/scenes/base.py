@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 
-BOUNDARY_KINDS = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "body")
+BOUNDARY_KINDS = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "free-z", "body")
 MACH_RANGE = (1e-6, 0.3)  # amplitudes a scene accepts: acoustic (linear) to weakly nonlinear
 PULSE_WIDTH_RANGE = (0.1, 20.0)  # m
 # Pulse widths about a peak that count as the pulse: beyond them a Gaussian pulse is below 1e-4 of its peak
@@ -146,7 +146,7 @@ class SceneKind:
             if len(self.walls) < 2:
                 x.add("free-x")
         periodic_y = "y" in self.periodic and "y" not in open_edges
-        z = {"periodic-z"} if self.dims == 3 and "z" in self.periodic else set()
+        z = set() if self.dims == 2 else {"periodic-z" if "z" in self.periodic and "z" not in open_edges else "free-z"}
         return frozenset(x | {"periodic-y" if periodic_y else "free-y"} | z | ({"body"} if self.body else set()))
 
     def headline(self, t_end: float) -> str:
@@ -206,7 +206,8 @@ class SceneKind:
         if self.walls:
             return tuple(axis for axis in ("y",) if axis in self.images)
         free_x = "x" not in self.periodic
-        return tuple(axis for axis in ("x", "y") if (axis == "x" and free_x) or axis in self.images)
+        axes = ("x", "y", "z")[: self.dims]
+        return tuple(axis for axis in axes if (axis == "x" and free_x) or axis in self.images)
 
     def closed_reason(self, axis: str) -> str:
         """Why the ``axis`` edges of this scene cannot be opened, one clause."""
