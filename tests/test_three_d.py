@@ -246,3 +246,41 @@ def test_open_faces_absorb_the_spherical_wave_and_every_solver_agrees_there():
         small(open="x")
     with pytest.raises(SceneError, match="--open xyz: the acoustic-pulse scene is 2D"):
         Scene(1.0, "acoustic-pulse", open="xyz")
+
+
+def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_path, monkeypatch):
+    """The report section of ``study --three-d`` from stored records: each method's errors by dx with the
+    prediction beside them, the orders, the issue's target line, and a pair's cost (ns per particle-neighbour-
+    step) of the 3D run against the 2D one."""
+    from dataclasses import replace
+
+    from pcabench import store
+    from pcabench.execute.sweep import failed_record
+    from pcabench.reports.frame import load as load_frame
+    from pcabench.studies.three_d.plan import THREE_D, three_d
+    from pcabench.studies.three_d import section
+    from pcabench.studies.three_d.section import rows, text
+
+    monkeypatch.setattr(section, "PREDICTED_UP_TO", 40_000)  # the 262,144-particle lattices not predicted here
+
+    path = tmp_path / "results" / store.store_name("m", "h")
+    path.parent.mkdir()
+    specs = [replace(spec, preset=THREE_D) for spec in three_d()]
+    high_order = {0.5: 0.0054, 0.25: 0.000228}  # order 4.56, under the target's 1e-3
+    for spec in specs:
+        rec = failed_record(spec.resolved(), "ok", "", "m")
+        s = spec.scene
+        rec.steps, rec.t_end, rec.me, rec.mean_neighbours = s.n_steps, s.t_final, 0.0, 80.0
+        rec.mse = high_order.get(s.dx, 0.1) if s.kernel == "laguerre-gauss" else 0.1 * s.dx
+        pi = 3.0 if s.dims == 3 else 1.0  # the cost runs: 3D three times the 2D per pair
+        rec.stages = {"input": 0.0, "init": 0.0, "snp": 0.0, "pi": pi * s.n_steps * s.n_particles * 80e-9,
+                      "su": 0.0, "output": 0.0}  # fmt: skip
+        store.append(rec, path)
+    data = rows(load_frame(path.parent))
+    assert len(data["accuracy"]) == 6 and {r["dims"] for r in data["cost"]} == {2, 3}
+    predicted = {r["dx"]: r["predicted"] for r in data["accuracy"] if r["label"].startswith("wendland")}
+    assert predicted[0.25] is None and 0.2 < predicted[1.0] < 0.25 and 0.09 < predicted[0.5] < 0.1  # 0.223, 0.0933
+    words = "\n".join(text(data, None))
+    assert "0.000228 at dx 0.25 (262,144 particles), order 4.57 (the issue's target" in words
+    assert "at most 0.001 and order 3.5: met)" in words and "| 1.00 / 1.00 |" in words  # Wendland's orders
+    assert "3D 3 (32,768 particles, 80 neighbours) against 2D 1 (32,761, 80): 3.00 times" in words, words

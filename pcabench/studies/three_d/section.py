@@ -39,7 +39,7 @@ def rows(df) -> dict | None:
             "error": float(r.mse) if ok else None,
             "seconds": float(r.t_solution) if ok else None,
             "steps": int(r.steps),
-            "pi": float(r.stages["pi"]) if ok else None,
+            "pi": float(r.t_pi) if ok else None,
         }
         if scene.steps == COST_STEPS and scene.t_end is None:
             cost.append(row)
@@ -132,7 +132,8 @@ def text(data, ctx) -> list[str]:
 
 
 def error_figure(data, ctx):
-    """The 3D pulse's error against dx per method: measured (markers) and predicted (dotted), log-log."""
+    """The 3D pulse's error against dx per method: measured (filled dots joined) and predicted (open circles around
+    them: for the linear model on the periodic cube they coincide), log-log."""
     if not data:
         return None
     found = methods(data["accuracy"])
@@ -143,7 +144,7 @@ def error_figure(data, ctx):
     colours = dict(zip(found, F.palette(len(found))))
     with F.figure(
         path,
-        f"The 3D pulse, linear, t = {T_END:g} s ({ctx.name}): markers measured, dotted predicted",
+        f"The 3D pulse, linear, t = {T_END:g} s ({ctx.name}): dots measured, open circles predicted",
         "dx (m)",
         "relative RMS of drho",
         logx=True,
@@ -156,10 +157,10 @@ def error_figure(data, ctx):
             if not pts:
                 continue
             label, cfl = key
-            ax.plot(*zip(*pts), "o-", color=colours[key], ms=6, label=f"{label}, CFL {cfl:g}")
+            ax.plot(*zip(*pts), "o-", color=colours[key], ms=5, label=f"{label}, CFL {cfl:g}")
             predicted = [(r["dx"], r["predicted"]) for r in found[key] if r["predicted"]]
             if predicted:
-                ax.plot(*zip(*predicted), ":", color=colours[key], lw=2)
+                ax.plot(*zip(*predicted), "o", mfc="none", mec=colours[key], ms=13, mew=1.5)
             values += [e for _, e in pts] + [p for _, p in predicted]
             xs += [d for d, _ in pts]
         F.nice_log_ticks(ax, values)
