@@ -257,8 +257,8 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     from pcabench import store
     from pcabench.execute.sweep import failed_record
     from pcabench.reports.frame import load as load_frame
-    from pcabench.studies.three_d.plan import THREE_D, three_d
     from pcabench.studies.three_d import section
+    from pcabench.studies.three_d.plan import THREE_D, three_d
     from pcabench.studies.three_d.section import rows, text
 
     monkeypatch.setattr(section, "PREDICTED_UP_TO", 40_000)  # the 262,144-particle lattices not predicted here
