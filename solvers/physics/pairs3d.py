@@ -22,13 +22,14 @@ from solvers.kernels.constants import C0SQ, NONLIN, NX, NY, NZ, ONE, RC2, RHO0, 
 
 
 def separation_rule(jit):
-    """r_ij's three components from lattice coordinates (whole numbers, exact) and displacements, m."""
+    """r_ij's three components, m: particle i at lattice coordinates (lxi, lyi, lzi) (shifted across a seam where
+    the sum is) and its own displacements, j at its own; the lattice part whole numbers, exact."""
 
     @jit
-    def separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k):
-        rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-        ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-        rz = (lzi - lz[j]) * k[SPACING] + (szi - sz[j])
+    def separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k):
+        rx = (lxi - lx[j]) * k[SPACING] + (sx[i] - sx[j])
+        ry = (lyi - ly[j]) * k[SPACING] + (sy[i] - sy[j])
+        rz = (lzi - lz[j]) * k[SPACING] + (sz[i] - sz[j])
         return rx, ry, rz
 
     return separation
@@ -38,13 +39,13 @@ def continuity_sum(jit, separation, gradient):
     """sum_j vol_j (u_i - u_j) . r_ij G_ij over particles j0..j1-1 (i's coordinates already shifted)."""
 
     @jit
-    def continuity_range(j0, j1, lxi, lyi, lzi, sxi, syi, szi, ui, vi, wi, lx, ly, lz, sx, sy, sz, u, v, w, vol, k):
+    def continuity_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, u, v, w, vol, k):
         acc = k[ZERO]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
             if r2 < k[RC2]:
-                acc += vol[j] * gradient(r2, k) * ((ui - u[j]) * rx + (vi - v[j]) * ry + (wi - w[j]) * rz)
+                acc += vol[j] * gradient(r2, k) * ((u[i] - u[j]) * rx + (v[i] - v[j]) * ry + (w[i] - w[j]) * rz)
         return acc
 
     return continuity_range
@@ -54,15 +55,15 @@ def momentum_sum(jit, separation, gradient):
     """sum_j m_j (pr_i + pr_j) G_ij r_ij over particles j0..j1-1, as (x, y, z)."""
 
     @jit
-    def momentum_range(j0, j1, lxi, lyi, lzi, sxi, syi, szi, pri, lx, ly, lz, sx, sy, sz, mass, pr, k):
+    def momentum_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, mass, pr, k):
         ax = k[ZERO]
         ay = k[ZERO]
         az = k[ZERO]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
             if r2 < k[RC2]:
-                c = mass[j] * (pri + pr[j]) * gradient(r2, k)
+                c = mass[j] * (pr[i] + pr[j]) * gradient(r2, k)
                 ax += c * rx
                 ay += c * ry
                 az += c * rz
@@ -75,10 +76,10 @@ def neighbour_count(jit, separation):
     """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
 
     @jit
-    def neighbours_range(j0, j1, lxi, lyi, lzi, sxi, syi, szi, lx, ly, lz, sx, sy, sz, k):
+    def neighbours_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k):
         count = 0
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             if rx * rx + ry * ry + rz * rz < k[RC2]:
                 count += 1
         return count
@@ -92,7 +93,7 @@ def moment_sums(jit, separation, gradient):
     as (x, y, z)."""
 
     @jit
-    def moments_range(j0, j1, lxi, lyi, lzi, sxi, syi, szi, lx, ly, lz, sx, sy, sz, vol, k):
+    def moments_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, vol, k):
         mxx = k[ZERO]
         mxy = k[ZERO]
         mxz = k[ZERO]
@@ -103,7 +104,7 @@ def moment_sums(jit, separation, gradient):
         gy = k[ZERO]
         gz = k[ZERO]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
             if r2 < k[RC2]:
                 c = vol[j] * gradient(r2, k)
@@ -228,120 +229,23 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
     nearest = minimum_image_rule(jit)
 
     @jit
-    def continuity_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k):
-        """d(drho_i)/dt from the 27 cells around particle i, kg/m^3/s."""
-        acc = k[ZERO]
-        for dz in range(-1, 2):
-            for dy in range(-1, 2):
-                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                acc += continuity_range(
-                    j0,
-                    j1,
-                    lx[i],
-                    lyi,
-                    lzi,
-                    sx[i],
-                    sy[i],
-                    sz[i],
-                    u[i],
-                    v[i],
-                    w[i],
-                    lx,
-                    ly,
-                    lz,
-                    sx,
-                    sy,
-                    sz,
-                    u,
-                    v,
-                    w,
-                    vol,
-                    k,
-                )
-                if across and q1 > q0:
-                    acc += continuity_range(
-                        q0,
-                        q1,
-                        lxq,
-                        lyi,
-                        lzi,
-                        sx[i],
-                        sy[i],
-                        sz[i],
-                        u[i],
-                        v[i],
-                        w[i],
-                        lx,
-                        ly,
-                        lz,
-                        sx,
-                        sy,
-                        sz,
-                        u,
-                        v,
-                        w,
-                        vol,
-                        k,
-                    )
-        return (k[RHO0] + k[NONLIN] * drho[i]) * acc
-
-    @jit
-    def momentum_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, mass, pr, k):
-        """du_i/dt from the 27 cells around particle i, m/s^2, as (x, y, z)."""
-        ax = k[ZERO]
-        ay = k[ZERO]
-        az = k[ZERO]
-        for dz in range(-1, 2):
-            for dy in range(-1, 2):
-                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                bx, by, bz = momentum_range(
-                    j0, j1, lx[i], lyi, lzi, sx[i], sy[i], sz[i], pr[i], lx, ly, lz, sx, sy, sz, mass, pr, k
-                )
-                ax += bx
-                ay += by
-                az += bz
-                if across and q1 > q0:
-                    bx, by, bz = momentum_range(
-                        q0, q1, lxq, lyi, lzi, sx[i], sy[i], sz[i], pr[i], lx, ly, lz, sx, sy, sz, mass, pr, k
-                    )
-                    ax += bx
-                    ay += by
-                    az += bz
-        return -ax, -ay, -az
-
-    @jit
-    def neighbours_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, k):
-        """Neighbours of particle i within the cutoff, itself excluded."""
-        count = 0
-        for dz in range(-1, 2):
-            for dy in range(-1, 2):
-                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                count += neighbours_range(j0, j1, lx[i], lyi, lzi, sx[i], sy[i], sz[i], lx, ly, lz, sx, sy, sz, k)
-                if across and q1 > q0:
-                    count += neighbours_range(q0, q1, lxq, lyi, lzi, sx[i], sy[i], sz[i], lx, ly, lz, sx, sy, sz, k)
-        return count - 1
-
-    @jit
     def moments_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, vol, k):
         """Particle i's moment matrix (6) and Gamma (3) from the 27 cells around it (solvers/corrections/)."""
         m0 = m1 = m2 = m3 = m4 = m5 = g0 = g1 = g2 = k[ZERO]
         for dz in range(-1, 2):
             for dy in range(-1, 2):
                 j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):
-                    if a1 > a0:
-                        a, b, c, d, e, f, p, q, r = moments_range(
-                            a0, a1, lxi, lyi, lzi, sx[i], sy[i], sz[i], lx, ly, lz, sx, sy, sz, vol, k
-                        )
-                        m0 += a
-                        m1 += b
-                        m2 += c
-                        m3 += d
-                        m4 += e
-                        m5 += f
-                        g0 += p
-                        g1 += q
-                        g2 += r
+                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):  # the row, then beyond the x seam
+                    a, b, c, d, e, f, p, q, r = moments_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, vol, k)
+                    m0 += a
+                    m1 += b
+                    m2 += c
+                    m3 += d
+                    m4 += e
+                    m5 += f
+                    g0 += p
+                    g1 += q
+                    g2 += r
         return m0, m1, m2, m3, m4, m5, g0, g1, g2
 
     @jit
@@ -350,9 +254,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
         m0 = m1 = m2 = m3 = m4 = m5 = g0 = g1 = g2 = k[ZERO]
         for j in range(n):
             lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            a, b, c, d, e, f, p, q, r = moments_range(
-                j, j + 1, lxi, lyi, lzi, sx[i], sy[i], sz[i], lx, ly, lz, sx, sy, sz, vol, k
-            )
+            a, b, c, d, e, f, p, q, r = moments_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, vol, k)
             m0 += a
             m1 += b
             m2 += c
@@ -365,14 +267,50 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
         return m0, m1, m2, m3, m4, m5, g0, g1, g2
 
     @jit
+    def continuity_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k):
+        """d(drho_i)/dt from the 27 cells around particle i, kg/m^3/s."""
+        acc = k[ZERO]
+        for dz in range(-1, 2):
+            for dy in range(-1, 2):
+                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
+                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):  # the row, then beyond the x seam
+                    acc += continuity_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, u, v, w, vol, k)
+        return (k[RHO0] + k[NONLIN] * drho[i]) * acc
+
+    @jit
+    def momentum_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, mass, pr, k):
+        """du_i/dt from the 27 cells around particle i, m/s^2, as (x, y, z)."""
+        ax = k[ZERO]
+        ay = k[ZERO]
+        az = k[ZERO]
+        for dz in range(-1, 2):
+            for dy in range(-1, 2):
+                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
+                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):
+                    bx, by, bz = momentum_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, mass, pr, k)
+                    ax += bx
+                    ay += by
+                    az += bz
+        return -ax, -ay, -az
+
+    @jit
+    def neighbours_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, k):
+        """Neighbours of particle i within the cutoff, itself excluded."""
+        count = 0
+        for dz in range(-1, 2):
+            for dy in range(-1, 2):
+                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
+                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):
+                    count += neighbours_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k)
+        return count - 1
+
+    @jit
     def continuity_allpair(i, n, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k):
         """d(drho_i)/dt summed over all n particles (the nearest image along periodic axes)."""
         acc = k[ZERO]
         for j in range(n):
             lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            acc += continuity_range(
-                j, j + 1, lxi, lyi, lzi, sx[i], sy[i], sz[i], u[i], v[i], w[i], lx, ly, lz, sx, sy, sz, u, v, w, vol, k
-            )
+            acc += continuity_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, u, v, w, vol, k)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
     @jit
@@ -383,9 +321,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
         az = k[ZERO]
         for j in range(n):
             lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            bx, by, bz = momentum_range(
-                j, j + 1, lxi, lyi, lzi, sx[i], sy[i], sz[i], pr[i], lx, ly, lz, sx, sy, sz, mass, pr, k
-            )
+            bx, by, bz = momentum_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, mass, pr, k)
             ax += bx
             ay += by
             az += bz
@@ -396,7 +332,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
         count = 0
         for j in range(n):
             lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            count += neighbours_range(j, j + 1, lxi, lyi, lzi, sx[i], sy[i], sz[i], lx, ly, lz, sx, sy, sz, k)
+            count += neighbours_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k)
         return count - 1
 
     @jit
