@@ -52,107 +52,95 @@ from solvers.kernels.constants import (
 )
 
 
-def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -> ModuleType:
-    """The pair functions compiled with ``jit`` for ``kernel`` in ``precision``, using
-    ``exp_neg(x) = exp(-x)`` (itself compiled here) where the kernel needs it. ``across``: whether an x
-    edge of the scene has images (a periodic seam or a rigid wall); False compiles the stencil sums and the
-    all-pair sums without the pairs across it (a compile-time constant: the paper's scene, free in x, pays
-    nothing for seams and walls it does not have; see :func:`stencil_range`).
+def range_sums(jit, gradient, mirror: bool) -> tuple:
+    """The four pair sums over the particles j0..j1-1: of the particles themselves, or (``mirror``) of their
+    mirror images across a rigid wall, x_j' = 2 x_w - x_j with the normal velocity reversed (u_j' = -u_j) and
+    the same v, drho, mass and coefficients. For mirrors ``lxi`` is i's column minus the wall's mirror sum M
+    (the image of column lx_j is column M - lx_j, its displacement -sx_j), so that
+    r_ij' = (lxi + lx_j) dx + (sx_i + sx_j), exact like every separation. ``mirror`` is a compile-time
+    constant: each variant has its own loop."""
 
-    They come back as attributes of a module object, which numba resolves inside the jitted sweeps
-    that call them (it cannot type a plain namespace).
-    """
-    gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg)))
+    @jit
+    def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):
+        """sum_j vol_j u_ij . r_ij G_ij over the particles j0..j1-1 (lyi already shifted)."""
+        acc = k[ZERO]
+        for j in range(j0, j1):
+            if mirror:
+                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+                uij = ui + u[j]
+            else:
+                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+                uij = ui - u[j]
+            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            r2 = rx * rx + ry * ry
+            if r2 < k[RC2]:
+                g = gradient(r2, k)
+                acc += vol[j] * g * (uij * rx + (vi - v[j]) * ry)
+        return acc
 
-    def ranges(mirror: bool) -> tuple:
-        """The three pair sums over the particles j0..j1-1: of the particles themselves, or (``mirror``) of their
-        mirror images across a rigid wall, x_j' = 2 x_w - x_j with the normal velocity reversed (u_j' = -u_j) and
-        the same v, drho, mass and coefficients. For mirrors ``lxi`` is i's column minus the wall's mirror sum M
-        (the image of column lx_j is column M - lx_j, its displacement -sx_j), so that
-        r_ij' = (lxi + lx_j) dx + (sx_i + sx_j), exact like every separation. ``mirror`` is a compile-time
-        constant: each variant has its own loop."""
+    @jit
+    def momentum_range(j0, j1, lxi, lyi, sxi, syi, pri, lx, ly, sx, sy, mass, pr, k):
+        """sum_j m_j (pr_i + pr_j) G_ij r_ij over j0..j1-1, as (x, y) components."""
+        ax = k[ZERO]
+        ay = k[ZERO]
+        for j in range(j0, j1):
+            if mirror:
+                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+            else:
+                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            r2 = rx * rx + ry * ry
+            if r2 < k[RC2]:
+                w = mass[j] * (pri + pr[j]) * gradient(r2, k)
+                ax += w * rx
+                ay += w * ry
+        return ax, ay
 
-        @jit
-        def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):
-            """sum_j vol_j u_ij . r_ij G_ij over the particles j0..j1-1 (lyi already shifted)."""
-            acc = k[ZERO]
-            for j in range(j0, j1):
-                if mirror:
-                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-                    uij = ui + u[j]
-                else:
-                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-                    uij = ui - u[j]
-                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-                r2 = rx * rx + ry * ry
-                if r2 < k[RC2]:
-                    g = gradient(r2, k)
-                    acc += vol[j] * g * (uij * rx + (vi - v[j]) * ry)
-            return acc
+    @jit
+    def neighbours_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, k):
+        """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
+        count = 0
+        for j in range(j0, j1):
+            if mirror:
+                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+            else:
+                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            if rx * rx + ry * ry < k[RC2]:
+                count += 1
+        return count
 
-        @jit
-        def momentum_range(j0, j1, lxi, lyi, sxi, syi, pri, lx, ly, sx, sy, mass, pr, k):
-            """sum_j m_j (pr_i + pr_j) G_ij r_ij over j0..j1-1, as (x, y) components."""
-            ax = k[ZERO]
-            ay = k[ZERO]
-            for j in range(j0, j1):
-                if mirror:
-                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-                else:
-                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-                r2 = rx * rx + ry * ry
-                if r2 < k[RC2]:
-                    w = mass[j] * (pri + pr[j]) * gradient(r2, k)
-                    ax += w * rx
-                    ay += w * ry
-            return ax, ay
+    @jit
+    def moments_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, vol, k):
+        """The kernel gradient correction's sums over j0..j1-1: the moment matrix
+        M = -sum_j vol_j G_ij r_ij (x) r_ij as (M_xx, M_xy, M_yy) and Gamma = sum_j vol_j G_ij r_ij as (x, y)."""
+        mxx = k[ZERO]
+        mxy = k[ZERO]
+        myy = k[ZERO]
+        gx = k[ZERO]
+        gy = k[ZERO]
+        for j in range(j0, j1):
+            if mirror:
+                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
+            else:
+                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            r2 = rx * rx + ry * ry
+            if r2 < k[RC2]:
+                w = vol[j] * gradient(r2, k)
+                gx += w * rx
+                gy += w * ry
+                mxx -= w * rx * rx
+                mxy -= w * rx * ry
+                myy -= w * ry * ry
+        return mxx, mxy, myy, gx, gy
 
-        @jit
-        def neighbours_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, k):
-            """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
-            count = 0
-            for j in range(j0, j1):
-                if mirror:
-                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-                else:
-                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-                if rx * rx + ry * ry < k[RC2]:
-                    count += 1
-            return count
+    return continuity_range, momentum_range, neighbours_range, moments_range
 
-        @jit
-        def moments_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, vol, k):
-            """The kernel gradient correction's sums over j0..j1-1: the moment matrix
-            M = -sum_j vol_j G_ij r_ij (x) r_ij as (M_xx, M_xy, M_yy) and Gamma = sum_j vol_j G_ij r_ij as (x, y)."""
-            mxx = k[ZERO]
-            mxy = k[ZERO]
-            myy = k[ZERO]
-            gx = k[ZERO]
-            gy = k[ZERO]
-            for j in range(j0, j1):
-                if mirror:
-                    rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-                else:
-                    rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-                ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-                r2 = rx * rx + ry * ry
-                if r2 < k[RC2]:
-                    w = vol[j] * gradient(r2, k)
-                    gx += w * rx
-                    gy += w * ry
-                    mxx -= w * rx * rx
-                    mxy -= w * rx * ry
-                    myy -= w * ry * ry
-            return mxx, mxy, myy, gx, gy
 
-        return continuity_range, momentum_range, neighbours_range, moments_range
+def cell_search(jit) -> dict:
+    """A particle's cell (particleIndex) and its lattice coordinates moved back across a periodic seam."""
 
-    continuity_range, momentum_range, neighbours_range, moments_range = ranges(mirror=False)
-    continuity_mirror, momentum_mirror, neighbours_mirror, moments_mirror = ranges(mirror=True)
-
-    # ---------------------------------------------------------------- cell list
     @jit
     def cell_index(lx, ly, sx, sy, dx, x_grid, width, height, cw, ch, ncx, ncy):
         """particleIndex of one particle: cy * ncx + cx from float64 positions.
@@ -190,6 +178,12 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
                 ly[i] -= math.floor(height / dx + 0.5)
             elif y < 0:
                 ly[i] += math.floor(height / dx + 0.5)
+
+    return {"cell_index": cell_index, "wrap_at": wrap_at}
+
+
+def stencil_rules(jit) -> dict:
+    """The 3x3 stencil's rows: the row's own range, and the range across the x boundary (a seam or a wall)."""
 
     @jit
     def stencil_range(i, dcy, cell, begin, ncx, ncy, ly, k):
@@ -275,6 +269,20 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         cx = cell[i] % ncx
         return cx == 0 or cx == ncx - 1
 
+    return {
+        "stencil_range": stencil_range,
+        "across_range": across_range,
+        "stencil_row": stencil_row,
+        "on_x_boundary": on_x_boundary,
+    }
+
+
+def across_sums(jit, stencil_row, on_x_boundary, plain, mirrored) -> dict:
+    """The sums over the particles across i's x boundary: periodic images beyond a seam, mirrors beyond a wall
+    (``plain`` and ``mirrored``: :func:`range_sums`' four)."""
+    continuity_range, momentum_range, neighbours_range, moments_range = plain
+    continuity_mirror, momentum_mirror, neighbours_mirror, moments_mirror = mirrored
+
     @jit
     def continuity_across(i, cell, begin, ncx, ncy, lx, ly, sx, sy, u, v, vol, k):
         """The part of sum_j vol_j u_ij . r_ij G_ij from across particle i's x boundary: the periodic images
@@ -344,6 +352,22 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
             gy += e
         return mxx, mxy, myy, gx, gy
 
+    return {
+        "continuity_across": continuity_across,
+        "momentum_across": momentum_across,
+        "neighbours_across": neighbours_across,
+        "moments_across": moments_across,
+    }
+
+
+def cell_sums(jit, across, stencil_range, plain, beyond) -> dict:
+    """The sums over particle i's 3x3 cells, and across its x boundary where ``across`` (``beyond``:
+    :func:`across_sums`')."""
+    continuity_range, momentum_range, neighbours_range, moments_range = plain
+    continuity_across, momentum_across, neighbours_across, moments_across = (
+        beyond[name] for name in ("continuity_across", "momentum_across", "neighbours_across", "moments_across")
+    )
+
     @jit
     def moments_cells(i, cell, begin, ncx, ncy, lx, ly, sx, sy, vol, k):
         """Particle i's moment matrix (M_xx, M_xy, M_yy) and Gamma (x, y) from the 3x3 cells around it and
@@ -406,7 +430,20 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
             count += neighbours_range(j0, j1, lx[i], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
-    # ---------------------------------------------------------------- all pairs
+    return {
+        "moments_cells": moments_cells,
+        "continuity_cells": continuity_cells,
+        "momentum_cells": momentum_cells,
+        "neighbours_cells": neighbours_cells,
+    }
+
+
+def allpair_sums(jit, across, plain, mirrored) -> dict:
+    """The sums over every particle (the paper's all-pair search): the nearest image along a periodic axis, each
+    wall's mirrors."""
+    continuity_range, momentum_range, neighbours_range, moments_range = plain
+    continuity_mirror, momentum_mirror, neighbours_mirror, moments_mirror = mirrored
+
     @jit
     def minimum_image_row(lyi, lyj, k):
         """lyi shifted by a whole period so that |lyi - lyj| <= ny/2 where y is periodic (exact)."""
@@ -511,6 +548,19 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
                 count += neighbours_mirror(j, j + 1, lx[i] - k[MIRROR_HI], lyi, sx[i], sy[i], lx, ly, sx, sy, k)
         return count - 1
 
+    return {
+        "minimum_image_row": minimum_image_row,
+        "minimum_image_column": minimum_image_column,
+        "continuity_allpair": continuity_allpair,
+        "momentum_allpair": momentum_allpair,
+        "moments_allpair": moments_allpair,
+        "neighbours_allpair": neighbours_allpair,
+    }
+
+
+def particle_passes(jit) -> dict:
+    """Per particle: the sweeps' coefficients (PI), the system update (SU) and the gradient correction's passes."""
+
     # ---- per particle: the sweeps' coefficients (PI) and the system update (SU), one particle each, so that a
     # device kernel or a CPU loop (parallel or not) makes each a single pass instead of a chain of array operations
     @jit
@@ -563,42 +613,41 @@ def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -
         ax[i] = (lxx[i] * bx + lxy[i] * by) / rho
         ay[i] = (lxy[i] * bx + lyy[i] * by) / rho
 
+    return {
+        "coefficients_at": coefficients_at,
+        "kick_at": kick_at,
+        "advance_at": advance_at,
+        "corrected_velocity_at": corrected_velocity_at,
+        "corrected_continuity_at": corrected_continuity_at,
+        "corrected_momentum_at": corrected_momentum_at,
+    }
+
+
+def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -> ModuleType:
+    """The pair functions compiled with ``jit`` for ``kernel`` in ``precision``, using
+    ``exp_neg(x) = exp(-x)`` (itself compiled here) where the kernel needs it. ``across``: whether an x
+    edge of the scene has images (a periodic seam or a rigid wall); False compiles the stencil sums and the
+    all-pair sums without the pairs across it (a compile-time constant: the paper's scene, free in x, pays
+    nothing for seams and walls it does not have; see :func:`stencil_range`).
+
+    They come back as attributes of a module object, which numba resolves inside the jitted sweeps
+    that call them (it cannot type a plain namespace).
+    """
+    gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg)))
+    plain = range_sums(jit, gradient, mirror=False)
+    mirrored = range_sums(jit, gradient, mirror=True)
+    stencil = stencil_rules(jit)
+    beyond = across_sums(jit, stencil["stencil_row"], stencil["on_x_boundary"], plain, mirrored)
     pairs = ModuleType(f"{__name__}.compiled", "The pair functions for one backend (see make_pairs).")
     pairs.__dict__.update(
         gradient=gradient,
-        continuity_range=continuity_range,
-        momentum_range=momentum_range,
-        neighbours_range=neighbours_range,
-        continuity_mirror=continuity_mirror,
-        momentum_mirror=momentum_mirror,
-        neighbours_mirror=neighbours_mirror,
-        moments_range=moments_range,
-        moments_mirror=moments_mirror,
-        moments_across=moments_across,
-        moments_cells=moments_cells,
-        moments_allpair=moments_allpair,
-        on_x_boundary=on_x_boundary,
-        continuity_across=continuity_across,
-        momentum_across=momentum_across,
-        neighbours_across=neighbours_across,
-        cell_index=cell_index,
-        stencil_row=stencil_row,
-        stencil_range=stencil_range,
-        across_range=across_range,
-        continuity_cells=continuity_cells,
-        momentum_cells=momentum_cells,
-        neighbours_cells=neighbours_cells,
-        minimum_image_row=minimum_image_row,
-        minimum_image_column=minimum_image_column,
-        wrap_at=wrap_at,
-        continuity_allpair=continuity_allpair,
-        momentum_allpair=momentum_allpair,
-        neighbours_allpair=neighbours_allpair,
-        coefficients_at=coefficients_at,
-        kick_at=kick_at,
-        advance_at=advance_at,
-        corrected_velocity_at=corrected_velocity_at,
-        corrected_continuity_at=corrected_continuity_at,
-        corrected_momentum_at=corrected_momentum_at,
+        **dict(zip(("continuity_range", "momentum_range", "neighbours_range", "moments_range"), plain)),
+        **dict(zip(("continuity_mirror", "momentum_mirror", "neighbours_mirror", "moments_mirror"), mirrored)),
+        **cell_search(jit),
+        **stencil,
+        **beyond,
+        **cell_sums(jit, across, stencil["stencil_range"], plain, beyond),
+        **allpair_sums(jit, across, plain, mirrored),
+        **particle_passes(jit),
     )
     return pairs
