@@ -44,6 +44,22 @@ def build_parser() -> argparse.ArgumentParser:
     results_help = f"folder of results stores, *.jsonl (default: {paths.user_results()})"
     reports_help = f"folder for the reports (default: {paths.user_reports()})"
 
+    add_run(sub, results_help)
+    add_study(sub, results_help, reports_help)
+    add_report(sub, results_help, reports_help)
+    add_runs(sub, results_help)
+    add_accuracy(sub)
+    add_advise(sub, results_help)
+    add_profile(sub)
+    add_gpu_check(sub, results_help, reports_help)
+    add_check_solver(sub)
+    add_cache(sub)
+    parser.subcommands = dict(sub.choices)  # an unknown option is its subcommand's error
+    return parser
+
+
+def add_run(sub, results_help: str) -> None:
+    """``pcabench run``: its options and the function that runs it."""
     p = sub.add_parser(
         "run",
         help="run one scene on one solver and print the stage table",
@@ -78,6 +94,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_run)
 
+
+def add_study(sub, results_help: str, reports_help: str) -> None:
+    """``pcabench study``: its options and the function that runs it."""
     p = sub.add_parser(
         "study",
         help="run a sweep (each run in its own process) and write the report",
@@ -115,6 +134,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_study)
 
+
+def add_report(sub, results_help: str, reports_help: str) -> None:
+    """``pcabench report``: its options and the function that runs it."""
     p = sub.add_parser("report", help="regenerate the reports from the stored results")
     p.add_argument(
         "--reference", action="store_true", help="the committed reference: reports/results -> reports/ of the checkout"
@@ -124,6 +146,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--scene", choices=scene_names(), help="only this scene's runs (default: every scene)")
     p.set_defaults(func=cmd_report)
 
+
+def add_runs(sub, results_help: str) -> None:
+    """``pcabench runs``: its options and the function that runs it."""
     p = sub.add_parser("runs", help="list and filter stored runs, or compare two machines or commits")
     p.add_argument("--results", type=folder("--results"), help=results_help)
     p.add_argument("--reference", action="store_true", help="the committed reference results (reports/results)")
@@ -148,6 +173,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_runs)
 
+
+def add_accuracy(sub) -> None:
+    """``pcabench accuracy``: its options and the function that runs it."""
     p = sub.add_parser(
         "accuracy",
         help="predict a run's error and largest stable CFL from the dispersion relation",
@@ -162,6 +190,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")
     p.set_defaults(func=cmd_accuracy)
 
+
+def add_advise(sub, results_help: str) -> None:
+    """``pcabench advise``: its options and the function that runs it."""
     p = sub.add_parser(
         "advise",
         help="the fastest stored run that reaches an error at a physical time",
@@ -210,6 +241,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="one JSON object: command, error, seconds, paper_seconds")
     p.set_defaults(func=cmd_advise)
 
+
+def add_profile(sub) -> None:
+    """``pcabench profile``: its options and the function that runs it."""
     p = sub.add_parser("profile", help="capture this machine's hardware profile")
     p.add_argument("--save", action="store_true", help="store it among the user's profiles")
     p.add_argument("--out", type=folder("--out"), help=f"folder to store it in (default: {paths.user_profiles()})")
@@ -221,6 +255,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_profile)
 
+
+def add_gpu_check(sub, results_help: str, reports_help: str) -> None:
+    """``pcabench gpu-check``: its options and the function that runs it."""
     p = sub.add_parser(
         "gpu-check",
         help="on a GPU machine: all of the GPU work in one call, within a budget",
@@ -244,6 +281,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_gpu_check)
 
+
+def add_check_solver(sub) -> None:
+    """``pcabench check-solver``: its options and the function that runs it."""
     p = sub.add_parser(
         "check-solver",
         help="the conformance suite: is a solver (yours too) right?",
@@ -259,6 +299,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="one JSON object: solver, ok, checks")
     p.set_defaults(func=cmd_check_solver)
 
+
+def add_cache(sub) -> None:
+    """``pcabench cache``: its options and the function that runs it."""
     p = sub.add_parser(
         "cache",
         help="show or clear the on-disk cache of compiled loops",
@@ -269,5 +312,3 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--clear", action="store_true", help="remove every compiled loop (all targets)")
     p.add_argument("--json", action="store_true", help="one JSON object: root, target, entries")
     p.set_defaults(func=cmd_cache)
-    parser.subcommands = dict(sub.choices)  # an unknown option is its subcommand's error
-    return parser
