@@ -357,11 +357,16 @@ def predict_2d(scene, kind) -> Prediction:
     x, y, drho, u, v, t = predicted_fields_2d(scene.replace(model="linear"))
     fields = Fields(x=x.ravel(), y=y.ravel(), u=u.ravel(), v=v.ravel(), drho=drho.ravel(), t=t)
     measures = kind.errors(scene.replace(model="linear"), fields)
-    axis, diagonal = phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4)
+    return scored_prediction(measures, stable_cfl(scene), t, phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4))
+
+
+def scored_prediction(measures: dict, stable: float, t: float, axis: tuple, diagonal: tuple) -> Prediction:
+    """A Prediction from a scene's error ``measures`` of the predicted fields (their ``mse`` and ``me`` the
+    headline), its stable CFL and the (lattice, with the step) phase errors along the axis and the diagonal."""
     return Prediction(
         predicted_error=measures.pop("mse"),
         predicted_me=measures.pop("me"),
-        stable_cfl=stable_cfl(scene),
+        stable_cfl=stable,
         t_end=t,
         lattice_phase_error=axis[0],
         step_phase_error=axis[1],

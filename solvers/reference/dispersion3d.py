@@ -18,7 +18,14 @@ from functools import lru_cache
 
 import numpy as np
 
-from solvers.reference.dispersion import ModeSolver, Prediction, evolve, largest_stable_z, step_phase_angle
+from solvers.reference.dispersion import (
+    ModeSolver,
+    Prediction,
+    evolve,
+    largest_stable_z,
+    scored_prediction,
+    step_phase_angle,
+)
 
 SYMBOL_CHUNK = 1 << 21  # wavenumbers x neighbours evaluated at once
 
@@ -126,17 +133,7 @@ def predict(scene, kind) -> Prediction:
     fields = Fields(x=exact.x, y=exact.y, z=exact.z, u=u.ravel(), v=v.ravel(), w=w.ravel(), drho=drho.ravel(), t=t)
     measures = kind.errors(linear, fields)
     axis, diagonal = phase_errors(scene, (1.0, 0.0, 0.0)), phase_errors(scene, (1.0, 1.0, 1.0))
-    return Prediction(
-        predicted_error=measures.pop("mse"),
-        predicted_me=measures.pop("me"),
-        stable_cfl=stable_cfl(scene),
-        t_end=t,
-        lattice_phase_error=axis[0],
-        step_phase_error=axis[1],
-        lattice_phase_error_diagonal=diagonal[0],
-        step_phase_error_diagonal=diagonal[1],
-        measures=measures,
-    )
+    return scored_prediction(measures, stable_cfl(scene), t, axis, diagonal)
 
 
 def phase_errors(scene, direction: tuple) -> tuple[float, float]:
