@@ -23,7 +23,7 @@ def sweeps(precision: str, kernel: str, across: bool = True, dims: int = 2) -> d
     the per-particle updates; in 3D solvers/loops/allpair3d.py's."""
     if dims == 3:
         loops = cpu_loops("allpair3d", precision, kernel, False, across)
-        return {**cpu_updates(precision, False), **{name: getattr(loops, name) for name in COMPILED["allpair3d"]}}
+        return {**cpu_updates(precision, False, dims), **{name: getattr(loops, name) for name in COMPILED["allpair3d"]}}
     loops = cpu_loops("allpair", precision, kernel, False, across)
     return {**{name: getattr(loops, name) for name in COMPILED["allpair"]}, **cpu_updates(precision, False)}
 

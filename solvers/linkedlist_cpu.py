@@ -42,7 +42,10 @@ def sweeps(precision: str, kernel: str, parallel: bool, across: bool = True, dim
     machine), and the per-particle updates; in 3D the 27-cell loops and their updates (solvers/loops/cells3d.py)."""
     if dims == 3:
         loops = cpu_loops("cells3d", precision, kernel, parallel, across)
-        return {**cpu_updates(precision, parallel), **{name: getattr(loops, name) for name in COMPILED["cells3d"]}}
+        return {
+            **cpu_updates(precision, parallel, dims),
+            **{name: getattr(loops, name) for name in COMPILED["cells3d"]},
+        }
     loops = cpu_loops("cells", precision, kernel, parallel, across)
     return {**{name: getattr(loops, name) for name in COMPILED["cells"]}, **cpu_updates(precision, parallel)}
 

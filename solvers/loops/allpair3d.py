@@ -24,16 +24,6 @@ def neighbours(lx, ly, lz, sx, sy, sz, k):
     return total
 
 
-def kick(u, v, w, ax, ay, az, c):
-    for i in range(u.shape[0]):
-        P.kick_at(i, u, v, w, ax, ay, az, c)
-
-
-def advance(drho, dd, sx, sy, sz, u, v, w, c, moving):
-    for i in range(drho.shape[0]):
-        P.advance_at(i, drho, dd, sx, sy, sz, u, v, w, c, moving)
-
-
 def moments(lx, ly, lz, sx, sy, sz, vol, mxx, mxy, mxz, myy, myz, mzz, gx, gy, gz, k):
     """The kernel gradient correction's moment matrix (6) and Gamma (3) of every particle (solvers/corrections/)."""
     n = lx.shape[0]
@@ -41,18 +31,3 @@ def moments(lx, ly, lz, sx, sy, sz, vol, mxx, mxy, mxz, myy, myz, mzz, gx, gy, g
         mxx[i], mxy[i], mxz[i], myy[i], myz[i], mzz[i], gx[i], gy[i], gz[i] = P.moments_allpair(
             i, n, lx, ly, lz, sx, sy, sz, vol, k
         )
-
-
-def corrected_velocity(u, v, w, lxx, lxy, lxz, lyy, lyz, lzz, wx, wy, wz):
-    for i in range(u.shape[0]):
-        P.corrected_velocity_at(i, u, v, w, lxx, lxy, lxz, lyy, lyz, lzz, wx, wy, wz)
-
-
-def corrected_continuity(dd, drho, wx, wy, wz, gx, gy, gz, k):
-    for i in range(dd.shape[0]):
-        P.corrected_continuity_at(i, dd, drho, wx, wy, wz, gx, gy, gz, k)
-
-
-def corrected_momentum(ax, ay, az, drho, lxx, lxy, lxz, lyy, lyz, lzz, gx, gy, gz, k):
-    for i in range(ax.shape[0]):
-        P.corrected_momentum_at(i, ax, ay, az, drho, lxx, lxy, lxz, lyy, lyz, lzz, gx, gy, gz, k)

@@ -34,34 +34,9 @@ def cell_ids(lx, ly, lz, sx, sy, sz, cell, dx, x_grid, width, height, depth, cw,
         )
 
 
-def kick(u, v, w, ax, ay, az, c):
-    for i in prange(u.shape[0]):
-        P.kick_at(i, u, v, w, ax, ay, az, c)
-
-
-def advance(drho, dd, sx, sy, sz, u, v, w, c, moving):
-    for i in prange(drho.shape[0]):
-        P.advance_at(i, drho, dd, sx, sy, sz, u, v, w, c, moving)
-
-
 def moments(cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, vol, mxx, mxy, mxz, myy, myz, mzz, gx, gy, gz, k):
     """The kernel gradient correction's moment matrix (6) and Gamma (3) of every particle (solvers/corrections/)."""
     for i in prange(lx.shape[0]):
         mxx[i], mxy[i], mxz[i], myy[i], myz[i], mzz[i], gx[i], gy[i], gz[i] = P.moments_cells(
             i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, vol, k
         )
-
-
-def corrected_velocity(u, v, w, lxx, lxy, lxz, lyy, lyz, lzz, wx, wy, wz):
-    for i in prange(u.shape[0]):
-        P.corrected_velocity_at(i, u, v, w, lxx, lxy, lxz, lyy, lyz, lzz, wx, wy, wz)
-
-
-def corrected_continuity(dd, drho, wx, wy, wz, gx, gy, gz, k):
-    for i in prange(dd.shape[0]):
-        P.corrected_continuity_at(i, dd, drho, wx, wy, wz, gx, gy, gz, k)
-
-
-def corrected_momentum(ax, ay, az, drho, lxx, lxy, lxz, lyy, lyz, lzz, gx, gy, gz, k):
-    for i in prange(ax.shape[0]):
-        P.corrected_momentum_at(i, ax, ay, az, drho, lxx, lxy, lxz, lyy, lyz, lzz, gx, gy, gz, k)

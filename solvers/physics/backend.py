@@ -106,40 +106,25 @@ COMPILED = {
         "cell_ids",
     ),
     "allpair": ("continuity", "momentum", "moments", "neighbours"),
-    "cells3d": (
-        "continuity",
-        "momentum",
-        "moments",
-        "neighbours",
-        "cell_ids",
-        "kick",
-        "advance",
-        "corrected_velocity",
-        "corrected_continuity",
-        "corrected_momentum",
-    ),
-    "allpair3d": (
-        "continuity",
-        "momentum",
-        "moments",
-        "neighbours",
-        "kick",
-        "advance",
-        "corrected_velocity",
-        "corrected_continuity",
-        "corrected_momentum",
-    ),
+    "cells3d": ("continuity", "momentum", "moments", "neighbours", "cell_ids"),
+    "allpair3d": ("continuity", "momentum", "moments", "neighbours"),
+    "updates3d": ("kick", "advance", "corrected_velocity", "corrected_continuity", "corrected_momentum"),
     "pairlist": ("build", "continuity", "continuity_split", "momentum", "moments"),
 }
 LOOP_OPTIONS = {"pairlist": {"error_model": "numpy"}}
 
 
 @lru_cache(maxsize=None)
-def cpu_updates(precision: str, parallel: bool) -> dict:
+def cpu_updates(precision: str, parallel: bool, dims: int = 2) -> dict:
     """The per-particle loops of a CPU solver, serial or on numba's threads: the sweeps' coefficients,
-    the system update (kick, advance) and the gather that reorders an array (``parts`` ranges)."""
+    the system update (kick, advance) and the gather that reorders an array (``parts`` ranges); in 3D the
+    kick, the advance and the correction's passes with the third component (solvers/loops/updates3d.py)."""
     loops = cpu_loops("updates", precision, DEFAULT_KERNEL, parallel)  # they do not depend on the kernel
-    return {name: getattr(loops, name) for name in COMPILED["updates"]}
+    out = {name: getattr(loops, name) for name in COMPILED["updates"]}
+    if dims == 3:
+        third = cpu_loops("updates3d", precision, DEFAULT_KERNEL, parallel)
+        out.update({name: getattr(third, name) for name in COMPILED["updates3d"]})
+    return out
 
 
 @lru_cache(maxsize=None)
