@@ -39,6 +39,10 @@ def main() -> int:
     before = signal.signal(signal.SIGTERM, _terminated)  # kept until cli.main installs its own
     before_int = signal.signal(signal.SIGINT, _interrupted)
     try:
+        if "--json" in sys.argv[1:]:  # one JSON object on stdout, whatever a plug-in the import loads prints
+            from pcabench import jsonout
+
+            jsonout.stdout_to_stderr()
         from pcabench.cli import main as cli_main
     except BaseException:  # noqa: BLE001 - a signal during the import, whatever the import made of it
         if _got["signal"] is None:

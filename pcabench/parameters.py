@@ -18,7 +18,7 @@ from typing import Callable
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel_names, scene_names, scenes
 from solvers.absorbers import absorber_named, absorber_names
-from solvers.bodies import DEFAULT_BOUNDARY_METHOD, boundary_method_names
+from solvers.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD, boundary_method_names
 from solvers.corrections import correction_named, correction_names
 from solvers.edges import OPEN_EDGES
 
@@ -156,7 +156,8 @@ BODY = (
         "boundary_method",
         "--boundary-method",
         "how a body's curved wall is modelled (solvers/bodies/: ghost particles on rings fitted to its surface, "
-        f"or on the lattice inside it; default {DEFAULT_BOUNDARY_METHOD})",
+        "on the lattice inside it, or none, the corrected operators making the wall; default "
+        f"{DEFAULT_BOUNDARY_METHOD}, with --correction {CORRECTED_BOUNDARY_METHOD})",
         boundary_method_names,
         per_scene=True,
     ),
@@ -177,7 +178,13 @@ METHOD = (
         ),
         correction_names,
     ),
-    Parameter("cutoff_factor", "--cutoff", "the Gaussian's cutoff in units of h", numeric=True),
+    Parameter(
+        "cutoff_factor",
+        "--cutoff",
+        "where a truncated kernel (one without a compact support: gaussian, laguerre-gauss) is cut, in units of h "
+        "(the Gaussian's default 3; 4 keeps laguerre-gauss fourth order); a compact kernel is cut at its support",
+        numeric=True,
+    ),
     Parameter("h_factor", "--h-factor", "h / dx", numeric=True),
     Parameter("cfl", "--cfl", "dt * c0 / dx", numeric=True),
 )

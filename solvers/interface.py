@@ -524,6 +524,15 @@ class Solver(abc.ABC):
             return float("nan")
         return m
 
+    def extremes(self) -> dict:
+        """{field: max |value| over particles}: 'velocity' (m/s, over its components) and 'drho' (kg/m^3); NaN for
+        a field that is not finite (what a run checks against Scene.blowup_bounds after every step)."""
+        a, out = self.arrays, {}
+        for field, names in (("velocity", VELOCITY[self.scene.dims]), ("drho", ("drho",))):
+            m = max(float(abs(a[name]).max()) for name in names)  # NaN anywhere: NaN (max propagates it)
+            out[field] = m if math.isfinite(m) else math.nan
+        return out
+
     def mean_neighbours(self) -> float:
         """Mean count of neighbours within the cutoff at the current positions, by the neighbour search on
         arrays of its own: no side effect (the state is not re-sorted: the count is the same in any order)."""

@@ -45,6 +45,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from types import ModuleType
 
+from solvers.sources import code_sources
+
 ENV = "PCABENCH_CACHE"  # the cache root, if set
 FIRST_PARTY = ("solvers",)  # a template's imports of these packages are part of its key
 _lock = threading.Lock()
@@ -163,24 +165,10 @@ def _source_file(dep) -> Path:
     return Path(inspect.getsourcefile(dep))
 
 
-def class_sources(cls: type) -> list[Path]:
-    """The source files of ``cls`` and of every class it inherits from (its whole MRO, built-in types left
-    out): a subclass's compiled code can come from any of them (``class K(Gaussian)`` compiles Gaussian's
-    ``compiled_gradient`` unless it overrides it)."""
-    out = []
-    for c in cls.__mro__:
-        if c.__module__ in ("builtins", "abc", "typing"):
-            continue
-        try:
-            out.append(Path(inspect.getsourcefile(c)))
-        except (TypeError, OSError):  # a class made at run time (no file): its module's name cannot key it
-            raise ValueError(f"jitcache: no source file for class {c.__qualname__} (of {cls.__qualname__})") from None
-    return list(dict.fromkeys(out))
-
-
 def _sources(dep) -> list[Path]:
-    """The source files ``dep`` stands for: a class's whole MRO (:func:`class_sources`), else its one file."""
-    return class_sources(dep) if inspect.isclass(dep) else [_source_file(dep)]
+    """The source files ``dep`` stands for: every file a class's code can come from (its MRO's, and a plug-in's
+    package, distribution and own imports: :func:`solvers.sources.code_sources`), else its one file."""
+    return code_sources(dep) if inspect.isclass(dep) else [_source_file(dep)]
 
 
 def imports_of(text: str) -> list[str]:

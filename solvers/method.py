@@ -92,7 +92,7 @@ class Method:
         elif cut is not None and cut < 1.0:
             yield f"cutoff_factor (cutoff/h) must be >= 1: a cutoff below h cuts the kernel's core (got {cut})"
         elif cut is not None and cut > 5.0:
-            yield f"cutoff_factor (cutoff/h) must be <= 5 (got {cut}); beyond 4 the Gaussian is below 1e-7"
+            yield f"cutoff_factor (cutoff/h) of the truncated kernel {self.kernel} must be in [1, 5] (got {cut})"
         else:
             try:
                 support = kernel_named(self.kernel).support

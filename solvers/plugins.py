@@ -95,6 +95,7 @@ class Registry:
         self.pinned = pinned  # a name keeps what it was first registered as for the life of the process
         self.order = order or (lambda entry: (entry.name != default, entry.name))
         self._found: dict[str, Any] | None = None
+        self._builtins: dict[str, Any] | None = None
         self._added: dict[str, Any] = {}
         self._classes: dict[str, Any] = {}  # what each name was registered as in this process (names key caches)
 
@@ -179,13 +180,21 @@ class Registry:
     def all(self) -> dict[str, Any]:
         """{name: entry}: the built-ins (in their order), then plug-ins', then those registered here."""
         if self._found is None:
+            builtin = self.builtins()
+            self._found = {**builtin, **{e.name: e for e in self._plugins(set(builtin))}}
+        return {**self._found, **self._added}
+
+    def builtins(self) -> dict[str, Any]:
+        """{name: entry} of the built-ins alone, in their order: no plug-in is loaded (a built-in's name is never a
+        plug-in's, so what it answers of a built-in holds with them)."""
+        if self._builtins is None:
             found = self._builtin()
             builtin = {e.name: e for e in found}
             if len(builtin) < len(found):  # two built-ins of one name: a mistake in the house, never a choice
                 twice = sorted({e.name for e in found if sum(f.name == e.name for f in found) > 1})
                 raise ValueError(f"two built-in {self.what}s share the name {', '.join(map(repr, twice))}")
-            self._found = {**builtin, **{e.name: e for e in self._plugins(set(builtin))}}
-        return {**self._found, **self._added}
+            self._builtins = builtin
+        return self._builtins
 
     def names(self) -> tuple[str, ...]:
         return tuple(self.all())
@@ -203,7 +212,7 @@ class Registry:
 
     def cache_clear(self) -> None:
         """Search the packages and entry points again at the next look-up (tests that install a plug-in)."""
-        self._found = None
+        self._found = self._builtins = None
 
     # ---------------------------------------------------------------- registering in this process
     def register(self, obj):

@@ -110,7 +110,7 @@ class Scene:
     precision: str = "float64"
     steps: int | None = None
     t_end: float | None = None
-    blowup_factor: float = 4.0  # unstable once max|u| > blowup_factor * mach * c0
+    blowup_factor: float = 4.0  # unstable once max|u| > blowup_factor * mach * c0 or max|drho| > ... * mach * rho0
     memory_limit_bytes: int | None = field(default=None, compare=False)
 
     # The scene's parameters, flat: its keywords, its record's columns and its options (pcabench/parameters.py),
@@ -437,10 +437,57 @@ class Scene:
 
     @property
     def boundary_method_used(self) -> str:
-        """How the body's wall is modelled: ``boundary_method``, or the default (solvers/bodies/)."""
-        from solvers.bodies import DEFAULT_BOUNDARY_METHOD
+        """How the body's wall is modelled: ``boundary_method``, or the default (solvers/bodies/): standard SPH's
+        (rings), or with a kernel correction the one whose wall holds with it (weak)."""
+        from solvers.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD
 
-        return self.boundary_method or DEFAULT_BOUNDARY_METHOD
+        if self.boundary_method:
+            return self.boundary_method
+        return DEFAULT_BOUNDARY_METHOD if self.correction == DEFAULT_CORRECTION else CORRECTED_BOUNDARY_METHOD
+
+    @property
+    def blowup_bounds(self) -> dict:
+        """{field: (bound, unit, formula)}: a run has blown up once max|field| passes its bound (the velocity, m/s,
+        over its components; drho, kg/m^3): ``blowup_factor`` times the pulse's amplitude, mach c0 and mach rho0."""
+        return {
+            "velocity": (self.blowup_factor * self.mach * self.c0, "m/s", "blowup_factor * mach * c0"),
+            "drho": (self.blowup_factor * self.mach * self.rho0, "kg/m^3", "blowup_factor * mach * rho0"),
+        }
+
+    @property
+    def cautions(self) -> tuple[str, ...]:
+        """Lines a run or a prediction of this scene prints before its work: a combination known to blow up
+        (:attr:`known_failure`), a truncated kernel cut below where it keeps its order."""
+        out = [self.known_failure] if self.known_failure else []
+        try:
+            order_cut = getattr(kernel_named(self.kernel), "order_cutoff", None)
+        except ValueError:
+            order_cut = None
+        if order_cut is not None and self.cutoff_factor < order_cut - 1e-9:
+            out.append(
+                f"--kernel {self.kernel} cut at {self.cutoff_factor:g} h loses its order (the cut's error leads); "
+                f"--cutoff {order_cut:g} keeps it"
+            )
+        return tuple(out)
+
+    @property
+    def known_failure(self) -> str:
+        """One line where this combination of body and method is known to blow up (a ghost body with a kernel
+        correction), naming what holds; "" otherwise."""
+        if self.body is None or self.correction == DEFAULT_CORRECTION:
+            return ""
+        from solvers.bodies import CORRECTED_BOUNDARY_METHOD, boundary_method_named
+
+        try:
+            why = getattr(boundary_method_named(self.boundary_method_used), "fails_with_correction", "")
+        except ValueError:  # an unknown method: named by _validate
+            return ""
+        return (
+            f"--boundary-method {self.boundary_method_used} with --correction {self.correction} is known to blow up: "
+            f"{why}; --boundary-method {CORRECTED_BOUNDARY_METHOD} holds"
+            if why
+            else ""
+        )
 
     def _validate_open(self, need, finite) -> None:
         """The open edges (:meth:`solvers.edges.Edges.problems`): the first problem, in one line."""
@@ -779,6 +826,8 @@ class Scene:
 
     def describe(self) -> str:
         scene = "" if self.name == DEFAULT_SCENE else f"{self.name}, "
+        if self.body is not None:  # the wall's model, the default's too (it depends on the correction)
+            scene += f"{self.boundary_method_used} wall, "
         corrected = "" if self.correction == DEFAULT_CORRECTION else f" ({self.correction}-corrected)"
         edges = (
             f"open {self.open} ({self.absorber_used}, {self.layer:g} m of layer, {self.strength:.3g} 1/s), "

@@ -265,6 +265,7 @@ def test_each_command_advise_names_run_gives_advise_what_it_asked_for(tmp_path, 
         (("--mach", "0.5"), "--mach"),
         (("--open", "y"), "--open y"),  # the plane pulse's y is a plane wave's period
         (("--scene", "cylinder", "--open", "x"), "--open"),  # its four edges are always open
+        (("--scene", "cylinder", "--domain", "strip"), "--domain strip"),  # the cylinder has no strip
     ],
 )
 def test_a_problem_the_scene_refuses_is_refused_before_any_advice(tmp_path, args, option, capsys):

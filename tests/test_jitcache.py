@@ -144,6 +144,42 @@ def test_a_kernel_that_subclasses_another_recompiles_when_the_class_it_inherits_
     assert edited["digest"] != first["digest"]
 
 
+HELPED = textwrap.dedent(
+    """
+    import os, sys
+    sys.path.insert(0, os.path.dirname(__file__))
+    import numpy as np
+    from plugin_helper import shape
+    from solvers.kernels.constants import GRAD0, INV_H2
+    from solvers.kernels.gaussian import Gaussian
+
+    class Plugin(Gaussian):
+        name = "plugin-helped"
+
+        def compiled_gradient(self, dtype, exp_neg):
+            def gradient(r2, k):
+                return shape(k[GRAD0] * exp_neg(r2 * k[INV_H2]))
+
+            return gradient
+    """
+)
+
+
+def test_a_kernel_recompiles_when_a_helper_module_its_compiled_code_calls_is_edited(tmp_path):
+    """The kernel's compiled gradient calls a jitted function of another module beside it (a plug-in's package,
+    or a lone module's sibling): an edit there is an edit of the loops (the key holds what the plug-in's own
+    modules import, solvers/sources.py)."""
+    kernel, helper, cache = tmp_path / "plugin_kernel.py", tmp_path / "plugin_helper.py", tmp_path / "cache"
+    kernel.write_text(HELPED)
+    helper.write_text("import numba\n\n\n@numba.njit\ndef shape(g):\n    return g\n")
+    first = probe(cache, kernel_file=kernel)
+    assert first["compiled"] > 0
+    helper.write_text("import numba\n\n\n@numba.njit\ndef shape(g):\n    return 1.25 * g\n")
+    edited = probe(cache, kernel_file=kernel)
+    assert edited["compiled"] > 0, "the loops were served from the cache after the helper's edit"
+    assert edited["digest"] != first["digest"]
+
+
 def test_the_key_covers_the_pair_physics_numba_and_the_target(monkeypatch):
     text = jitcache.render("solvers.loops.allpair", {"P": "cpu_pairs('float64', 'gaussian')"}, {})
     base = jitcache.key(text, ("solvers.physics.pairs",))

@@ -3,6 +3,7 @@ the code that makes a run, first-party and plug-ins alike; the store's resume ke
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -57,6 +58,61 @@ def test_a_study_reruns_what_a_plugins_edit_changed_and_resumes_what_it_did_not(
     rows = store.read_rows(results)
     assert len(rows) == 2 and len({r["code"] for r in rows}) == 2  # one commit, two codes: told apart
     assert len({r["commit"] for r in rows}) == 1
+
+
+LONE = """
+from solvers.kernels.wendland_c2 import WendlandC2
+
+from lone_constants import SCALE
+
+
+class Lone(WendlandC2):
+    name = "lone-kernel"
+
+    def value(self, r, h, dims=2):
+        return SCALE * super().value(r, h, dims)
+"""
+
+
+@pytest.mark.parametrize("layout", ["lone module", "package"])
+def test_the_code_key_holds_every_module_a_plugin_imports_of_its_own(tmp_path, layout):
+    """A kernel plug-in that imports a constant from a module beside it (a lone module's sibling, or another
+    module of its package): an edit there changes the code key (a study runs again), undoing it restores it."""
+    from solvers.kernels.registry import ENTRY_POINT_GROUP as KERNELS
+
+    site = tmp_path / "site"
+    if layout == "lone module":
+        install(site, "lone_kernel", LONE, {})
+        constants = site / "lone_constants.py"
+        target = "lone_kernel:Lone"
+    else:
+        install(site, "lone_kernel", "", {})
+        (site / "lone_kernel.py").unlink()
+        (site / "lone_pkg").mkdir()
+        (site / "lone_pkg" / "__init__.py").write_text(LONE.replace("from lone_constants", "from lone_pkg.constants"))
+        constants = site / "lone_pkg" / "constants.py"
+        target = "lone_pkg:Lone"
+    (site / "lone_kernel-0.1.dist-info" / "entry_points.txt").write_text(f"[{KERNELS}]\nlone-kernel = {target}\n")
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)])}
+
+    def key() -> str:
+        out = subprocess.run(
+            [sys.executable, "-c", "from pcabench.store.provenance import code_key; print(code_key())"],
+            capture_output=True,
+            text=True,
+            env=env,
+            cwd=ROOT,
+            timeout=120,
+        )
+        assert out.returncode == 0, out.stderr[-2000:]
+        return out.stdout.split()[-1]
+
+    constants.write_text("SCALE = 1.0\n")
+    before = key()
+    constants.write_text("SCALE = 1.5\n")
+    assert key() != before, "an edit of a module the plug-in imports left the code key as it was"
+    constants.write_text("SCALE = 1.0\n")
+    assert key() == before
 
 
 # ---------------------------------------------------------------- the parent checks what it scores
@@ -178,19 +234,22 @@ def alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the subreaper is Linux's")
-@pytest.mark.parametrize("command", ["run", "study"])
+@pytest.mark.parametrize("command", ["run", "plain run", "study"])
 def test_a_process_that_leaves_the_runs_group_ends_with_the_run(tmp_path, command):
-    """`run` returns and `study` stores its run in seconds, not when the escaped processes end (600 s), and
-    neither escaped process outlives the run."""
+    """`run` (with a budget: in a child; plain: in-process) returns and `study` stores its run in seconds, not
+    when the escaped processes end (600 s), though they hold its stdout and stderr pipes, and neither escaped
+    process outlives the run."""
     site, pids = tmp_path / "site", tmp_path / "pids"
     pids.mkdir()
     install(site, "escaper_solver", ESCAPER, {"escaper": "escaper_solver:Escaper"})
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)]), "ESCAPE_PIDS": str(pids)}
-    words = ["--solver", "escaper", "--dx", "1", "--steps", "3", "--run-budget", "60"]
-    extra = [] if command == "run" else ["--no-report", "--results", str(tmp_path)]
+    words = ["--solver", "escaper", "--dx", "1", "--steps", "3"] + (
+        [] if command == "plain run" else ["--run-budget", "60"]
+    )
+    extra = ["--no-report", "--results", str(tmp_path)] if command == "study" else []
     started = time.monotonic()
-    out = subprocess.run(
-        [sys.executable, "-m", "pcabench.cli", command, *words, *extra],
+    out = subprocess.run(  # capture_output: pipes, which the escaped processes inherit and hold
+        [sys.executable, "-m", "pcabench.cli", command.split()[-1], *words, *extra],
         capture_output=True,
         text=True,
         env=env,
@@ -210,6 +269,66 @@ def test_a_process_that_leaves_the_runs_group_ends_with_the_run(tmp_path, comman
                 pass
 
 
+FORGER = """
+import glob
+import json
+import os
+
+from solvers.linkedlist_cpu import LinkedListCPU
+
+
+class Forger(LinkedListCPU):
+    \"\"\"Appends to the store, behind the sweep's back, a copy of the row stored first with its stage times cut
+    a hundredfold and its error 1e-9: the same run_id, so the later copy would win.\"\"\"
+
+    name = "forger"
+
+    def init(self):
+        super().init()
+        folder = os.environ.get("FORGE_DIR")
+        if folder:
+            for path in glob.glob(os.path.join(folder, "*.jsonl")):
+                with open(path) as f:
+                    row = json.loads(f.readline())
+                row["stages"] = {k: v / 100 for k, v in row["stages"].items()}
+                row["mse"] = 1e-9
+                with open(path, "a") as f:
+                    f.write(json.dumps(row) + "\\n")
+"""
+
+
+def test_a_row_a_runs_process_writes_into_the_store_is_found_and_never_read(tmp_path):
+    """A run's process appends a forged copy of a stored row while the sweep holds the store: the sweep moves it
+    to ``<store>.foreign`` with one warning, and the stored row keeps its own times and error."""
+    site, results = tmp_path / "site", tmp_path / "results"
+    install(site, "forger_solver", FORGER, {"forger": "forger_solver:Forger"})
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)])}
+
+    def study(steps: int, forge: bool) -> subprocess.CompletedProcess:
+        return subprocess.run(
+            [sys.executable, "-m", "pcabench.cli", "study", "--solver", "forger", "--dx", "1", "--steps", str(steps)]
+            + ["--no-report", "--results", str(results)],
+            capture_output=True,
+            text=True,
+            env={**env, **({"FORGE_DIR": str(results)} if forge else {})},
+            cwd=ROOT,
+            timeout=300,
+        )
+
+    first = study(2, forge=False)
+    assert first.returncode == 0, first.stderr[-2000:]
+    (original,) = store.read_rows(results)
+    second = study(3, forge=True)
+    assert second.returncode == 0, second.stderr[-2000:]
+    assert "behind the sweep's back" in second.stderr, second.stderr[-2000:]
+    rows = {r["run_id"]: r for r in store.read_rows(results)}
+    assert len(rows) == 2
+    kept = rows[original["run_id"]]
+    assert kept["stages"] == original["stages"] and kept["mse"] == original["mse"]
+    (foreign,) = results.glob("*.foreign")
+    assert json.loads(foreign.read_text().splitlines()[0])["mse"] == 1e-9
+
+
 LOUD = """
 import atexit
 import os
@@ -225,14 +344,40 @@ class Loud(LinkedListCPU):
 """
 
 
-def test_run_json_is_one_object_on_stdout_whatever_a_plugin_prints_at_import_or_exit(tmp_path):
+LOUD_KERNEL = """
+import atexit
+import os
+
+from solvers.kernels.wendland_c2 import WendlandC2
+
+print("loud plug-in: imported")  # at import: a kernel's registry loads as the command line is built
+atexit.register(lambda: os.write(1, b"loud plug-in: bye\\n"))
+
+
+class LoudKernel(WendlandC2):
+    name = "loud-kernel"
+"""
+
+
+@pytest.mark.parametrize("registry", ["solver", "kernel"])
+def test_run_json_is_one_object_on_stdout_whatever_a_plugin_prints_at_import_or_exit(tmp_path, registry):
+    """A solver plug-in that runs, or a kernel plug-in that is only installed (another kernel runs)."""
     import json
 
+    from solvers.kernels.registry import ENTRY_POINT_GROUP as KERNELS
+
     site = tmp_path / "site"
-    install(site, "loud_solver", LOUD, {"loud-cpu": "loud_solver:Loud"})
+    if registry == "solver":
+        install(site, "loud_solver", LOUD, {"loud-cpu": "loud_solver:Loud"})
+    else:
+        install(site, "loud_kernel", LOUD_KERNEL, {})
+        (site / "loud_kernel-0.1.dist-info" / "entry_points.txt").write_text(
+            f"[{KERNELS}]\nloud-kernel = loud_kernel:LoudKernel\n"
+        )
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(site), str(ROOT)])}
+    solver = "loud-cpu" if registry == "solver" else "linkedlist-cpu"
     out = subprocess.run(
-        [sys.executable, "-m", "pcabench.cli", "run", "--solver", "loud-cpu", "--dx", "1", "--steps", "2", "--json"],
+        [sys.executable, "-m", "pcabench.cli", "run", "--solver", solver, "--dx", "1", "--steps", "2", "--json"],
         capture_output=True,
         text=True,
         env=env,

@@ -28,8 +28,16 @@ def cmd_accuracy(args) -> int:
     p = predict(scene)
     past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/predict/stability.py)
     if args.json:
-        jsonout.emit(jsonout.dumps({"scene": scene.as_dict(), **p.as_dict(), "past_stable_cfl": past}, sort_keys=True))
+        known = {"known_failure": scene.known_failure, "cautions": list(scene.cautions)}  # ("" / [] where none)
+        jsonout.emit(
+            jsonout.dumps({"scene": scene.as_dict(), **p.as_dict(), "past_stable_cfl": past, **known}, sort_keys=True)
+        )
         return 0
+    for caution in scene.cautions:  # the prediction is of the interior's operators: it cannot see a wall blow up
+        print(
+            f"warning: {caution}"
+            + (". The prediction below assumes the run holds." if caution == scene.known_failure else "")
+        )
     if past:
         print(
             f"CFL {scene.cfl:g} is past the largest stable CFL {p.stable_cfl:.3g} of {scene.integrator}: a run "

@@ -33,6 +33,7 @@ from solvers import (
     DEFAULT_SCENE,
     Scene,
     scene_kind,
+    scenes,
 )
 from solvers.method import Method
 
@@ -215,6 +216,9 @@ def cmd_advise(args) -> int:
         raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
     if not args.t_end > 0:
         raise OptionError(f"--t-end is a physical time in s, > 0 (got {args.t_end:g})")
+    if args.domain == "strip" and not scene_kind(args.scene).strip:  # before any work, as a run refuses it
+        strips = ", ".join(name for name, kind in scenes().items() if kind.strip)
+        raise OptionError(f"--domain strip applies to the scenes with a strip ({strips}), not to {args.scene}")
     results = results_of(args)
     df = load_frame(results) if results is not None and Path(results).exists() else None
     mach = Scene.default("mach") if args.mach is None else args.mach

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import sys
 from pathlib import Path
 
@@ -43,11 +44,13 @@ def cmd_run(args) -> int:
         store_path = check_writable(Path(args.results or paths.user_results()) / store_name(machine_id()))
     if not args.json:
         print(f"pcabench run: {spec.label}; {scene.describe()}", flush=True)
+    for caution in scene.cautions:  # before the work: the user may stop it
+        print(f"pcabench run: warning: {caution}", file=sys.stderr, flush=True)
     if args.run_budget is not None:  # in a child, as a sweep runs it: the budget holds whatever the solver does
         record = run_in_child(spec, args)
     else:
         progress = None if args.quiet else Progress(args.solver)
-        with solver_output_to_stderr(args.json):
+        with solver_output_to_stderr(args.json), contained():
             record = run(spec, machine_id(), fields_path=args.fields, progress=progress)
     if store_path is not None:
         from pcabench.store import append
@@ -62,6 +65,24 @@ def cmd_run(args) -> int:
     for what, path in went:  # where they went (on stderr beside --json's one object)
         print(f"{what:<17}{path}", file=sys.stderr if args.json else sys.stdout)
     return EXIT_OK if record.status == "ok" else EXIT_RUN_FAILED
+
+
+@contextlib.contextmanager
+def contained():
+    """Within: what the run starts ends with it, as a sweep's run (pcabench/execute/containment.py): this process
+    adopts the descendants that leave it (a plug-in's daemon, double-forked) and, after the run, ends every child
+    it did not have before, with its group, so none outlives the run or holds its output pipes open."""
+    from pcabench.execute import containment
+
+    adopting = containment.become_subreaper()
+    known = containment.children()
+    try:
+        yield
+    finally:
+        ended = containment.end_adopted(known) if adopting else 0
+        containment.stop_subreaper()
+        if ended:
+            print(f"pcabench run: ended {ended} process(es) the run left running", file=sys.stderr)
 
 
 def vtu_available() -> str:

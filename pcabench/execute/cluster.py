@@ -224,4 +224,4 @@ class Stores:
             store.check_writable(path)
             self.lock.hold(path)
             self.paths.add(path)
-        return store.append(row, path, held=self.lock.held(path))
+        return self.lock.append(row, path)

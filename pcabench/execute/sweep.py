@@ -459,7 +459,7 @@ class StoreFile:
         self.path, self.lock = path, lock
 
     def append(self, row: dict) -> dict:
-        return store.append(row, self.path, held=self.lock.held(self.path))
+        return self.lock.append(row, self.path)
 
 
 def run_specs(

@@ -55,6 +55,7 @@ from pathlib import Path
 from pcabench.errors import StoreError, StoreFull  # noqa: F401 - raised here, re-exported for callers
 from pcabench.store import schema
 from pcabench.store.schema import SCHEMA
+from pcabench.store.watch import StoreWatch
 from solvers import Scene, SceneError
 
 MIN_FREE_BYTES = 1 << 20  # a sweep needs room for its records: refuse to start with less free space
@@ -339,6 +340,7 @@ class SweepLock:
         self.folder = path if whole_folder else path.parent
         self.store = None if whole_folder else path
         self.fds, self.reserves, self.stores = [], [], {}
+        self.watches: dict = {}  # store path -> StoreWatch: what the sweep has seen of each store it holds
 
     def _lock(self, path: Path, how: int, what: str, holder_wrote_pid: bool = True) -> int:
         fd = _open(path, os.O_RDWR | os.O_CREAT)
@@ -395,14 +397,34 @@ class SweepLock:
             except BlockingIOError:
                 raise StoreError(f"results store {store_path} is being written by another process") from None
             self.reserves.append(keep_reserve(store_path))
+            _repair_tail(fd, store_path)  # whole lines only: what the watch sees ends with one
             self.stores[store_path] = fd
+            self.watches[store_path] = StoreWatch(fd, store_path)
         return self.stores[store_path]
 
     def held(self, store_path) -> int | None:
         """The held store's locked file descriptor (:meth:`hold`), or None."""
         return self.stores.get(Path(store_path))
 
+    def append(self, record, store_path) -> dict:
+        """:func:`append` ``record`` to the held store at ``store_path`` (held here if it is not yet), after moving
+        aside whatever was written into it behind this sweep's back (pcabench/store/watch.py); the row."""
+        store_path = Path(store_path)
+        fd = self.hold(store_path)
+        watch = self.watches[store_path]
+        watch.check()
+        try:
+            return append(record, store_path, held=fd)
+        finally:
+            watch.saw_append()
+
     def __exit__(self, *exc):
+        for watch in self.watches.values():  # the last run's process may have written after the last append
+            try:
+                watch.check()
+            except OSError:
+                pass
+        self.watches = {}
         for reserve in self.reserves:
             reserve.unlink(missing_ok=True)
         for fd in self.fds:

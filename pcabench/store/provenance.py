@@ -89,11 +89,12 @@ def _package_root(name: str) -> Path:
 def run_sources() -> dict[str, Path | None]:
     """{name: file} of every source that makes a run: each ``*.py`` of :data:`RUN_PACKAGES` (but
     :data:`NOT_RUN_CODE`), named by its path from the packages' folder; and each plug-in of
-    :func:`run_registries` (an entry whose class, or a class it inherits from, lives outside them): every
-    ``*.py`` of its top-level package (its one file for a lone module), named by the content alone, so the
+    :func:`run_registries` (an entry whose class, or a class it inherits from, lives outside them): every file
+    its code can come from (:func:`solvers.sources.code_sources`: its distribution's, its package's, the modules
+    it imports that are neither the interpreter's nor the environment's), named by the content alone, so the
     same plug-in installed at two places is one code. A plug-in class with no source file: None (its code is
     unknown, so no two processes share its key and nothing resumes on it)."""
-    from solvers.jitcache import class_sources
+    from solvers.sources import code_sources
 
     out, roots = {}, [_package_root(p) for p in RUN_PACKAGES]
     for root in roots:
@@ -105,22 +106,13 @@ def run_sources() -> dict[str, Path | None]:
         for entry in registry.all().values():
             cls = entry if inspect.isclass(entry) else type(entry)
             try:
-                sources = class_sources(cls)
+                sources = code_sources(cls)
             except ValueError:  # a class with no file (made in a notebook's cell): its code cannot be known
                 out[f"unknown:{cls.__module__}.{cls.__qualname__}"] = None
                 continue
-            for file in sources:
-                file = file.resolve()
-                if any(file.is_relative_to(root) for root in roots):
-                    continue
-                top = inspect.getmodule(cls).__name__.split(".")[0]
-                module = __import__(top)
-                files = [file]
-                if getattr(module, "__path__", None) and getattr(module, "__file__", None):
-                    files = sorted(Path(module.__file__).resolve().parent.rglob("*.py"))
-                for path in files:
-                    if "__pycache__" not in path.parts:
-                        out[f"plug-in:{hashlib.sha256(path.read_bytes()).hexdigest()}"] = path
+            for path in sources:
+                if not any(path.is_relative_to(root) for root in roots):
+                    out[f"plug-in:{hashlib.sha256(path.read_bytes()).hexdigest()}"] = path
     return out
 
 

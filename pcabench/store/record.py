@@ -162,9 +162,35 @@ class RunRecord:
         lines.append(f"{'jit':<8}{self.jit_seconds:12.4f}   ({how}, outside the timed stages)")
         return "\n".join(lines)
 
+    def failure_text(self, scene) -> str:
+        """``pcabench run``'s report of a run that did not finish scored: the stage table, its size, how far it
+        got, and its status in words (a blow-up: the step, the time and the field past its bound)."""
+        at = f" at step {self.failed_step}" if self.failed_step else ""
+        when = f" (t = {self.failed_step * scene.dt:.6g} s)" if self.failed_step else ""
+        words = {
+            "unstable": f"blew up{at}{when}",
+            "error": f"failed{at}{when}",
+            "out-of-memory": f"ran out of memory{at}",
+            "timeout": "stopped past its run budget",
+        }.get(self.status, self.status + at)
+        lines = [
+            self.stage_table(),
+            f"particles        {self.n_particles:,}",
+            f"steps            {self.steps} of {scene.n_steps}",
+            f"kernel           {scene.kernel} (cutoff {scene.cutoff:.4g} m)",
+            f"status           {self.status}: {words}; no errors measured",
+        ]
+        if self.message:
+            lines.append(f"message          {self.message.splitlines()[0]}")
+        if scene.known_failure:
+            lines.append(f"note             {scene.known_failure}")
+        return "\n".join(lines)
+
     def text(self, scene) -> str:
         """``pcabench run``'s report of this run of ``scene``: the stage table, the run's size, its errors
         (in the scene's primary field: u in m/s, drho in kg/m^3) and its status."""
+        if self.status != "ok":  # a failed run took no measures: what it is, and where and why it stopped
+            return self.failure_text(scene)
         primary = scene.kind.primary
         unit = {"u": "m/s", "drho": "kg/m^3"}.get(primary, "")
 

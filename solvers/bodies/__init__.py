@@ -5,6 +5,7 @@ from __future__ import annotations
 from solvers.bodies.base import GHOST, INERT, BodyEntered, BoundaryMethod
 from solvers.bodies.registry import (
     BOUNDARY_METHODS,
+    CORRECTED_BOUNDARY_METHOD,
     DEFAULT_BOUNDARY_METHOD,
     ENTRY_POINT_GROUP,
     boundary_method_named,
@@ -17,6 +18,7 @@ __all__ = [
     "BodyEntered",
     "BoundaryMethod",
     "BOUNDARY_METHODS",
+    "CORRECTED_BOUNDARY_METHOD",
     "DEFAULT_BOUNDARY_METHOD",
     "ENTRY_POINT_GROUP",
     "boundary_method_named",

@@ -24,6 +24,14 @@ class BodyEntered(RuntimeError):
     """A fluid particle moved inside the body: the run has failed at this step."""
 
 
+# A ghost body with a corrected kernel: ghosts filled from the fluid break the corrected operators' adjoint pairing
+GHOSTS_BREAK_CORRECTION = (
+    "ghosts filled from the fluid break the corrected operators' adjoint pairing; the corrected Laguerre-Gauss "
+    "method (h 1.5 dx, 4 h, Verlet CFL 0.5, dx 0.04) blew up at the body with rings at t = 1.8 s and with the "
+    "lattice's ghosts near t = 4 s (docs/accuracy.md)"
+)
+
+
 class BoundaryMethod:
     """Where a body's ghost particles sit (:meth:`place`) and where the fluid is sampled for their values
     (:meth:`sample_points`: by default their mirror points across the wall)."""
@@ -31,6 +39,8 @@ class BoundaryMethod:
     name: str = ""
     summary: str = ""
     needs_correction: bool = False  # whether it makes a wall only with a kernel correction (solvers/corrections/)
+    # Where its wall is known to blow up with a kernel correction: what was measured, one clause ("" where it holds)
+    fails_with_correction: str = ""
 
     def place(self, scene, x, y) -> tuple:
         """(ghost, inert, gx, gy) for the lattice sites at ``x``, ``y`` (m, float64 arrays, site order): which

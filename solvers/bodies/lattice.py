@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from solvers.bodies.base import BoundaryMethod, sites_inside
+from solvers.bodies.base import GHOSTS_BREAK_CORRECTION, BoundaryMethod, sites_inside
 
 
 class Lattice(BoundaryMethod):
@@ -12,6 +12,7 @@ class Lattice(BoundaryMethod):
 
     name = "lattice"
     summary = "the lattice's sites inside the body as its ghosts (a staircase), values from their mirror points"
+    fails_with_correction = GHOSTS_BREAK_CORRECTION
 
     def place(self, scene, x, y) -> tuple:
         _x0, _y0, a = scene.body

@@ -8,7 +8,9 @@ from solvers.bodies.base import BoundaryMethod
 from solvers.plugins import Registry
 
 ENTRY_POINT_GROUP = "pcabench.boundary_methods"
-DEFAULT_BOUNDARY_METHOD = "rings"
+DEFAULT_BOUNDARY_METHOD = "rings"  # standard SPH's body
+# A corrected method's body (--correction other than none): the one whose wall holds with it (ghosts blow up)
+CORRECTED_BOUNDARY_METHOD = "weak"
 
 BOUNDARY_METHODS = Registry(
     "boundary method",

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from solvers.bodies.base import BoundaryMethod, ring_count, sites_inside
+from solvers.bodies.base import GHOSTS_BREAK_CORRECTION, BoundaryMethod, ring_count, sites_inside
 
 
 class Rings(BoundaryMethod):
@@ -17,6 +17,7 @@ class Rings(BoundaryMethod):
 
     name = "rings"
     summary = "ghost particles on rings fitted to the body's surface, values from their mirror points"
+    fails_with_correction = GHOSTS_BREAK_CORRECTION
 
     def rings(self, scene, available: int) -> tuple:
         """(radius, angle) of every ring particle, m and rad, the outer ring first; at most ``available``."""

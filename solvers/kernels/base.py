@@ -37,6 +37,9 @@ class Kernel(abc.ABC):
     negative_lobe: bool = False  # W < 0 somewhere (a higher-order kernel): the tensile instability's source
     dimensions: tuple = (2,)  # the dimensions it is normalised for: (2, 3) takes ``dims`` in its methods
     norms: dict = {}  # {dims: sigma} where it has several dimensions (norm is norms[2])
+    # A truncated kernel's cut (in h) below which it loses its order ("--cutoff 2" leaves a fourth-order kernel
+    # second order); None where none is stated
+    order_cutoff: float | None = None
 
     @abc.abstractmethod
     def value(self, r, h: float):

@@ -28,6 +28,7 @@ class LaguerreGauss(Kernel):
     support = None
     norm = 2.0 / math.pi  # W = norm / h^2 (1 - q^2 / 2) exp(-q^2)
     negative_lobe = True  # beyond q = sqrt(2) (2D), sqrt(5/2) (3D)
+    order_cutoff = 4.0  # its fourth order needs the cut at 4 h (exp(-16): 1e-7); at 2 h it is second order
     dimensions = (2, 3)
     norms = {2: 2.0 / math.pi, 3: 2.5 * math.pi**-1.5}  # W(0) h^d
 

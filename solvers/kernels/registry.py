@@ -66,8 +66,9 @@ def kernel_named(name: str) -> Kernel:
 
 def truncated(name: str) -> bool:
     """Whether kernel ``name`` is cut at the scene's ``cutoff_factor`` (the Gaussian) rather than at its own
-    support; a name not known here (a stored row of a plug-in not installed) is not."""
-    kern = kernels().get(name)
+    support; a name not known here (a stored row of a plug-in not installed) is not. A built-in's answer loads
+    no plug-in (the scenes' default method is made at import)."""
+    kern = KERNELS.builtins().get(name) or kernels().get(name)
     return kern is not None and kern.support is None
 
 
