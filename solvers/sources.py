@@ -39,17 +39,19 @@ def class_sources(cls: type) -> list[Path]:
     return list(dict.fromkeys(out))
 
 
-def code_sources(cls: type) -> list[Path]:
+@functools.lru_cache(maxsize=None)
+def code_sources(cls: type) -> tuple[Path, ...]:
     """Every source file ``cls``'s code can come from (the module's docstring): its MRO's, and for a plug-in its
     distribution's, its package's and its imports' outside the interpreter and the environment; resolved,
-    sorted. ValueError for a class with no file."""
+    sorted. Found once per class and process (what the files hold is read by their users: a key reads each
+    file's bytes every time). ValueError for a class with no file."""
     out = set()
     for c, file in zip(_classes(cls), class_sources(cls)):
         file = file.resolve()
         out.add(file)
         if not file.is_relative_to(SOLVERS_ROOT):
             out |= _reach(file, c.__module__)
-    return sorted(out)
+    return tuple(sorted(out))
 
 
 def _classes(cls: type) -> list[type]:

@@ -189,6 +189,7 @@ LAYERS = (
         "solvers.boundaries",
         "solvers.sampling",
         "solvers.jitcache",
+        "solvers.sources",
     ),  # registries, kernels, absorbers, corrections, boundary methods, sampling between particles
     ("solvers.physics",),  # the rates per pair and the integrators, for every backend
     ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method", "solvers.edges"),

@@ -11,6 +11,7 @@ import subprocess
 import sys
 import time
 import warnings
+from pathlib import Path
 
 import pytest
 
@@ -568,3 +569,34 @@ def test_smaller_bad_inputs_are_one_line_before_any_work(command, args, words, c
     err = one_line_error(capsys, command, *args)
     assert all(w in err for w in words), err
     assert list(tmp_path.iterdir()) == []  # nothing written, not even into the current folder
+
+
+def test_a_held_store_written_behind_the_sweeps_back_is_found(tmp_path):
+    """While a sweep holds its store: bytes another writer appends (the lock is advisory) are moved to
+    ``<store>.foreign`` before the sweep's next append, one warning each time; a rewrite of earlier rows cannot be
+    mended and is named; the sweep's own appends are never taken for either."""
+    path = tmp_path / "m.jsonl"
+
+    def record(steps: int):
+        spec = RunSpec("linkedlist-cpu", Scene(dx=1.0, steps=steps)).resolved()
+        return sweep_module.failed_record(spec, "skipped", "a test row", "m")
+
+    with store.SweepLock(path) as lock:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            lock.append(record(1), path)
+            lock.append(record(2), path)  # its own appends: nothing to say
+        mine = path.read_bytes()
+        with open(path, "a") as f:  # another writer, past the lock
+            f.write('{"forged": 1}\n')
+        with pytest.warns(store.StoreWarning, match="behind the sweep's back .* moved to"):
+            lock.append(record(3), path)
+        assert path.read_bytes().startswith(mine) and b"forged" not in path.read_bytes()
+        assert Path(f"{path}.foreign").read_text() == '{"forged": 1}\n'
+        assert path.read_bytes().startswith(b'{"code"')
+        with open(path, "r+b") as f:  # an earlier row rewritten in place
+            f.seek(2)
+            f.write(b"CODE")  # '{"code": ...' of the first row
+        with pytest.warns(store.StoreWarning, match="changed behind the sweep's back"):
+            lock.append(record(4), path)
+    assert len(path.read_text().splitlines()) == 4

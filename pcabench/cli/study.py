@@ -85,6 +85,7 @@ def run_study(
             flush=True,
         )
         sweep(specs, store_path, run_budget, sweep_budget, retry_failed=retry_failed)
+        own = own_run_ids(store_path, specs)
     if reports is None:
         return 0
     from pcabench.cli.report import report_progress
@@ -94,13 +95,26 @@ def run_study(
     for p in written:
         print(f"wrote {p}", file=sys.stderr)
     if not cluster:
-        table = summary(results, profile["id"])
+        table = summary(results, profile["id"], own)
         if table:
             print(table)
         report = next((p for p in written if p.name == "report.md" and p.parent.name.startswith(profile["id"])), None)
         if report:
             print(f"\nReport with every table and figure: {report}")
     return 0
+
+
+def own_run_ids(store_path: Path, specs: list[RunSpec]) -> set:
+    """The run ids of the rows in ``store_path`` that are ``specs``' runs by this code on this machine and host
+    (run now or found stored)."""
+    from pcabench.machine.profiles import machine_id
+    from pcabench.spec import row_identity
+    from pcabench.store import read_rows
+    from pcabench.store.provenance import code_key, host_id
+
+    keys = {s.resolved().key(machine_id(), code_key(), host_id()) for s in specs}  # as the sweep keys its runs
+    rows = read_rows(store_path) if store_path.exists() else []
+    return {r["run_id"] for r in rows if row_identity(r) in keys}
 
 
 def study_specs(args) -> tuple[str, list[RunSpec]]:

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import functools
 import itertools
+import math
 import shlex
 import sys
+import time
 
 from pcabench.predict.methods import high_order_methods, step_weight
 from pcabench.predict.stability import margin, stable_cfl
@@ -70,6 +72,9 @@ def candidates(kind, dxs, hs, shares) -> list[tuple[dict, tuple, tuple]]:
     return standard + [(m, SHORT_SHARES + shares[-1:], fine) for m in high_order_methods()]
 
 
+PROGRESS_S = 2.0  # s between the search's progress lines on stderr
+
+
 def suggest(
     error: float,
     t_end: float,
@@ -83,20 +88,25 @@ def suggest(
     x neighbours x the step's sweeps: on the thinnest strip where a strip serves the scene, else on its own
     domain), the one predicted closest to it, and the paper configuration's dx. A scene with a body is predicted
     with its wall exact (the bulk's dispersion alone: a lower bound of a run's error), a corrected method with
-    the weak wall (solvers/bodies/weak.py: the ghosts' walls grow with a corrected negative-lobe kernel); its
-    search takes a minute or two and says so on stderr. The study command it names makes runs that advise, asked
+    the weak wall (solvers/bodies/weak.py: the ghosts' walls grow with a corrected negative-lobe kernel); the
+    search says how far it is on stderr, every 2 s. The study command it names makes runs that advise, asked
     again, reads: ``problem`` (the study options of the problem asked about: ``--open x``, ``--mach 0.1``) goes into
     it, and a strip only where ``domain`` is not ``full``."""
     kind = scene_kind(scene)
     dxs, hs, shares = search_grid(kind, model)
     asked = error * (BODY_MARGIN if kind.body else 1.0)  # the prediction's target (a body's: with its margin)
     best, paper, closest = None, None, None
-    for method, method_shares, method_dxs in candidates(kind, dxs, hs, shares):
+    methods = candidates(kind, dxs, hs, shares)
+    said = [-math.inf]  # when progress was last printed (at most every PROGRESS_S, the first at once)
+    for i, (method, method_shares, method_dxs) in enumerate(methods, 1):
         corrected = method.get("correction", "none") != "none"
         wall = {"boundary_method": "weak"} if kind.body and corrected else {}
-        if kind.body:
+        if time.monotonic() - said[0] >= PROGRESS_S:
+            said[0] = time.monotonic()
             label = Method.of(method).numerics
-            print(f"advise: predicting {scene}'s probes with {label} ...", file=sys.stderr, flush=True)
+            print(
+                f"advise: predicting {scene} with method {i}/{len(methods)} ({label}) ...", file=sys.stderr, flush=True
+            )
         for share in method_shares:
             tried: dict = {}
             trial_at = functools.partial(_trial, kind, scene, t_end, {**method, **wall}, share, tried)

@@ -244,10 +244,23 @@ def cards_page(df_all, reports_dir: Path, ours: list[dict]) -> list[Path]:
     return [path, *figs]
 
 
-def summary(results_dir: Path, profile: str) -> str:
-    """A study's closing table for the terminal: this machine's step times (Table 4's SNP / PI / SU columns)."""
+CLOSING_ROWS = 30  # runs a study's closing table lists at most (the report and `pcabench runs` have them all)
+
+
+def summary(results_dir: Path, profile: str, run_ids=None) -> str:
+    """A study's closing table for the terminal, of its own runs (``run_ids``; None: every run of this machine):
+    on the paper's scene alone, their step times (Table 4's SNP / PI / SU columns); else each run, its method,
+    status, error and step time."""
     df = frame.load(results_dir)
-    rows = table4(df[(df.profile_id == profile) & (df.scene == DEFAULT_SCENE)]) if not df.empty else []
+    if not df.empty:
+        df = df[df.profile_id == profile]
+        if run_ids is not None:
+            df = df[df.run_id.isin(set(run_ids))]
+    if df.empty:
+        return ""
+    if (df.scene != DEFAULT_SCENE).any():
+        return run_table(df)
+    rows = table4(df)
     if not rows:
         return ""
     return "Step times on this machine, ms per step (the paper's scene; the report has every table):\n" + md_table(
@@ -264,6 +277,36 @@ def summary(results_dir: Path, profile: str) -> str:
             ]
             for r in rows
         ],
+    )
+
+
+def run_table(df) -> str:
+    """This study's runs, one line each (at most CLOSING_ROWS): scene, dx, N, method, model, status, the
+    headline error and the step time."""
+    lines = []
+    for _, r in df.sort_values(["scene", "dx"], ascending=[True, False]).head(CLOSING_ROWS).iterrows():
+        method = f"{r.kernel} h {float(r.h_factor):.3g} dx" + (
+            "" if r.correction in ("none", None) else f", {r.correction}"
+        )
+        error = r.headline if r.headline == r.headline and r.headline is not None else r.mse
+        lines.append(
+            [
+                r.scene,
+                f"{float(r.dx):g}",
+                f"{int(r.n_particles):,}",
+                method,
+                f"{r.model}/{r.integrator} CFL {float(r.cfl):g}",
+                r.status
+                + (f" (step {int(r.failed_step)})" if r.failed_step == r.failed_step and r.failed_step else ""),
+                fmt(error, ".4g"),
+                fmt(1e3 * r.t_step, ".3f"),
+            ]
+        )
+    more = len(df) - CLOSING_ROWS
+    return (
+        "This study's runs on this machine (the report has every table and figure):\n"
+        + md_table(["scene", "dx (m)", "N", "method", "model", "status", "error", "ms/step"], lines)
+        + (f"\n... and {more} more (`pcabench runs` lists them all)" if more > 0 else "")
     )
 
 

@@ -60,8 +60,9 @@ def figure(
 ):
     """A constrained-layout figure with ``nrows x ncols`` axes, labelled and gridded, saved to ``path`` on exit.
 
-    ``legend``: "right" puts one legend of every labelled series outside the axes, "below" one legend under
-    each axes (for panels whose series share styles), "none" draws none.
+    ``legend``: "right" puts one legend of every labelled series outside the axes, "bottom" the same under them
+    all (two columns: the axes keep the figure's width), "below" one legend under each axes (for panels whose
+    series share styles), "none" draws none.
     """
     import matplotlib
 
@@ -96,9 +97,10 @@ def figure(
             handles.setdefault(lab, h)
         if legend == "below" and ax.get_legend_handles_labels()[0]:
             ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=7, frameon=False)
-    if handles and legend == "right":
+    if handles and legend in ("right", "bottom"):
         labels = sorted(handles, key=lambda lab: "(published)" in lab)  # measured first, the paper's after
-        fig.legend([handles[lab] for lab in labels], labels, loc="outside right center", fontsize=7, frameon=False)
+        where = {"loc": "outside right center"} if legend == "right" else {"loc": "outside lower center", "ncol": 2}
+        fig.legend([handles[lab] for lab in labels], labels, **where, fontsize=7, frameon=False, handlelength=3)
     suptitle(fig, title)
     save_figure(fig, path, dpi=110)  # whole or not at all; a link at its name is replaced, not followed
     save_figure_data(fig, path)  # its data beside it, as a CSV a reader replots

@@ -230,6 +230,19 @@ class RunRecord:
             f"{name.replace('_', ' '):<16} {value:.6g}" if math.isfinite(value) else f"{name.replace('_', ' '):<16} -"
             for name, value in self.errors.items()
         ]
+        points = scene.probe_points()
+        for name, series in (self.probes or {}).items():  # a probe no measure scores: what it recorded
+            if name == "t" or f"probe_{name}" in self.errors or name not in points:
+                continue
+            t = (self.probes or {}).get("t") or []
+            values = [abs(v) for v in series if v is not None and math.isfinite(v)]
+            at = ", ".join(f"{c:g}" for c in points[name])
+            lines.append(
+                f"probe {name:<10} drho at ({at}) m, {len(series)} samples"
+                + (f" over {t[0]:.4g}-{t[-1]:.4g} s" if t else "")
+                + (f": max |drho| {max(values):.4g} kg/m^3" if values else "")
+                + " (the series: --json)"
+            )
         if self.mse_isothermal is not None:
             lines.append(
                 f"MSE against the isothermal solution (the equations lagrangian solves) {self.mse_isothermal:.6g}"

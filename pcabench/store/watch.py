@@ -5,18 +5,19 @@ never writes a store another holds; but a lock is advisory, and a run's own proc
 user) can append to the file all the same. So the holder keeps the store's size and the SHA-256 of its bytes as
 it last saw them (when it took the store, after each of its own appends), and before each append and on release
 compares: a store that grew is cut back to what the sweep saw and the bytes added behind its back are moved to
-``<store>.foreign`` (never read: only ``*.jsonl`` is a store), with one warning; a store whose earlier bytes
-changed, or that was replaced by another file, cannot be mended: one warning says so, naming the file.
+``<store>.foreign`` (never read: only ``*.jsonl`` is a store); a store whose earlier bytes changed, or that was
+replaced by another file, cannot be mended. Either way :meth:`StoreWatch.check` returns one line naming the file,
+which the holder gives as a warning.
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
-import warnings
 from pathlib import Path
 
 CHUNK = 1 << 20
+TAIL = 1 << 16  # bytes at the store's end compared at every check
 
 
 class StoreWatch:
@@ -26,11 +27,17 @@ class StoreWatch:
         self.fd, self.path = fd, Path(path)
         self.size, self.digest = 0, hashlib.sha256()
         self._read_to(os.fstat(fd).st_size)
-        self.stamp = self._stamp()
+        self.stamp, self.tail = self._stamp(), self._tail()
 
     def _stamp(self) -> tuple:
         st = os.fstat(self.fd)
         return st.st_ino, st.st_size, st.st_mtime_ns
+
+    def _tail(self) -> bytes:
+        """The SHA-256 of the store's last TAIL bytes (a rewrite in place within the time stamp's tick changes no
+        stamp: it is found where it reaches them)."""
+        size = os.fstat(self.fd).st_size
+        return hashlib.sha256(os.pread(self.fd, min(TAIL, size), max(size - TAIL, 0))).digest()
 
     def _read_to(self, end: int) -> None:
         """Hash the store's bytes from what is seen up to ``end``."""
@@ -51,34 +58,34 @@ class StoreWatch:
             pos += len(data)
         return h.digest()
 
-    def check(self, stacklevel: int = 3) -> str:
+    def check(self) -> str:
         """Compare the store with what its holder last saw: '' where it is unchanged; else, after moving what was
-        appended behind the holder's back aside (or finding a change that cannot be mended), the warning it
-        gave."""
+        appended behind the holder's back aside (or finding a change that cannot be mended), one line saying
+        so (the holder warns with it)."""
         try:
             on_disk = os.stat(self.path).st_ino
         except OSError:
             on_disk = None
         if on_disk != os.fstat(self.fd).st_ino:
-            return self._warn(
+            return (
                 f"{self.path} was removed or replaced by another file while the sweep held it (a run's process "
                 "wrote it): the runs this sweep stores from here go to the file it holds, which no longer has that "
                 "name; rerun the sweep"
             )
-        if self._stamp() == self.stamp:
+        if self._stamp() == self.stamp and self._tail() == self.tail:  # (a write in the stamp's own tick: the tail)
             return ""
         size = os.fstat(self.fd).st_size
         if size < self.size or self._prefix_digest(self.size) != self.digest.digest():
-            message = self._warn(
+            message = (
                 f"{self.path} was changed behind the sweep's back (its first {self.size:,} bytes are not what the "
                 "sweep last saw): a run's process rewrote it; its rows are as that process left them"
             )
             self.size, self.digest = 0, hashlib.sha256()
             self._read_to(size)
-            self.stamp = self._stamp()
+            self.stamp, self.tail = self._stamp(), self._tail()
             return message
         if size == self.size:  # touched, not changed
-            self.stamp = self._stamp()
+            self.stamp, self.tail = self._stamp(), self._tail()
             return ""
         extra = os.pread(self.fd, size - self.size, self.size)
         foreign = Path(f"{self.path}.foreign")
@@ -91,19 +98,13 @@ class StoreWatch:
             os.close(out)
         os.ftruncate(self.fd, self.size)
         os.fsync(self.fd)
-        self.stamp = self._stamp()
-        return self._warn(
+        self.stamp, self.tail = self._stamp(), self._tail()
+        return (
             f"{self.path}: {size - self.size:,} bytes written into the store behind the sweep's back (a run's "
-            f"process, while the sweep held it) were moved to {foreign}: they are not read",
+            f"process, while the sweep held it) were moved to {foreign}: they are not read"
         )
 
     def saw_append(self) -> None:
         """The holder appended: what it wrote is seen (the store checked just before by :meth:`check`)."""
         self._read_to(os.fstat(self.fd).st_size)
-        self.stamp = self._stamp()
-
-    def _warn(self, message: str) -> str:
-        from pcabench.store import StoreWarning
-
-        warnings.warn(message, StoreWarning, stacklevel=4)
-        return message
+        self.stamp, self.tail = self._stamp(), self._tail()

@@ -116,7 +116,7 @@ def text(data, ctx) -> list[str]:
     table = [
         [
             f"{r['dx']:g}",
-            f"{r['per_width']:g}",
+            f"{r['per_width']:.3g}",
             _method(r),
             r["method"],
             r["model"],
@@ -202,7 +202,7 @@ def text(data, ctx) -> list[str]:
                 f"- **Predicted, {label}, CFL {cfl:g}**{past} (the wall exact): "
                 + ", ".join(f"{e:.3g} at dx {dx:g}" for dx, e in pts)
                 + (
-                    f"; 2 % from dx {max(reach):g} m ({scene.pulse_width / max(reach):g} particles a pulse width)."
+                    f"; 2 % from dx {max(reach):g} m ({scene.pulse_width / max(reach):.3g} particles a pulse width)."
                     if reach
                     else f"; 2 % not by dx {PREDICTED_DX[-1]:g} m (the kernel's long-wave phase-speed deficit at "
                     "fixed h / dx, which refinement keeps, floors it: docs/accuracy.md)."
@@ -290,7 +290,7 @@ def probes_figure(data, ctx):
         path,
         f"The pulse scattered by a cylinder: p(t) at the workshop's points, {_method(best)}, CFL {best['cfl']:g}, "
         f"dx = {best['dx']:g} m "
-        f"({best['per_width']:g} particles a pulse width), linear ({ctx.name}); black: the exact solution",
+        f"({best['per_width']:.3g} particles a pulse width), linear ({ctx.name}); black: the exact solution",
         "t (s)",
         "p (Pa, c0^2 drho)",
         ncols=3,

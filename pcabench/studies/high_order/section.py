@@ -160,14 +160,16 @@ def kernel_colours(runs) -> dict:
 
 
 def _style(label: str, cfl: float) -> dict:
-    """Solid: corrected, dashed: standard; triangles: RK4, circles: Verlet at the paper's CFL 0.2, squares: Verlet
-    at another CFL."""
+    """Solid and filled: corrected, dashed and hollow: standard; triangles: RK4, circles: Verlet at the paper's CFL
+    0.2, squares: Verlet at another CFL."""
     marker = "^" if "rk4" in label else "o" if math.isclose(cfl, 0.2) else "s"
-    return {"ls": "-" if "gradient" in label else "--", "marker": marker}
+    corrected = "gradient" in label
+    return {"ls": "-" if corrected else "--", "marker": marker, **({} if corrected else {"mfc": "none"})}
 
 
 STYLE_KEY = (
-    "solid: gradient-corrected, dashed: standard; triangles: RK4, circles: Verlet at CFL 0.2, squares: Verlet at "
+    "solid, filled: gradient-corrected; dashed, hollow: standard; triangles: RK4, circles: Verlet at CFL 0.2, "
+    "squares: Verlet at "
 )
 STYLE_KEY += "another CFL"
 

@@ -1,4 +1,5 @@
-"""The runs that did not finish, each with its status, step and message."""
+"""The runs that did not finish, each with its scene, method (kernel, h, correction, body), status, step and
+message."""
 
 from __future__ import annotations
 
@@ -14,15 +15,31 @@ def rows(ctx):
     return latest(ctx.df[ctx.df.status != "ok"])
 
 
+def wall(r) -> str:
+    """A run's body's wall model ('' without a body), as its scene resolves it (the default with a correction
+    is not standard SPH's)."""
+    from pcabench.spec import scene_from_row
+
+    try:
+        scene = scene_from_row(r.to_dict())
+    except Exception:  # noqa: BLE001 - a row its scene cannot be rebuilt from: no wall named
+        return ""
+    return scene.boundary_method_used if scene.body is not None else ""
+
+
 def text(bad, ctx) -> list[str]:
     if bad.empty:
         return []
     rows = [
         [
             r.solver,
+            r.scene + (f" ({wall(r)} wall)" if wall(r) else ""),
             r.precision,
             r.model,
             r.integrator,
+            r.kernel,
+            fmt(r.h_factor, ".3g"),
+            "-" if r.correction in (None, "none") else r.correction,
             f"{r.dx:g}",
             f"{int(r.n_particles):,}",
             T.protocol(r),
@@ -37,7 +54,23 @@ def text(bad, ctx) -> list[str]:
         "## Runs that did not finish",
         "",
         md_table(
-            ["solver", "precision", "model", "integrator", "dx", "N", "protocol", "CFL", "status", "step", "message"],
+            [
+                "solver",
+                "scene",
+                "precision",
+                "model",
+                "integrator",
+                "kernel",
+                "h/dx",
+                "correction",
+                "dx",
+                "N",
+                "protocol",
+                "CFL",
+                "status",
+                "step",
+                "message",
+            ],
             rows,
         ),
         "",

@@ -171,9 +171,11 @@ def fig9(rows, out: Path, pid: str):
             _published(
                 a,
                 [r for r in pub if r["search"] == search],
-                marker,  # large and on top: never hidden
+                marker,  # on top, hollow, in the colour of the measured line it goes with: apart where close
                 f"paper {search}, {P.CONVERSION['Fig. 9 text']} (published; two sizes, not joined)",
-                ms=10,
+                ms=7,
+                mec=SEARCH_COLOUR[search],
+                mew=1.5,
                 zorder=4,
                 ls="none",  # the paper gives two sizes 2.4 decades apart: a line would invent the ones between
             )
@@ -236,6 +238,7 @@ def fig10(series, out: Path, pid: str):
     ncols = min(len(runs), 2)
     nrows = -(-len(runs) // ncols)
     spare = nrows * ncols > len(runs)  # an empty slot holds the legend: the figure keeps its width
+    under = not spare and ncols > 1  # else under two panels or more: a key at their right would squeeze them
     with figure(
         path,
         f"Fig. 10: one step against N ({pid}, full domain), a panel per run length{key}; grey "
@@ -247,8 +250,11 @@ def fig10(series, out: Path, pid: str):
         logx=True,
         logy=True,
         sharey=True,
-        size=(4.6 * ncols + (0.6 if spare else 4.6), 3.4 * nrows + 0.6),
-        legend="none" if spare else "right",
+        size=(
+            4.6 * ncols + (4.6 if ncols == 1 else 0.6),
+            3.4 * nrows + 0.6 + (0.16 * (-(-(len(configs) + 3) // 2)) if under else 0),
+        ),
+        legend="none" if spare else "bottom" if under else "right",
     ) as axes:
         for ax in axes[len(runs) :]:
             ax.set_visible(False)
