@@ -44,3 +44,38 @@ def test_the_failure_table_names_each_runs_scene_wall_kernel_h_and_correction(tm
     header = next(line for line in text.splitlines() if line.startswith("| solver"))
     assert all(f"| {c} |" in header for c in ("scene", "kernel", "h/dx", "correction")), header
     assert "| cylinder (rings wall) |" in text and "| laguerre-gauss | 1.5 | gradient |" in text, text
+
+
+def test_the_reference_rows_say_what_the_reader_says():
+    """Every scored row of the committed reference names its headline measure, as the reader names it, and none
+    keeps a relative error against a pulse that has gone (the 4.6e28 of rows older than the headline:
+    tools/migrate_headline.py)."""
+    import json
+    from pathlib import Path
+
+    from pcabench.reports.frame import headline_of
+
+    rows = [
+        json.loads(line)
+        for path in sorted((Path(__file__).resolve().parents[1] / "reports" / "results").glob("*.jsonl"))
+        for line in path.read_text().splitlines()
+        if line.strip()
+    ]
+    scored = [r for r in rows if r["status"] == "ok"]
+    assert scored and all("measure" in r for r in scored)
+    assert all(r["measure"] == headline_of({k: v for k, v in r.items() if k != "measure"})[0] for r in scored[::50])
+    assert max(r["mse"] for r in scored if r.get("mse") is not None) < 1e3
+
+
+def test_advise_says_how_far_its_search_is(monkeypatch, capsys):
+    """The prediction's search (19-81 s for a tight error) prints a line every 2 s (here every 0 s: each method)."""
+    from pcabench.predict import search
+
+    monkeypatch.setattr(search, "PROGRESS_S", 0.0)
+    methods = search.candidates(
+        search.scene_kind("acoustic-pulse"), *search.search_grid(search.scene_kind("acoustic-pulse"))
+    )
+    monkeypatch.setattr(search, "candidates", lambda *a: methods[:2])
+    search.suggest(0.001, 10.0, scene="acoustic-pulse")
+    err = capsys.readouterr().err
+    assert err.startswith("advise: predicting acoustic-pulse with method 1/2"), err

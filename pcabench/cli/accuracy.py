@@ -25,7 +25,10 @@ def cmd_accuracy(args) -> int:
         **given,
         **domain_of(args),
     )
-    p = predict(scene)
+    from pcabench.execute.progress import Heartbeat
+
+    with Heartbeat(f"pcabench accuracy: predicting {scene.n_particles:,} particles"):  # a 3D lattice: a minute
+        p = predict(scene)
     past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/predict/stability.py)
     if args.json:
         known = {"known_failure": scene.known_failure, "cautions": list(scene.cautions)}  # ("" / [] where none)

@@ -38,3 +38,34 @@ class Progress:
             self.stream.write("\n")
             OPEN["line"] = False
         self.stream.flush()
+
+
+class Heartbeat:
+    """Within: a line on stderr every ``every`` seconds once the work has taken that long ("label: 4 s ..."), for
+    work that has no steps to count (a prediction); the line is ended on leaving."""
+
+    def __init__(self, label: str, every: float = 2.0, stream=sys.stderr):
+        import threading
+
+        self.label, self.every, self.stream = label, every, stream
+        self.done, self.said = threading.Event(), False
+        self.thread = threading.Thread(target=self._beat, daemon=True)
+
+    def _beat(self) -> None:
+        t0 = time.perf_counter()
+        while not self.done.wait(self.every):
+            self.stream.write(f"\r{self.label}: {time.perf_counter() - t0:.0f} s ")
+            self.stream.flush()
+            OPEN["line"], self.said = self.stream is sys.stderr, True
+
+    def __enter__(self):
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.done.set()
+        self.thread.join()
+        if self.said:
+            self.stream.write("\n")
+            self.stream.flush()
+            OPEN["line"] = False

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import functools
 import itertools
-import math
 import shlex
 import sys
 import time
@@ -97,7 +96,7 @@ def suggest(
     asked = error * (BODY_MARGIN if kind.body else 1.0)  # the prediction's target (a body's: with its margin)
     best, paper, closest = None, None, None
     methods = candidates(kind, dxs, hs, shares)
-    said = [-math.inf]  # when progress was last printed (at most every PROGRESS_S, the first at once)
+    said = [time.monotonic()]  # when progress was last printed: every PROGRESS_S (a quick search prints none)
     for i, (method, method_shares, method_dxs) in enumerate(methods, 1):
         corrected = method.get("correction", "none") != "none"
         wall = {"boundary_method": "weak"} if kind.body and corrected else {}
