@@ -249,8 +249,8 @@ CLOSING_ROWS = 30  # runs a study's closing table lists at most (the report and 
 
 def summary(results_dir: Path, profile: str, run_ids=None) -> str:
     """A study's closing table for the terminal, of its own runs (``run_ids``; None: every run of this machine):
-    on the paper's scene alone, their step times (Table 4's SNP / PI / SU columns); else each run, its method,
-    status, error and step time."""
+    where it has the paper's timing runs (its scene, a fixed step count), their step times (Table 4's SNP / PI /
+    SU columns) and a line counting the rest; else each run, its method, status, error and step time."""
     df = frame.load(results_dir)
     if not df.empty:
         df = df[df.profile_id == profile]
@@ -258,25 +258,36 @@ def summary(results_dir: Path, profile: str, run_ids=None) -> str:
             df = df[df.run_id.isin(set(run_ids))]
     if df.empty:
         return ""
-    if (df.scene != DEFAULT_SCENE).any():
-        return run_table(df)
-    rows = table4(df)
+    timing = (df.scene == DEFAULT_SCENE) & df.protocol.str.endswith(" steps")
+    rows = table4(df[timing]) if timing.any() else []
     if not rows:
-        return ""
-    return "Step times on this machine, ms per step (the paper's scene; the report has every table):\n" + md_table(
-        ["config", "protocol", "N", "SNP", "PI", "SU", "step"],
-        [
+        return run_table(df)
+    rest = int((~timing).sum())
+    more = f"\n... and {rest} more runs (accuracy, other scenes): the report's tables, `pcabench runs`" if rest else ""
+    return "Step times on this machine, ms per step (the paper's scene; the report has every table):\n" + more_table(
+        rows, more
+    )
+
+
+def more_table(rows, more: str) -> str:
+    """Table 4's step-time columns of ``rows``, then ``more``."""
+    return (
+        md_table(
+            ["config", "protocol", "N", "SNP", "PI", "SU", "step"],
             [
-                r["config"],
-                r["protocol"],
-                f"{r['N']:,}",
-                fmt(r["snp"], ".3f"),
-                fmt(r["pi"], ".3f"),
-                fmt(r["su"], ".3f"),
-                fmt(r["snp"] + r["pi"] + r["su"], ".3f"),
-            ]
-            for r in rows
-        ],
+                [
+                    r["config"],
+                    r["protocol"],
+                    f"{r['N']:,}",
+                    fmt(r["snp"], ".3f"),
+                    fmt(r["pi"], ".3f"),
+                    fmt(r["su"], ".3f"),
+                    fmt(r["snp"] + r["pi"] + r["su"], ".3f"),
+                ]
+                for r in rows
+            ],
+        )
+        + more
     )
 
 
