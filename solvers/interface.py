@@ -492,26 +492,27 @@ class Solver(abc.ABC):
         return np.asarray(arr)
 
     def sample(self, points) -> np.ndarray:
-        """drho (kg/m^3, float64) at ``points`` ((p, 2), m) from the fluid particles within a cutoff of each, by
+        """drho (kg/m^3, float64) at ``points`` ((p, dims), m) from the fluid particles within a cutoff of each, by
         first-order moving least squares (solvers/sampling.py): a probe's reading. The weights are kept while the
         particles neither move nor change order."""
         from solvers.sampling import mls_weights
 
         s, a, xp = self.scene, self.arrays, self.xp
-        points = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        dims = s.dims
+        points = np.asarray(points, dtype=np.float64).reshape(-1, dims)
         key = (getattr(self, "reordered", 0), points.tobytes())
         cached = getattr(self, "_probes", None)
         if self.moving or cached is None or cached[0] != key:
-            px = s.x_lo + (a["lx"].astype(xp.float64) + 0.5) * s.dx + a["sx"]
-            py = s.y_lo + (a["ly"].astype(xp.float64) + 0.5) * s.dx + a["sy"]
-            near = xp.zeros(px.shape, dtype=bool)
-            for x, y in points:
-                near |= (px - x) ** 2 + (py - y) ** 2 < (s.cutoff * (1 + 1e-9)) ** 2
+            lows = (s.x_lo, s.y_lo, s.z_lo)[:dims]
+            axes = [lo + (a[f"l{c}"].astype(xp.float64) + 0.5) * s.dx + a[f"s{c}"] for lo, c in zip(lows, "xyz"[:dims])]
+            near = xp.zeros(axes[0].shape, dtype=bool)
+            for p in points:
+                near |= sum((q - c) ** 2 for q, c in zip(axes, p)) < (s.cutoff * (1 + 1e-9)) ** 2
             if "role" in a:
                 near &= a["role"] == 0
             idx = xp.flatnonzero(near)
-            pos = np.stack([self.to_host(px[idx]), self.to_host(py[idx])], axis=1)
-            cached = (key, idx, mls_weights(s, points, pos, s.dx * s.dx))
+            pos = np.stack([self.to_host(q[idx]) for q in axes], axis=1)
+            cached = (key, idx, mls_weights(s, points, pos, s.dx**dims))
             self._probes = cached
         _key, idx, weights = cached
         return weights @ self.to_host(a["drho"][idx]).astype(np.float64)

@@ -11,10 +11,10 @@ import numpy as np
 
 def mls_weights(scene, points, fluid, volume: float):
     """The sampling matrix (scipy CSR, points x fluid): row p holds the weights that give a field's value at
-    ``points[p]`` from its values at the ``fluid`` positions ((m, 2) arrays, m), by first-order moving least
-    squares with the scene's kernel W (cut at its cutoff) and each particle's ``volume`` (m^2); Shepard's
-    normalised average where the moment matrix is near singular (fewer than 6 neighbours, or all to one side
-    of a line)."""
+    ``points[p]`` from its values at the ``fluid`` positions ((m, d) arrays, m; d = 2 or 3, the scene's), by
+    first-order moving least squares with the scene's kernel W (cut at its cutoff) and each particle's ``volume``
+    (m^d); Shepard's normalised average where the moment matrix is near singular (fewer than 3 d neighbours, or
+    all to one side of a line or plane)."""
     from scipy.sparse import csr_matrix
     from scipy.spatial import cKDTree
 
@@ -24,19 +24,23 @@ def mls_weights(scene, points, fluid, volume: float):
     counts = np.array([len(n) for n in lists], dtype=np.int64)
     rows = np.repeat(np.arange(len(points)), counts)
     cols = np.concatenate([np.asarray(n, dtype=np.int64) for n in lists]) if counts.sum() else np.zeros(0, np.int64)
+    dims = fluid.shape[1]
+    n = dims + 1  # the basis 1, x, y (, z)
     d = (fluid[cols] - points[rows]) / h  # in units of h: a well-scaled basis
-    w = scene.sph_kernel.value(np.hypot(d[:, 0], d[:, 1]) * h, h) * volume
-    basis = np.stack([np.ones_like(w), d[:, 0], d[:, 1]], axis=1)
-    moments = np.zeros((len(points), 3, 3))
-    for i in range(3):
-        for j in range(3):
+    distance = (np.hypot(d[:, 0], d[:, 1]) if dims == 2 else np.sqrt(np.sum(d * d, axis=1))) * h
+    w = (scene.sph_kernel.value(distance, h, dims=3) if dims == 3 else scene.sph_kernel.value(distance, h)) * volume
+    basis = np.concatenate([np.ones_like(w)[:, None], d], axis=1)
+    moments = np.zeros((len(points), n, n))
+    for i in range(n):
+        for j in range(n):
             moments[:, i, j] = np.bincount(rows, weights=w * basis[:, i] * basis[:, j], minlength=len(points))
     total = moments[:, 0, 0]
     det = np.linalg.det(moments)
-    good = (counts >= 6) & (total > 0) & (np.abs(det) > 1e-6 * np.maximum(total, 1e-300) ** 3)
-    coef = np.zeros((len(points), 3))
+    good = (counts >= 3 * dims) & (total > 0) & (np.abs(det) > 1e-6 * np.maximum(total, 1e-300) ** n)
+    coef = np.zeros((len(points), n))
+    unit = np.eye(n)[0]
     if good.any():
-        coef[good] = np.linalg.solve(moments[good], np.tile([1.0, 0.0, 0.0], (int(good.sum()), 1))[..., None])[..., 0]
+        coef[good] = np.linalg.solve(moments[good], np.tile(unit, (int(good.sum()), 1))[..., None])[..., 0]
     shepard = ~good & (total > 0)
     coef[shepard, 0] = 1.0 / total[shepard]
     psi = w * np.einsum("pk,pk->p", coef[rows], basis)

@@ -103,7 +103,7 @@ class Scene:
     pulse_center: float | None = None  # pulse position at t = 0, m; None: the kind's (the paper's 0)
     cylinder_radius: float | None = None  # a rigid cylinder's radius, m (a scene kind with a body); None: the kind's
     boundary_method: str = ""  # how a body's curved wall is modelled (solvers/bodies/); "": the default
-    probes: tuple = ()  # points ((x, y), ...) m where a run records drho every few steps, beside the kind's own
+    probes: tuple = ()  # points ((x, y) or (x, y, z), ...) m where a run records drho every few steps, beside its own
     edges: Edges = Edges()  # the open edges and their layer (solvers/edges.py); open "": the kind's
     method: Method = DEFAULT_METHOD  # kernel, h/dx, truncation, CFL, integrator, correction (solvers/method.py)
     model: str = "lagrangian"
@@ -224,10 +224,17 @@ class Scene:
                 object.__setattr__(self, key, kind.defaults.get(key, PAPER_PULSE.get(key)))
         if not self.open:
             object.__setattr__(self, "edges", replace(self.edges, open=kind.defaults.get("open", "")))
+        words = "x,y,z" if kind.dims == 3 else "x,y"
         try:
-            points = tuple((float(p[0]), float(p[1])) for p in self.probes or ())
-        except (TypeError, ValueError, IndexError):
-            raise SceneError(f"--probe takes points x,y in m (got {self.probes!r})") from None
+            points = tuple(tuple(float(c) for c in p) for p in self.probes or ())
+        except (TypeError, ValueError):
+            raise SceneError(f"--probe takes points {words} in m (got {self.probes!r})") from None
+        for p in points:
+            if len(p) != kind.dims:
+                raise SceneError(
+                    f"--probe takes points {words} in m in the {self.name} scene ({kind.dims}D; got "
+                    f"{','.join(f'{c:g}' for c in p)})"
+                )
         object.__setattr__(self, "probes", points)
         self._validate()
 
@@ -375,28 +382,28 @@ class Scene:
             finite(key)
         need(self.z_max > self.z_min, f"z_max must be > z_min (got {self.z_min}..{self.z_max})")
         need(self.strip_height is None, f"--strip-height: the {self.name} scene is 3D (a strip is a 2D scene's)")
-        need(not self.probes, f"--probe: the {self.name} scene is 3D, whose probes are not built yet")
         try:
             self.sph_kernel.in_dims(3)
         except ValueError as exc:
             need(False, str(exc))
 
     def probe_points(self) -> dict:
-        """{name: (x, y)}: where a run records drho (the scene kind's points, then ``probes`` as P1, P2, ...), m."""
+        """{name: (x, y) or (x, y, z)}: where a run records drho (the scene kind's points, then ``probes`` as P1, P2,
+        ...), m."""
         points = dict(self.kind.probe_points(self))
         points.update({f"P{i + 1}": p for i, p in enumerate(self.probes)})
         return points
 
     def _validate_probes(self, need) -> None:
-        for x, y in self.probes:
+        box = [(self.x_min, self.x_max), (self.y_min, self.y_max)] + ([(self.z_min, self.z_max)] * (self.dims == 3))
+        for p in self.probes:
             need(
-                math.isfinite(x)
-                and math.isfinite(y)
-                and self.x_min <= x <= self.x_max
-                and self.y_min <= y <= self.y_max,
-                f"--probe {x:g},{y:g} is outside the domain [{self.x_min:g}, {self.x_max:g}] x "
-                f"[{self.y_min:g}, {self.y_max:g}] m",
+                all(math.isfinite(c) and lo <= c <= hi for c, (lo, hi) in zip(p, box)),
+                f"--probe {','.join(f'{c:g}' for c in p)} is outside the domain "
+                + " x ".join(f"[{lo:g}, {hi:g}]" for lo, hi in box)
+                + " m",
             )
+            x, y = p[0], p[1]
             if self.body is not None:
                 x0, y0, a = self.body
                 need(

@@ -75,14 +75,18 @@ def number(name, low: float | None = None):
 
 
 def point(name):
+    """A point x,y (a 2D scene's) or x,y,z (a 3D scene's, checked against it by Scene), m."""
+
     def parse(text):
         parts = text.split(",")
-        if len(parts) != 2 or not all(DECIMAL.fullmatch(x.strip()) for x in parts):
-            raise argparse.ArgumentTypeError(f"{name} takes a point x,y in m, such as 1.5,-2 (got {text!r})")
-        x, y = (float(v) for v in parts)
-        if not (math.isfinite(x) and math.isfinite(y)):
+        if len(parts) not in (2, 3) or not all(DECIMAL.fullmatch(x.strip()) for x in parts):
+            raise argparse.ArgumentTypeError(
+                f"{name} takes a point x,y (x,y,z in a 3D scene) in m, such as 1.5,-2 (got {text!r})"
+            )
+        coordinates = tuple(float(v) for v in parts)
+        if not all(math.isfinite(c) for c in coordinates):
             raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
-        return x, y
+        return coordinates
 
     return parse
 
@@ -141,9 +145,9 @@ def add_problem_options(p: argparse.ArgumentParser, many: bool = False) -> None:
             "--probe",
             action="append",
             type=point("--probe"),
-            metavar="X,Y",
-            help="a point (m) where the run records drho every few steps, beside the scene's own (the cylinder's "
-            "A, B, C); repeat for more",
+            metavar="X,Y[,Z]",
+            help="a point (m; x,y,z in a 3D scene) where the run records drho every few steps, beside the scene's "
+            "own (the cylinder's A, B, C); repeat for more",
         )
         p.add_argument(
             "--domain-size",
