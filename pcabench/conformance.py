@@ -40,6 +40,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from solvers import (
+    DEFAULT_SCENE,
     INTEGRATORS,
     MODELS,
     PRECISIONS,
@@ -50,7 +51,7 @@ from solvers import (
     scenes,
     solver_class,
 )
-from solvers.corrections import correction_names
+from solvers.corrections import DEFAULT_CORRECTION, correction_names
 from solvers.interface import STAGES, Solver
 from solvers.physics.integrators import advance_steps, evolve
 from solvers.registry import SOLVERS
@@ -160,7 +161,10 @@ class Subject:
     def scene(self, name: str = "plane-pulse", steps: int | None = None, **method) -> Scene:
         """A conformance scene: ``name``'s tiny lattice with the class's defaults and ``method`` on top."""
         base = {axis: self.default(axis) for axis in AXES if getattr(self.cls, CLAIMS[axis], None)}
-        return Scene(**{**self.cases[name], "steps": steps or self.steps, **base, **method})
+        case = self.cases[name]
+        if needs_correction(case) and base.get("correction") == DEFAULT_CORRECTION:
+            base.pop("correction")  # the case's own (a 3D body's wall is the corrected operators')
+        return Scene(**{**case, "steps": steps or self.steps, **base, **method})
 
     def configurations(self) -> list[dict]:
         """(scene name, method, pair loop) to check: the full product, or (quick) the defaults and each
@@ -192,7 +196,10 @@ class Subject:
         scene sums its pairs on the fly)."""
         if config["scene"] == LARGER:
             return True
-        return config["pair_loop"] in self.cls.pair_loops_for(Scene(**self.cases[config["scene"]]))
+        case = self.cases[config["scene"]]
+        if needs_correction(case) and config.get("correction") == DEFAULT_CORRECTION:
+            return False  # a 3D body is refused uncorrected (its one wall is the corrected operators')
+        return config["pair_loop"] in self.cls.pair_loops_for(Scene(**case))
 
     def scene_of(self, config: dict) -> Scene:
         return self.scene(config["scene"], **{axis: config[axis] for axis in AXES})
@@ -217,6 +224,12 @@ class Subject:
                 return result
             self.runs[key] = result
         return self.runs[key]
+
+
+def needs_correction(case: dict) -> bool:
+    """Whether a conformance scene is run only with a kernel correction (a 3D body: solvers/boundaries/body3d.py)."""
+    kind = scenes()[case.get("name", DEFAULT_SCENE)]
+    return bool(kind.body and kind.dims == 3)
 
 
 def label(config: dict) -> str:

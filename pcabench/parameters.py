@@ -114,6 +114,13 @@ PROBLEM = (
         numeric=True,
         per_scene=True,
     ),
+    Parameter(
+        "sphere_radius",
+        "--sphere-radius",
+        lambda: _per_scene("the rigid sphere's radius, m, in the 3D scenes with a body", "sphere_radius"),
+        numeric=True,
+        per_scene=True,
+    ),
     Parameter("x_max", "--wall-x", _wall_help, numeric=True, per_scene=True),
 )
 BOUNDARY = (

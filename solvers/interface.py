@@ -240,8 +240,8 @@ class Solver(abc.ABC):
         for name in ("sx", "sy", "sz", *RATES_3D, "vol", "pr"):
             a[name] = xp.zeros(s.n_particles, dt)
         self.arrays = a
-        for model in self.boundary_models:  # an open layer (a sponge: nothing to start)
-            model.start(self, x, y, drho)
+        for model in self.boundary_models:  # an open layer (a sponge: nothing to start), a body's roles
+            model.start(self, x, y, drho, z=z)
         self.saved = {}
         self.t = 0.0
         self.reordered = 0

@@ -67,9 +67,10 @@ FLOAT_ARRAYS_3D = 8
 # Parameters whose default is the scene kind's where it states one (SceneKind.defaults), else these (the paper's;
 # a body's radius only where the kind has a body).
 PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
-PER_KIND = ("pulse_width", "pulse_center", "cylinder_radius")
+PER_KIND = ("pulse_width", "pulse_center", "cylinder_radius", "sphere_radius")
 LAYER_UNSET = Edges.layer_unset()  # a closed scene's layer options
 DEFAULT_METHOD = Method.paper()  # Scene's method unless given (solvers/method.py: the paper's)
+CORRECTED_BODY_3D = "weak"  # the one wall a 3D body has (solvers/boundaries/body.py)
 
 
 class SceneError(ValueError):
@@ -102,6 +103,7 @@ class Scene:
     pulse_width: float | None = None  # the 3 in exp(-((x - c0 t)/3)^2), m; None: the kind's (the paper's 3)
     pulse_center: float | None = None  # pulse position at t = 0, m; None: the kind's (the paper's 0)
     cylinder_radius: float | None = None  # a rigid cylinder's radius, m (a scene kind with a body); None: the kind's
+    sphere_radius: float | None = None  # a rigid sphere's radius, m (a 3D scene kind with a body); None: the kind's
     boundary_method: str = ""  # how a body's curved wall is modelled (solvers/bodies/); "": the default
     probes: tuple = ()  # points ((x, y) or (x, y, z), ...) m where a run records drho every few steps, beside its own
     edges: Edges = Edges()  # the open edges and their layer (solvers/edges.py); open "": the kind's
@@ -117,9 +119,9 @@ class Scene:
     # in this order; the method's and the edges' are read through from those values.
     PARAMETERS: ClassVar[tuple] = (
         "dx", "name", "x_min", "x_max", "y_min", "y_max", "z_min", "z_max", "strip_height", "rho0", "c0", "mach",
-        "pulse_width", "pulse_center", "cylinder_radius", "boundary_method", "probes", "open", "layer_width",
-        "absorber", "absorber_strength", "h_factor", "cutoff_factor", "kernel", "correction", "cfl", "model",
-        "integrator", "precision", "steps", "t_end", "blowup_factor",
+        "pulse_width", "pulse_center", "cylinder_radius", "sphere_radius", "boundary_method", "probes", "open",
+        "layer_width", "absorber", "absorber_strength", "h_factor", "cutoff_factor", "kernel", "correction", "cfl",
+        "model", "integrator", "precision", "steps", "t_end", "blowup_factor",
     )  # fmt: skip
 
     def __init__(self, dx: float, name: str = DEFAULT_SCENE, *, method=None, edges=None, **given) -> None:
@@ -403,23 +405,29 @@ class Scene:
                 + " x ".join(f"[{lo:g}, {hi:g}]" for lo, hi in box)
                 + " m",
             )
-            x, y = p[0], p[1]
             if self.body is not None:
                 x0, y0, a = self.body
+                centre = (x0, y0, 0.0)[: self.dims]  # a cylinder's axis, a sphere's centre
                 need(
-                    math.hypot(x - x0, y - y0) >= a + self.cutoff,
-                    f"--probe {x:g},{y:g} is inside the body or within a cutoff of its wall (r < "
-                    f"{a + self.cutoff:.4g} m from its axis)",
+                    math.dist(p, centre) >= a + self.cutoff,
+                    f"--probe {','.join(f'{c:g}' for c in p)} is inside the body or within a cutoff of its wall (r < "
+                    f"{a + self.cutoff:.4g} m from its {'centre' if self.dims == 3 else 'axis'})",
                 )
 
     def _validate_body(self, need, finite) -> None:
         """A body's parameters only where the kind has a body (its own checks are the kind's), and a known
         boundary method."""
-        if not self.kind.body:
+        if not (self.kind.body and self.dims == 2):
             need(
                 self.cylinder_radius is None,
-                f"--cylinder-radius: the {self.name} scene has no body (use --scene cylinder)",
+                f"--cylinder-radius: the {self.name} scene has no body of that shape (use --scene cylinder)",
             )
+        if not (self.kind.body and self.dims == 3):
+            need(
+                self.sphere_radius is None,
+                f"--sphere-radius: the {self.name} scene has no body of that shape (use --scene sphere)",
+            )
+        if not self.kind.body:
             need(
                 not self.boundary_method,
                 f"--boundary-method: the {self.name} scene has no body (use --scene cylinder)",
@@ -431,6 +439,14 @@ class Scene:
             method = boundary_method_named(self.boundary_method_used)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
+        if self.dims == 3:  # a body in 3D: the weak wall alone (the ghost bodies place particles in a plane)
+            need(
+                method.name == CORRECTED_BODY_3D,
+                f"--boundary-method {method.name}: the {self.name} scene's body is 3D, whose wall is "
+                f"--boundary-method {CORRECTED_BODY_3D} alone (the ghost bodies are 2D's); it needs a kernel "
+                "correction: add --correction gradient (the high-order method: --kernel laguerre-gauss --cutoff 4 "
+                "--h-factor 1.5 --correction gradient)",
+            )
         need(
             not getattr(method, "needs_correction", False) or self.correction != DEFAULT_CORRECTION,
             f"--boundary-method {method.name} makes a wall only with a kernel correction: add --correction "
@@ -439,7 +455,8 @@ class Scene:
 
     @property
     def body(self) -> tuple | None:
-        """(x0, y0, radius) of the scene's rigid body, m (a cylinder, its axis at x0, y0), or None."""
+        """(x0, y0, radius) of the scene's rigid body, m (a cylinder, its axis at x0, y0; in a 3D scene a sphere,
+        its centre at x0, y0 and z = 0), or None."""
         return self.kind.body_of(self) if self.kind.body else None
 
     @property

@@ -195,6 +195,7 @@ def test_a_solver_without_walls_is_refused_a_walled_scene_in_one_line_and_confor
         "acoustic-pulse-3d",
         "acoustic-pulse-3d-open",
         "cylinder",
+        "sphere",
     ]
 
 

@@ -44,9 +44,11 @@ def test_bad_cylinder_input_is_one_line_naming_the_option(changes, words):
 
 
 def test_a_body_parameter_on_a_scene_without_one_is_refused():
-    for changes in (dict(cylinder_radius=0.5), dict(boundary_method="rings")):
+    for changes in (dict(cylinder_radius=0.5), dict(boundary_method="rings"), dict(sphere_radius=0.5)):
         with pytest.raises(SceneError, match="has no body"):
             Scene(dx=0.5, steps=2, **changes)
+    with pytest.raises(SceneError, match="--sphere-radius: the cylinder scene has no body of that shape"):
+        Scene(dx=0.05, name="cylinder", steps=2, sphere_radius=0.5)
 
 
 def test_the_workshops_defaults_and_points():

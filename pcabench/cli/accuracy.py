@@ -5,6 +5,7 @@ from __future__ import annotations
 from pcabench import jsonout
 from pcabench.cli.options import ACCURACY_OPTIONS, check_wall_option, domain_of
 from pcabench.machine import memory
+from pcabench.spec import OptionError
 from solvers import (
     DEFAULT_SCENE,
     Scene,
@@ -26,9 +27,13 @@ def cmd_accuracy(args) -> int:
         **domain_of(args),
     )
     from pcabench.execute.progress import Heartbeat
+    from solvers.scenes.base import NoPrediction
 
-    with Heartbeat(f"pcabench accuracy: predicting {scene.n_particles:,} particles"):  # a 3D lattice: a minute
-        p = predict(scene)
+    try:
+        with Heartbeat(f"pcabench accuracy: predicting {scene.n_particles:,} particles"):  # a 3D lattice: a minute
+            p = predict(scene)
+    except NoPrediction as exc:
+        raise OptionError(str(exc)) from None
     past = p.stable_cfl <= scene.cfl  # at or past the largest stable step (pcabench/predict/stability.py)
     if args.json:
         known = {"known_failure": scene.known_failure, "cautions": list(scene.cautions)}  # ("" / [] where none)

@@ -208,6 +208,16 @@ def answering_machine(df, machines, asked: tuple) -> tuple[str, dict]:
 
 
 def cmd_advise(args) -> int:
+    """``pcabench advise``; a scene kind with no prediction (the sphere) refused in one line."""
+    from solvers.scenes.base import NoPrediction
+
+    try:
+        return _advise(args)
+    except NoPrediction as exc:
+        raise OptionError(str(exc)) from None
+
+
+def _advise(args) -> int:
     from pcabench.machine.profiles import machine_id
     from pcabench.reports.frame import load as load_frame
     from pcabench.store import runs

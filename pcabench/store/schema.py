@@ -166,6 +166,7 @@ SCENE_FIELDS: dict[str, Field] = {
     "absorber": _name(max_len=32, pattern=SOLVER_NAME),
     "absorber_strength": Field(("number", "null"), low=0, high=1e12, above=True),
     "cylinder_radius": Field(("number", "null"), low=0, high=1e12, above=True),
+    "sphere_radius": Field(("number", "null"), low=0, high=1e12, above=True),
     "boundary_method": _name(max_len=32, pattern=SOLVER_NAME),
     "probes": Field(("list",)),
 }

@@ -1,16 +1,17 @@
 """A scene's boundaries as one family of models, one file each (see base.py): rigid walls at x edges (walls.py),
-the absorbing layer beyond open edges (layer.py) and a rigid body inside the domain (body.py). How each is made
-is a plug-in of its own where there are choices: the layer's absorber (solvers/absorbers/), the body's boundary
-method (solvers/bodies/)."""
+the absorbing layer beyond open edges (layer.py) and a rigid body inside the domain (body.py; a 3D scene's:
+body3d.py). How each is made is a plug-in of its own where there are choices: the layer's absorber
+(solvers/absorbers/), the body's boundary method (solvers/bodies/)."""
 
 from __future__ import annotations
 
 from solvers.boundaries.base import Boundary
 from solvers.boundaries.body import RigidBody
+from solvers.boundaries.body3d import RigidBody3D
 from solvers.boundaries.layer import OpenLayer
 from solvers.boundaries.walls import Walls, across
 
-MODELS = (Walls, OpenLayer, RigidBody)  # in the order a solver calls them
+MODELS = (Walls, OpenLayer, RigidBody, RigidBody3D)  # in the order a solver calls them
 
 
 def boundary_models(scene) -> tuple:
@@ -18,4 +19,4 @@ def boundary_models(scene) -> tuple:
     return tuple(model(scene) for model in MODELS if model.applies(scene))
 
 
-__all__ = ["Boundary", "MODELS", "OpenLayer", "RigidBody", "Walls", "across", "boundary_models"]
+__all__ = ["Boundary", "MODELS", "OpenLayer", "RigidBody", "RigidBody3D", "Walls", "across", "boundary_models"]

@@ -30,9 +30,9 @@ class Boundary:
         """Whether ``scene`` has this boundary."""
         raise NotImplementedError
 
-    def start(self, solver, x, y, drho) -> None:
-        """The solver's arrays exist (``solver.arrays``), its particles at their lattice sites ``x``, ``y`` (m) with
-        the initial ``drho`` (kg/m^3): set the model's own arrays and places."""
+    def start(self, solver, x, y, drho, z=None) -> None:
+        """The solver's arrays exist (``solver.arrays``), its particles at their lattice sites ``x``, ``y`` (and
+        ``z`` in a 3D scene; m) with the initial ``drho`` (kg/m^3): set the model's own arrays and places."""
 
     def before_sweep(self, solver) -> bool:
         """Before the pair sums of PI; True where it changed drho (a solver then recomputes what it keeps of it)."""

@@ -130,9 +130,9 @@ class RigidBody(Boundary):
 
     @classmethod
     def applies(cls, scene) -> bool:
-        return scene.body is not None
+        return scene.body is not None and scene.dims == 2
 
-    def start(self, solver, x, y, drho) -> None:
+    def start(self, solver, x, y, drho, z=None) -> None:
         """The body's particles' roles and places (``role``, their shifts), their fields zero and the inert ones
         massless."""
         a, xp, dt = solver.arrays, solver.xp, solver.dtype

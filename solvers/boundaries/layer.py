@@ -32,7 +32,7 @@ class OpenLayer(Boundary):
     def applies(cls, scene) -> bool:
         return bool(scene.open)
 
-    def start(self, solver, x, y, drho) -> None:
+    def start(self, solver, x, y, drho, z=None) -> None:
         """A split absorber's x parts of drho (half of it) and of its rate (drho_y = drho - drho_x)."""
         self.key, self.sigma, self.cache = None, (), {}
         if self.split:

@@ -104,8 +104,14 @@ class GradientCorrection(Correction):
         smallest = xp.linalg.eigvalsh(m.astype(xp.float64))[:, 0]
         del m
         bad = ~(smallest >= SMALLEST_MOMENT)
-        if bool(bad.any()):
-            self.refuse(solver, int(xp.argmax(bad)), float(smallest[int(xp.argmax(bad))]))
+        body = solver.arrays["role"] != 0 if "role" in solver.arrays else None
+        fluid_bad = bad & ~body if body is not None else bad
+        if bool(fluid_bad.any()):
+            self.refuse(solver, int(xp.argmax(fluid_bad)), float(smallest[int(xp.argmax(fluid_bad))]))
+        if body is not None:  # a body's inert particles lend nothing: where their M is poor, no correction
+            one, zero = solver.dtype.type(1.0), solver.dtype.type(0.0)
+            for arr, value in ((xx, one), (xy, zero), (xz, zero), (yy, one), (yz, zero), (zz, one)):
+                arr[bad] = value
         cxx, cxy, cxz = yy * zz - yz * yz, xz * yz - xy * zz, xy * yz - xz * yy  # the adjugate's (symmetric)
         cyy, cyz, czz = xx * zz - xz * xz, xy * xz - xx * yz, xx * yy - xy * xy
         det = xx * cxx + xy * cxy + xz * cxz

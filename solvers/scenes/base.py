@@ -105,6 +105,10 @@ def left_behind(scene, fields, exact) -> dict:
     }
 
 
+class NoPrediction(ValueError):
+    """A scene kind with no prediction of its errors (``accuracy`` and ``advise`` refuse it in one line)."""
+
+
 class SceneKind:
     """Base class of the scene kinds: a problem with an exact reference. Subclasses set ``name``."""
 
@@ -264,8 +268,9 @@ class SceneKind:
         return self.isothermal_errors(scene, self.exact_fields(scene, scene.t_final))
 
     def predict(self, scene):
-        """The linear model's predicted errors from the dispersion relation (solvers/reference/dispersion.py)."""
-        raise NotImplementedError
+        """The linear model's predicted errors from the dispersion relation (solvers/reference/dispersion.py);
+        NoPrediction where the kind has none."""
+        raise NoPrediction(f"the {self.name} scene has no prediction from the dispersion relation")
 
     def stable_cfl(self, scene) -> float | None:
         """The largest stable CFL of ``scene``'s method where this kind's lattice is not the square one (a 3D

@@ -1,0 +1,76 @@
+"""A rigid body in a 3D scene (a sphere): its wall the weak one, the only one a 3D body has.
+
+The sphere (``Scene.body``: radius a, its centre at x0, y0 and z = 0) holds the lattice sites inside it; every one
+is inert (solvers/bodies/weak.py): zero fields and no mass, so no sum counts it and the fluid near the wall has
+truncated neighbourhoods, where the gradient-corrected operators make the wall (u . n = 0 weakly, the
+summation-by-parts boundary). The inert particles never move (put back after every advance of moving particles)
+and a fluid particle half a spacing inside the sphere stops the run (BodyEntered). The ghost bodies of 2D
+(solvers/boundaries/body.py) are refused on a 3D scene (Scene's body check).
+"""
+
+from __future__ import annotations
+
+from solvers.bodies.base import ENTRY_DEPTH, FLUID, INERT, BodyEntered
+from solvers.boundaries.base import Boundary
+
+FIELDS = ("u", "v", "w", "drho")
+
+
+class RigidBody3D(Boundary):
+    """A 3D scene's body in a solver: its sites' roles (``role``: INERT inside, FLUID outside), their fields kept
+    zero before every sweep, their places kept after every advance."""
+
+    name = "body"
+    kind = "body"
+
+    def __init__(self, scene):
+        super().__init__(scene)
+        self.x0, self.y0, self.a = scene.body
+
+    @classmethod
+    def applies(cls, scene) -> bool:
+        return scene.body is not None and scene.dims == 3
+
+    def start(self, solver, x, y, drho, z=None) -> None:
+        a, xp, dt = solver.arrays, solver.xp, solver.dtype
+        inside = (x - self.x0) ** 2 + (y - self.y0) ** 2 + z**2 < self.a**2
+        a["role"] = xp.where(inside, INERT, FLUID).astype(dt)
+        for name in FIELDS:
+            a[name][inside] = 0
+        a["mass"][inside] = 0  # no volume: no sum counts the inert particles
+        self.n_inert = int(inside.sum())
+
+    def inert(self, solver):
+        return solver.arrays["role"] != 0
+
+    def before_sweep(self, solver) -> bool:
+        """The inert particles' fields zero (their own sums gave them values no fluid particle reads); a fluid
+        particle inside the sphere stops the run."""
+        a = solver.arrays
+        inert = self.inert(solver)
+        for name in FIELDS:
+            a[name][inert] = 0
+        if solver.moving:
+            self.check_entered(solver, inert)
+        return True
+
+    def check_entered(self, solver, inert) -> None:
+        s, a, xp = self.scene, solver.arrays, solver.xp
+        r2 = sum(
+            (lo + (a[f"l{c}"].astype(xp.float64) + 0.5) * s.dx + a[f"s{c}"] - c0) ** 2
+            for lo, c, c0 in ((s.x_lo, "x", self.x0), (s.y_lo, "y", self.y0), (s.z_lo, "z", 0.0))
+        )
+        deep = (self.a - ENTRY_DEPTH * s.dx) ** 2
+        entered = (r2 < deep) & ~inert
+        if bool(entered.any()):
+            raise BodyEntered(
+                f"{int(entered.sum())} fluid particle(s) inside the sphere, past half a spacing below its surface "
+                f"(r < {self.a - ENTRY_DEPTH * s.dx:.4g} m): the wall let them through"
+            )
+
+    def moved(self, solver) -> None:
+        """The inert particles back at their sites."""
+        a = solver.arrays
+        inert = self.inert(solver)
+        for name in ("sx", "sy", "sz"):
+            a[name][inert] = 0

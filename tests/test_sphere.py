@@ -1,0 +1,67 @@
+"""The rigid sphere (issue 65): the 3D body's scene, its weak wall and its one-line refusals. Its exact reference is
+tests/test_sphere_reference.py's; the solvers' agreement on it is the conformance suite's (SceneKind.smallest)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from solvers import Scene, SceneError
+from solvers.bodies.base import INERT
+from solvers.physics.integrators import evolve
+from solvers.registry import make_solver
+
+HIGH = dict(kernel="laguerre-gauss", h_factor=1.5, cutoff_factor=4.0, correction="gradient", cfl=0.5)
+
+
+@pytest.mark.parametrize(
+    "changes, words",
+    [
+        ({}, "--boundary-method rings: the sphere scene's body is 3D"),  # standard SPH: no wall in 3D
+        (dict(**HIGH, boundary_method="lattice"), "whose wall is --boundary-method weak alone"),
+        (dict(**HIGH, open="x"), "its six faces are always open"),
+        (dict(**HIGH, probes=((0.3, 0.0, 0.0),)), "--probe 0.3,0,0 is inside the body"),
+        (dict(**HIGH, pulse_center=0.7), "--pulse-center: the pulse's centre must be at least a pulse width"),
+        (dict(**HIGH, cylinder_radius=0.5), "--cylinder-radius: the sphere scene has no body of that shape"),
+    ],
+)
+def test_bad_sphere_input_is_one_line_naming_the_option(changes, words):
+    with pytest.raises(SceneError) as err:
+        Scene(0.1, "sphere", steps=2, **changes)
+    assert words in str(err.value) and "\n" not in str(err.value), str(err.value)
+
+
+def test_the_sphere_defaults_are_the_issues_problem():
+    scene = Scene(0.1, "sphere", t_end=4.0, **HIGH)
+    assert scene.body == (0.0, 0.0, 0.5) and scene.pulse_width == 0.4 and scene.pulse_center == 1.5
+    assert scene.open == "xyz" and scene.boundary_method_used == "weak"
+    assert scene.probe_points() == {"A": (0.0, 1.5, 0.0), "B": (-1.0607, 1.0607, 0.0), "C": (-1.5, 0.0, 0.0)}
+
+
+def test_the_bodys_particles_are_massless_and_stay_silent():
+    """Inside the sphere every site is inert, massless and zero after every step; outside the pulse moves."""
+    kw = dict(x_min=-1.0, x_max=2.0, y_min=-1.0, y_max=1.0, z_min=-1.0, z_max=1.0, pulse_center=1.2, layer_width=0.5)
+    method = dict(kernel="wendland-c2", h_factor=1.3, correction="gradient", cfl=0.5)
+    scene = Scene(0.125, "sphere", steps=4, model="linear", **method, **kw)
+    solver = evolve(make_solver("linkedlist-cpu"), scene)
+    solver.prepare_boundaries()
+    a = solver.arrays
+    inert = a["role"] == INERT
+    assert inert.sum() > 100 and np.all(a["mass"][inert] == 0)
+    assert all(np.all(a[name][inert] == 0) for name in ("u", "v", "w", "drho"))
+    fluid = ~inert
+    assert np.all(np.isfinite(a["drho"][fluid])) and np.abs(a["u"][fluid]).max() > 0
+
+
+@pytest.mark.parametrize("command", ["accuracy", "advise"])
+def test_the_commands_that_predict_refuse_the_sphere_in_one_line(command, capsys):
+    from .conftest import cli_main
+
+    args = ["--scene", "sphere", "--t-end", "4"]
+    args += (
+        ["--error", "0.02"]
+        if command == "advise"
+        else ["--dx", "0.1", *"--kernel laguerre-gauss --cutoff 4 --h-factor 1.5 --correction gradient".split()]
+    )
+    rc, out, err = cli_main(command, *args, capsys=capsys)
+    assert rc == 2 and "no prediction yet" in err and len(err.strip().splitlines()) == 1, err
