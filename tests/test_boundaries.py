@@ -11,7 +11,7 @@ import pytest
 import solvers.boundaries as boundaries
 from pcabench.conformance import run_steps
 from solvers import Scene, scenes
-from solvers.boundaries import OpenLayer, RigidBody, Walls, boundary_models
+from solvers.boundaries import OpenLayer, RigidBody, RigidBody3D, Walls, boundary_models
 from solvers.registry import make_solver
 
 
@@ -26,7 +26,7 @@ def kind_cases():
 def test_each_scene_kind_gets_the_models_of_its_boundaries(scene):
     models = {type(m) for m in boundary_models(scene)}
     assert (Walls in models) == ("wall-x" in scene.boundaries) == bool(scene.walls)
-    assert (RigidBody in models) == ("body" in scene.boundaries) == (scene.body is not None)
+    assert bool(models & {RigidBody, RigidBody3D}) == ("body" in scene.boundaries) == (scene.body is not None)
     assert (OpenLayer in models) == bool(scene.open) == (scene.n_layer > 0)
 
 

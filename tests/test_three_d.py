@@ -272,6 +272,10 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
         s = spec.scene
         rec.steps, rec.t_end, rec.me, rec.mean_neighbours = s.n_steps, s.t_final, 0.0, 80.0
         rec.mse = high_order.get(s.dx, 0.1) if s.kernel == "laguerre-gauss" else 0.1 * s.dx
+        if s.name == "sphere":  # the sphere's probes: 0.279 and 0.154 (measured), order 2.66
+            rec.mse = {0.125: 0.279, 0.1: 0.154}[s.dx]
+            rec.errors = {"probe_A": rec.mse, "probe_B": rec.mse, "probe_C": rec.mse, "probe_rms": rec.mse}
+            rec.measure, rec.headline = "probes_p", rec.mse
         pi = 3.0 if s.dims == 3 else 1.0  # the cost runs: 3D three times the 2D per pair
         rec.stages = {"input": 0.0, "init": 0.0, "snp": 0.0, "pi": pi * s.n_steps * s.n_particles * 80e-9,
                       "su": 0.0, "output": 0.0}  # fmt: skip
@@ -284,6 +288,8 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     assert "0.000228 at dx 0.25 (262,144 particles), order 4.57 (the issue's target" in words
     assert "at most 0.001 and order 3.5: met)" in words and "| 1.00 / 1.00 |" in words  # Wendland's orders
     assert "3D 3 (32,768 particles, 80 neighbours) against 2D 1 (32,761, 80): 3.00 times" in words, words
+    assert [r["dx"] for r in data["sphere"]] == [0.125, 0.1]
+    assert "| 0.1 | 185,193 |" in words and "| 0.154 | 0.154 | 0.154 | 0.154 | 2.66 |" in words, words
 
 
 @pytest.mark.tier2  # 27,000 particles of the fourth-order method: 15 s

@@ -15,11 +15,11 @@ TITLE = "A rigid cylinder (ghost particles)"
 
 @dataclass(frozen=True)
 class Cases:
-    """Every scene kind with a body at its card size (the workshop's cylinder at 5 particles a pulse width:
-    102,400 particles), each boundary method (its ghosts filled from the fluid on the host), model and
-    precision."""
+    """Every 2D scene kind with a body (the GPU solver's 3D is to come) at its card size (the workshop's cylinder
+    at 5 particles a pulse width: 102,400 particles), each boundary method (its ghosts filled from the fluid on the
+    host), model and precision."""
 
-    scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: kind.body))
+    scenes: tuple = field(default_factory=lambda: card_cases(lambda kind: kind.body and kind.dims == 2))
     methods: tuple = ("lattice", "rings")
     models: tuple = ("linear", "lagrangian")
     precisions: tuple = ("float64", "float32")
