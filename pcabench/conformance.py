@@ -756,8 +756,14 @@ def main(solver: str, quick: bool = False, as_json: bool = False, out=None) -> i
     """``pcabench check-solver``: one line per check (or one JSON object); 0 if none failed, else 1."""
     out = out or sys.stdout
     t0 = time.perf_counter()
-    results = []
-    for result in iter_checks(solver, quick):
+    from pcabench.execute.progress import Heartbeat
+
+    results, checks = [], iter_checks(solver, quick)
+    while True:
+        with Heartbeat(f"check-solver {solver}: check {len(results) + 1} running"):  # a check of minutes says so
+            result = next(checks, None)
+        if result is None:
+            break
         results.append(result)
         if not as_json:
             print(result.line(), file=out, flush=True)
