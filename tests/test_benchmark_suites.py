@@ -111,6 +111,7 @@ def test_the_step_guard_warns_past_its_threshold_and_fails_only_when_asked(monke
     assert guard.main(["--pairs", "2", "--fail", "--threshold", "0.05"]) == 1
 
 
+@pytest.mark.tier2  # two trees' step timed alternating: 20 s (the second tier)
 def test_the_step_guard_runs_each_side_from_its_own_tree(tmp_path):
     """End to end at 400 particles against HEAD exported by git archive: each side imports its own tree."""
     guard = ci_module("step_guard")

@@ -35,6 +35,7 @@ def outcome(results):
     )
 
 
+@pytest.mark.tier2  # a local Dask cluster's sweep: 13-21 s (the second tier)
 def test_a_cluster_sweep_makes_the_same_runs_as_a_serial_one_and_resumes(tmp_path):
     serial, dask = tmp_path / "serial", tmp_path / "dask"
     assert study(serial, *SWEEP).returncode == 0
@@ -63,6 +64,7 @@ def run_child_under_a_worker(root: int) -> tuple[int, int] | None:
     return None
 
 
+@pytest.mark.tier2  # a local Dask cluster's sweep: 13-21 s (the second tier)
 def test_a_killed_worker_loses_and_duplicates_nothing(tmp_path):
     args = ["--dx", "0.25", "0.2", "--steps", "150", "--no-report", "--cluster", "local:2"]
     proc = subprocess.Popen(

@@ -175,6 +175,7 @@ print(json.dumps(out))
 """
 
 
+@pytest.mark.tier2  # a few steps in numba's CUDA simulator: 23 s (the second tier; the other simulator tests stay)
 def test_simulated_step_launches_and_host_round_trips():
     """A lagrangian Verlet step is at most 8 kernel launches, touches no array-module operation (each would be
     a CuPy launch or a host round trip on a GPU) and never synchronises; the one-block cellBegin scan is exact."""

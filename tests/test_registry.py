@@ -131,6 +131,7 @@ def test_a_broken_or_clashing_plugin_is_left_out_with_one_warning(site):
         assert sum(words in m for m in mine) == 1, (words, mine)
 
 
+@pytest.mark.tier2  # a plug-in through run, study, report and the benchmarks: 15 s (the second tier)
 def test_a_plugin_runs_through_run_a_study_a_report_and_the_benchmarks(tmp_path):
     site = install(tmp_path / "site", "argsort_solver", readme_example(), {NAME: "argsort_solver:ArgsortCellList"})
     install(site, "broken_solver", BROKEN, {"missing": "broken_solver:Absent"})  # one broken plug-in beside it
