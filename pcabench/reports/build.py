@@ -264,30 +264,26 @@ def summary(results_dir: Path, profile: str, run_ids=None) -> str:
         return run_table(df)
     rest = int((~timing).sum())
     more = f"\n... and {rest} more runs (accuracy, other scenes): the report's tables, `pcabench runs`" if rest else ""
-    return "Step times on this machine, ms per step (the paper's scene; the report has every table):\n" + more_table(
-        rows, more
-    )
+    heading = "Step times on this machine, ms per step (the paper's scene; the report has every table):\n"
+    return heading + step_table(rows) + more
 
 
-def more_table(rows, more: str) -> str:
-    """Table 4's step-time columns of ``rows``, then ``more``."""
-    return (
-        md_table(
-            ["config", "protocol", "N", "SNP", "PI", "SU", "step"],
+def step_table(rows) -> str:
+    """Table 4's step-time columns (ms) of ``rows``."""
+    return md_table(
+        ["config", "protocol", "N", "SNP", "PI", "SU", "step"],
+        [
             [
-                [
-                    r["config"],
-                    r["protocol"],
-                    f"{r['N']:,}",
-                    fmt(r["snp"], ".3f"),
-                    fmt(r["pi"], ".3f"),
-                    fmt(r["su"], ".3f"),
-                    fmt(r["snp"] + r["pi"] + r["su"], ".3f"),
-                ]
-                for r in rows
-            ],
-        )
-        + more
+                r["config"],
+                r["protocol"],
+                f"{r['N']:,}",
+                fmt(r["snp"], ".3f"),
+                fmt(r["pi"], ".3f"),
+                fmt(r["su"], ".3f"),
+                fmt(r["snp"] + r["pi"] + r["su"], ".3f"),
+            ]
+            for r in rows
+        ],
     )
 
 

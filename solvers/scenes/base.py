@@ -105,6 +105,31 @@ def left_behind(scene, fields, exact) -> dict:
     }
 
 
+def window_probe_errors(scene, probes, window: tuple, exact) -> dict:
+    """The relative RMS of p = c0^2 drho at each probe over ``window`` (t0, t1) s (to the run's end; NaN before
+    it), ``probe_<name>``, over all probes together, ``probe_rms``, and the largest error, ``probe_max``.
+    ``exact(names, t)``: the exact drho at those probes and times, an array (len(names), len(t)), kg/m^3. A
+    probe the sound has not reached (its reference below 1e-6 of the pulse's amplitude) has none (NaN)."""
+    import numpy as np
+
+    t = np.asarray(probes["t"], dtype=np.float64)
+    inside = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
+    names = [k for k in probes if k != "t"]
+    nan = float("nan")
+    if inside.sum() < 2 or not names:
+        return {"probe_rms": nan, "probe_max": nan, **{f"probe_{k}": nan for k in names}}
+    out, num, den, worst = {}, 0.0, 0.0, 0.0
+    for name, ref in zip(names, exact(names, t[inside])):
+        d = np.asarray(probes[name], dtype=np.float64)[inside] - ref
+        quiet = np.sqrt(np.mean(ref**2)) < 1e-6 * scene.rho0 * scene.mach  # no sound there yet
+        out[f"probe_{name}"] = nan if quiet else float(np.sqrt(np.sum(d**2) / np.sum(ref**2)))
+        num, den = num + float(np.sum(d**2)), den + float(np.sum(ref**2))
+        worst = max(worst, float(np.max(np.abs(d))))
+    out["probe_rms"] = float(np.sqrt(num / den)) if np.isfinite(num) and den > 0 else nan
+    out["probe_max"] = worst if np.isfinite(num) else nan
+    return out
+
+
 class NoPrediction(ValueError):
     """A scene kind with no prediction of its errors (``accuracy`` and ``advise`` refuse it in one line)."""
 

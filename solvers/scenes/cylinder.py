@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from solvers.scenes.base import PULSE_WIDTH_RANGE, SceneKind
+from solvers.scenes.base import PULSE_WIDTH_RANGE, SceneKind, window_probe_errors
 
 LN2 = math.log(2.0)
 NEAR_CUTOFFS = 3.0  # the near-body band: the fluid within this many cutoffs of the surface
@@ -85,28 +85,15 @@ class Cylinder(SceneKind):
         return probe_points(scene)
 
     def probe_errors(self, scene, probes) -> dict:
-        """The relative RMS of p = c0^2 drho at each probe over the workshop's window 6 <= t <= 10 s (to the run's
-        end; NaN before the window), ``probe_<name>``, and over all probes together, ``probe_rms``."""
-        t = np.asarray(probes["t"], dtype=np.float64)
-        inside = (t >= WINDOW[0] - 1e-9) & (t <= WINDOW[1] + 1e-9)
-        names = [k for k in probes if k != "t"]
-        nan = float("nan")
-        if inside.sum() < 2 or not names:
-            return {"probe_rms": nan, "probe_max": nan, **{f"probe_{k}": nan for k in names}}
-        ref = self.reference(scene, float(t[inside].max()))
-        out, num, den, worst = {}, 0.0, 0.0, 0.0
+        """The probes' errors over the workshop's window 6 <= t <= 10 s (:func:`window_probe_errors`) against the
+        series solution."""
         points = scene.probe_points()
-        for name in names:
-            x, y = points[name]
-            exact = ref.drho(np.array([x]), np.array([y]), t[inside])[:, 0]
-            d = np.asarray(probes[name], dtype=np.float64)[inside] - exact
-            quiet = np.sqrt(np.mean(exact**2)) < 1e-6 * scene.rho0 * scene.mach  # no sound there yet
-            out[f"probe_{name}"] = nan if quiet else float(np.sqrt(np.sum(d**2) / np.sum(exact**2)))
-            num, den = num + float(np.sum(d**2)), den + float(np.sum(exact**2))
-            worst = max(worst, float(np.max(np.abs(d))))
-        out["probe_rms"] = float(np.sqrt(num / den)) if np.isfinite(num) else nan
-        out["probe_max"] = worst if np.isfinite(num) else nan
-        return out
+
+        def exact(names, times):
+            ref = self.reference(scene, float(times.max()))
+            return [ref.drho(np.array([points[k][0]]), np.array([points[k][1]]), times)[:, 0] for k in names]
+
+        return window_probe_errors(scene, probes, WINDOW, exact)
 
     def check(self, scene) -> list[str]:
         out = super().check(scene)

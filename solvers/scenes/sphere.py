@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from solvers.scenes.base import PULSE_WIDTH_RANGE, SceneKind
+from solvers.scenes.base import PULSE_WIDTH_RANGE, SceneKind, window_probe_errors
 
 LN2 = math.log(2.0)
 PROBES = {"A": (0.0, 1.5, 0.0), "B": (-1.0607, 1.0607, 0.0), "C": (-1.5, 0.0, 0.0)}  # m
@@ -70,36 +70,24 @@ class Sphere(SceneKind):
         return dict(PROBES)
 
     def probe_errors(self, scene, probes) -> dict:
-        """The relative RMS of p = c0^2 drho at each probe over the window 1.5 <= t <= 4 s (to the run's end; NaN
-        before it), ``probe_<name>``, and over all probes together, ``probe_rms``; the largest error, ``probe_max``."""
+        """The probes' errors over the window 1.5 <= t <= 4 s (:func:`window_probe_errors`) against the exact
+        series (solvers/reference/sphere.py)."""
         from solvers.reference.sphere import drho as exact_drho
 
-        t = np.asarray(probes["t"], dtype=np.float64)
-        inside = (t >= WINDOW[0] - 1e-9) & (t <= WINDOW[1] + 1e-9)
-        names = [k for k in probes if k != "t"]
-        nan = float("nan")
-        if inside.sum() < 2 or not names:
-            return {"probe_rms": nan, "probe_max": nan, **{f"probe_{k}": nan for k in names}}
         points = scene.probe_points()
-        exact = exact_drho(
-            np.array([points[k] for k in names]),
-            t[inside],
-            scene.sphere_radius,
-            scene.pulse_center,
-            scene.pulse_width,
-            scene.rho0 * scene.mach,
-            scene.c0,
-        )
-        out, num, den, worst = {}, 0.0, 0.0, 0.0
-        for row, name in zip(exact, names):
-            d = np.asarray(probes[name], dtype=np.float64)[inside] - row
-            quiet = np.sqrt(np.mean(row**2)) < 1e-6 * scene.rho0 * scene.mach  # no sound there yet
-            out[f"probe_{name}"] = nan if quiet else float(np.sqrt(np.sum(d**2) / np.sum(row**2)))
-            num, den = num + float(np.sum(d**2)), den + float(np.sum(row**2))
-            worst = max(worst, float(np.max(np.abs(d))))
-        out["probe_rms"] = float(np.sqrt(num / den)) if np.isfinite(num) and den > 0 else nan
-        out["probe_max"] = worst if np.isfinite(num) else nan
-        return out
+
+        def exact(names, times):
+            return exact_drho(
+                np.array([points[k] for k in names]),
+                times,
+                scene.sphere_radius,
+                scene.pulse_center,
+                scene.pulse_width,
+                scene.rho0 * scene.mach,
+                scene.c0,
+            )
+
+        return window_probe_errors(scene, probes, WINDOW, exact)
 
     def check(self, scene) -> list[str]:
         out = super().check(scene)
