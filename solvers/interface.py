@@ -517,14 +517,6 @@ class Solver(abc.ABC):
         _key, idx, weights = cached
         return weights @ self.to_host(a["drho"][idx]).astype(np.float64)
 
-    def amplitude(self) -> float:
-        """max |u|, |v| over particles (NaN or inf if the state is not finite), m/s."""
-        a = self.arrays
-        m = max(*(float(abs(a[name]).max()) for name in VELOCITY[self.scene.dims]), 0.0)
-        if not np.isfinite(float(self.xp.sum(a["drho"]))):
-            return float("nan")
-        return m
-
     def extremes(self) -> dict:
         """{field: max |value| over particles}: 'velocity' (m/s, over its components) and 'drho' (kg/m^3); NaN for
         a field that is not finite (what a run checks against Scene.blowup_bounds after every step)."""

@@ -207,7 +207,7 @@ class CellListSolver(Solver):
         probe.rates(True, True)
         probe.kick(0.5)
         probe.advance(1.0)
-        probe.amplitude()
+        probe.extremes()
         probe.output()
         probe.mean_neighbours()
         probe.synchronize()
