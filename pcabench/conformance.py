@@ -135,6 +135,9 @@ class Failure(AssertionError):
 
 
 # ---------------------------------------------------------------- the solver under test
+SIMULATED_MOST = 4_000  # particles of a case run in numba's CUDA simulator (Python threads: seconds a step)
+
+
 class Subject:
     """The class under test, its configurations and their runs (each run once, shared by the checks)."""
 
@@ -152,11 +155,18 @@ class Subject:
         return Scene.default(axis) if Scene.default(axis) in claimed else claimed[0]
 
     def claimed_scenes(self) -> list[str]:
+        """The scene cases whose boundaries the class claims."""
         return [
             name
             for name in self.cases
             if name != LARGER and set(self.scene(name=name).boundaries) <= set(self.cls.boundaries)
         ]
+
+    def run_scenes(self) -> list[str]:
+        """The claimed scene cases the checks run: in numba's CUDA simulator those of at most ``SIMULATED_MOST``
+        particles (a GPU class's larger cases, the 3D body's, are run on a card: ``pcabench gpu-check``)."""
+        claimed = self.claimed_scenes()
+        return [name for name in claimed if not (self.simulated and self.scene(name=name).n_particles > SIMULATED_MOST)]
 
     def scene(self, name: str = "plane-pulse", steps: int | None = None, **method) -> Scene:
         """A conformance scene: ``name``'s tiny lattice with the class's defaults and ``method`` on top."""
@@ -171,7 +181,7 @@ class Subject:
         claimed value once, and each walled scene with every claimed model (a wall's mirrors are set once for
         particles that stay on the lattice and follow moving ones every step: two paths)."""
         axes = {axis: tuple(getattr(self.cls, CLAIMS[axis])) for axis in AXES}
-        axes["scene"] = tuple(self.claimed_scenes())
+        axes["scene"] = tuple(self.run_scenes())
         axes["pair_loop"] = tuple(self.cls.pair_loops)
         base = {axis: (self.default(axis) if axis in AXES else values[0]) for axis, values in axes.items()}
         larger = [{**base, "scene": LARGER}] if "plane-pulse" in axes["scene"] and not self.simulated else []
@@ -411,7 +421,7 @@ def neighbours(subject: Subject) -> str:
     claimed scene and kernel), leaves every array the solver holds (and its time) exactly as it was, and
     counting between steps changes no result beyond round-off."""
     problems, kernels = [], subject.cls.kernels if not subject.quick else (subject.default("kernel"),)
-    for name, kernel in itertools.product(subject.claimed_scenes(), kernels):
+    for name, kernel in itertools.product(subject.run_scenes(), kernels):
         scene = subject.scene(name, kernel=kernel)
         solver = subject.make()
         solver.input(scene)

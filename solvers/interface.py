@@ -566,25 +566,35 @@ def cell_grid(scene: Scene) -> tuple:
     return scene.cutoff, ch, ncx, ncy, -scene.cutoff, 0.0, height
 
 
+def stencil_reach(scene: Scene) -> tuple:
+    """Cells a cutoff spans along x, y and z in a 3D scene's grid: eight along x (a row trimmed to the sphere's
+    chord to an eighth of a cutoff), along y and z two where a cell then still spans 2 dx (the fourth-order and
+    the paper's kernels, 6 dx cutoffs), else one: rows of a few particles cost more than the candidates they drop
+    (measured by ``pcabench study --three-d``'s pair-cost runs, docs/performance.md "A pair in 3D")."""
+    across = 2 if scene.cutoff >= 4.0 * scene.dx else 1
+    return 8, across, across
+
+
 def cell_grid_3d(scene: Scene) -> tuple:
-    """(cw, ch, cd, ncx, ncy, ncz, x_grid, width, height, depth) of a 3D scene: along each periodic axis a whole
-    number of cells at least a cutoff wide filling the period (the period, m, given), along a free one cells a
-    cutoff wide with a spare one each side in x (particles past a free edge are clamped into the edge cells in y
-    and z, as in 2D: :func:`cell_grid`)."""
+    """(cw, ch, cd, ncx, ncy, ncz, x_grid, width, height, depth, reach_x, reach_y, reach_z) of a 3D scene: along
+    each axis cells at least a cutoff over the reach (:func:`stencil_reach`) wide, along a periodic axis a whole
+    number of them filling the period (the period, m, given), along a free x a cutoff spare each side (particles
+    past a free edge are clamped into the edge cells in y and z, as in 2D: :func:`cell_grid`)."""
+    reaches = stencil_reach(scene)
     sizes, counts, periods = [], [], []
-    for span, periodic in (
-        (scene.width, scene.periodic_x),
-        (scene.height, scene.periodic_y),
-        (scene.depth, scene.periodic_z),
+    for span, periodic, reach in zip(
+        (scene.width, scene.height, scene.depth), (scene.periodic_x, scene.periodic_y, scene.periodic_z), reaches
     ):
-        n = max(int(math.floor(span / scene.cutoff + 1e-9)), 1)
+        n = max(int(math.floor(span * reach / scene.cutoff + 1e-9)), 1)
         sizes.append(span / n)
         counts.append(n)
         periods.append(span if periodic else 0.0)
     x_grid = 0.0
-    if not scene.periodic_x:  # one cutoff wide with one spare each side, as the 2D free x edges
-        sizes[0], counts[0], x_grid = scene.cutoff, int(math.ceil(scene.width / scene.cutoff)) + 2, -scene.cutoff
-    return (*sizes, *counts, x_grid, *periods)
+    if not scene.periodic_x:  # a cutoff spare each side, as the 2D free x edges
+        reach = reaches[0]
+        sizes[0], x_grid = scene.cutoff / reach, -scene.cutoff
+        counts[0] = int(math.ceil(scene.width * reach / scene.cutoff)) + 2 * reach
+    return (*sizes, *counts, x_grid, *periods, *reaches)
 
 
 def tiny_scene(scene: Scene) -> Scene:

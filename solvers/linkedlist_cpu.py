@@ -39,7 +39,8 @@ from solvers.search.celllist import CellListSolver
 def sweeps(precision: str, kernel: str, parallel: bool, across: bool = True, dims: int = 2) -> dict:
     """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool, with or
     without the pairs across an x seam or wall (``across``; solvers/loops/cells.py, compiled once per
-    machine), and the per-particle updates; in 3D the 27-cell loops and their updates (solvers/loops/cells3d.py)."""
+    machine), and the per-particle updates; in 3D the trimmed stencil's loops and their updates
+    (solvers/loops/cells3d.py)."""
     if dims == 3:
         loops = cpu_loops("cells3d", precision, kernel, parallel, across)
         return {

@@ -1,8 +1,9 @@
 """Linked-list GPU solver: every stage on the device, float32 or float64 from one source.
 
 Device arrays are CuPy's; the kernels are numba-cuda, built from the same
-pair physics as the CPU solvers (solvers/physics/pairs.py). One thread per particle,
-every launch on the solver's own stream.
+pair physics as the CPU solvers (solvers/physics/pairs.py; in 3D pairs3d.py
+and the kernels of solvers/loops/gpu3d.py). One thread per particle, every
+launch on the solver's own stream.
 
 The per-particle arrays are the rows of one 2D block (and a spare block of
 the same shape), so that SNP moves all of them in one launch. SNP, every step
@@ -26,6 +27,7 @@ import numpy as np
 
 from solvers.gpu.cells import DeviceCellList
 from solvers.gpu.device import device_backend, simulated
+from solvers.interface import POSITIONS, VELOCITY
 from solvers.scene import SceneError
 from solvers.search.celllist import CellListSolver
 
@@ -42,7 +44,7 @@ class LinkedListGPU(CellListSolver):
     device = "gpu"
     serial_why = "one GPU thread per particle"
     resources = {"timing": 1, "GPU": 1}
-    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "body")
+    boundaries = ("free-x", "periodic-x", "wall-x", "free-y", "periodic-y", "periodic-z", "free-z", "body")
     neighbour_search = DeviceCellList
 
     @classmethod
@@ -105,13 +107,14 @@ class LinkedListGPU(CellListSolver):
         from solvers.gpu.cuda_kernels import kernels  # numba.cuda only once a device (or the simulator) is known
 
         blocks, threads = grid or (self.blocks, self.threads_per_block)
-        kernels(self.scene.precision, self.scene.kernel)[name][blocks, threads, self.launch_stream](*args)
+        s = self.scene
+        kernels(s.precision, s.kernel, s.dims)[name][blocks, threads, self.launch_stream](*args)
 
     def sort_cells(self) -> None:
         """Counting sort by cell in three launches (the search's two, then the scatter); the spare block
         becomes the current one."""
         a, now = self.arrays, self.current
-        self.nnps.bin(a["lx"], a["ly"], a["sx"], a["sy"])
+        self.nnps.bin(*(a[name] for name in self.nnps.positions))
         self.launch("scatter", *self.nnps.scatter_arguments(self.blocks_of[now], self.blocks_of[1 - now], now))
         self.set_state(1 - now)
         self.reordered += 1
@@ -139,16 +142,17 @@ class LinkedListGPU(CellListSolver):
 
     def advance_launch(self, f: float) -> None:
         """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""
-        a = self.arrays
+        a, dims = self.arrays, self.scene.dims
+        displacement = (a[name] for name in POSITIONS[dims][dims:])
+        velocity = (a[name] for name in VELOCITY[dims])
+        c = self.dtype.type(f * self.scene.dt)
         self.launch(
             "advance",
             a["drho"],
             a["dd"],
-            a["sx"],
-            a["sy"],
-            a["u"],
-            a["v"],
-            self.dtype.type(f * self.scene.dt),
+            *displacement,
+            *velocity,
+            c,
             self.moving,
             a["mass"],
             a["vol"],

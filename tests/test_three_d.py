@@ -61,7 +61,7 @@ def test_the_open_closed_form_and_the_periodic_fft_agree_while_the_images_are_fa
 
 
 def test_every_cpu_solver_gives_the_all_pair_solvers_3d_fields():
-    """The 27-cell stencil (serial and threaded) against every pair tested with the nearest image: the same sums,
+    """The trimmed stencil (serial and threaded) against every pair tested with the nearest image: the same sums,
     to round-off, with the pulse crossing the periodic faces; the neighbour count is the sphere's."""
     scene = small()
     fields = {}
@@ -75,6 +75,32 @@ def test_every_cpu_solver_gives_the_all_pair_solvers_3d_fields():
     for key, f in fields.items():
         for c in ("drho", "u", "v", "w", "x", "y", "z"):
             assert np.abs(getattr(f, c) - getattr(ref, c)).max() < 1e-10 * max(np.abs(getattr(ref, c)).max(), 1e-3), key
+
+
+@pytest.mark.parametrize("edges", ["periodic", "open"])
+def test_the_trimmed_stencil_finds_every_pair_of_scattered_particles(edges):
+    """Cells half a cutoff wide and each stencil row trimmed to the cutoff's sphere: with every particle moved
+    up to 0.45 dx off its site (into other cells, across the periodic seams and past the free faces), the cell
+    list counts every pair the all-pair search counts, and its rates are the all-pair rates."""
+    scene = small(dx=0.5, open="xyz") if edges == "open" else small()
+    solvers = [make_solver(name) for name in ("allpair-cpu", "linkedlist-cpu")]
+    counts, rates = [], []
+    for solver in solvers:
+        solver.input(scene)
+        solver.init()
+        a = solver.arrays
+        for axis, shift in zip(("lx", "ly", "lz"), ("sx", "sy", "sz")):  # the same scatter in any order
+            key = a["lx"] * 7.31 + a["ly"] * 3.17 + a["lz"] * 1.93 + len(axis + shift) * ord(axis[1])
+            a[shift][:] = 0.45 * scene.dx * np.sin(key * 12.9898)
+        a["drho"][:] = np.cos(a["lx"] + 2 * a["ly"] - a["lz"])  # something to sum
+        solver.nnps.valid = False
+        counts.append(solver.mean_neighbours() * scene.n_particles)
+        solver.snp()
+        solver.rates(True, True)
+        order = np.lexsort((a["lz"], a["ly"], a["lx"]))
+        rates.append(np.array([a[name][order] for name in ("dd", "ax", "ay", "az")]))
+    assert counts[0] > 40 * scene.n_particles and counts[1] == counts[0]
+    assert np.abs(rates[1] - rates[0]).max() < 1e-10 * np.abs(rates[0]).max()
 
 
 def test_the_3d_pulse_converges_to_its_exact_solution():
@@ -276,18 +302,21 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
             rec.mse = {0.125: 0.279, 0.1: 0.154}[s.dx]
             rec.errors = {"probe_A": rec.mse, "probe_B": rec.mse, "probe_C": rec.mse, "probe_rms": rec.mse}
             rec.measure, rec.headline = "probes_p", rec.mse
-        pi = 3.0 if s.dims == 3 else 1.0  # the cost runs: 3D three times the 2D per pair
+        pi = (3.0 if s.kernel == "wendland-c2" else 1.2) if s.dims == 3 else 1.0  # the cost runs: 3D per 2D pair
         rec.stages = {"input": 0.0, "init": 0.0, "snp": 0.0, "pi": pi * s.n_steps * s.n_particles * 80e-9,
                       "su": 0.0, "output": 0.0}  # fmt: skip
         store.append(rec, path)
     data = rows(load_frame(path.parent))
-    assert len(data["accuracy"]) == 6 and {r["dims"] for r in data["cost"]} == {2, 3}
+    assert len(data["accuracy"]) == 6 and sorted(r["dims"] for r in data["cost"]) == [2, 2, 3, 3]
     predicted = {r["dx"]: r["predicted"] for r in data["accuracy"] if r["label"].startswith("wendland")}
     assert predicted[0.25] is None and 0.2 < predicted[1.0] < 0.25 and 0.09 < predicted[0.5] < 0.1  # 0.223, 0.0933
     words = "\n".join(text(data, None))
     assert "0.000228 at dx 0.25 (262,144 particles), order 4.57 (the issue's target" in words
     assert "at most 0.001 and order 3.5: met)" in words and "| 1.00 / 1.00 |" in words  # Wendland's orders
-    assert "3D 3 (32,768 particles, 80 neighbours) against 2D 1 (32,761, 80): 3.00 times" in words, words
+    assert "wendland-c2** (the gather loop" in words and "laguerre-gauss** (the gather loop" in words
+    pairs = "(32,768 particles, 80 neighbours) against 2D 1 (32,761, 80)"
+    assert f"3D 3 {pairs}: 3.00 times (the issue asks at most 1.3: not met)" in words, words
+    assert f"3D 1.2 {pairs}: 1.20 times (the issue asks at most 1.3: met)" in words, words
     assert [r["dx"] for r in data["sphere"]] == [0.125, 0.1]
     assert "| 0.1 | 185,193 |" in words and "| 0.154 | 0.154 | 0.154 | 0.154 | 2.66 |" in words, words
 
@@ -320,3 +349,55 @@ def test_probes_in_3d_read_the_spherical_wave():
         Scene(0.5, "acoustic-pulse", probes=((3.0, 0.0, 1.0),))
     with pytest.raises(SceneError, match="--probe 30,0,0 is outside the domain"):
         Scene(0.5, "acoustic-pulse-3d", probes=((30.0, 0.0, 0.0),))
+
+
+SIM_3D = r"""
+import json, sys, numpy as np
+from solvers import Scene
+from solvers.physics.integrators import evolve
+from solvers.registry import make_solver
+out = []
+for case in json.loads(sys.argv[1]):
+    scene = Scene(**case)
+    fields = {}
+    for name in ("linkedlist-cpu", "linkedlist-gpu"):
+        solver = evolve(make_solver(name), scene)
+        f = solver.output()
+        fields[name] = {c: np.asarray(getattr(f, c), dtype=float) for c in ("drho", "u", "v", "w", "x", "y", "z")}
+        fields[name]["neighbours"] = solver.mean_neighbours()
+    cpu, gpu = fields["linkedlist-cpu"], fields["linkedlist-gpu"]
+    row = {c: float(np.abs(gpu[c] - cpu[c]).max() / max(np.abs(cpu[c]).max(), 1e-30)) for c in cpu if c != "neighbours"}
+    out.append({**row, "neighbours": [cpu["neighbours"], gpu["neighbours"]], "moving": float(np.abs(cpu["u"]).max())})
+print(json.dumps(out))
+"""
+
+
+@pytest.mark.tier2  # numba's CUDA simulator runs a thread per particle in Python: about 2 min
+def test_the_gpu_solver_gives_the_cpu_cell_lists_3d_fields_in_the_simulator():
+    """linkedlist-gpu's 3D kernels (solvers/loops/gpu3d.py, the trimmed stencil as device functions) in numba's
+    CUDA simulator against linkedlist-cpu: the periodic cube with moving particles in float64, the corrected
+    method in float32, the six open faces' sponge, and the rigid sphere's weak wall."""
+    import json
+
+    from .conftest import in_simulator
+
+    cube = {**SMALL, "dx": 1.0, "steps": 2}
+    sphere = dict(
+        name="sphere", dx=0.25, sphere_radius=1.0, pulse_width=0.5, pulse_center=1.5, x_min=-1.75, x_max=2.5,
+        y_min=-1.75, y_max=1.75, z_min=-1.75, z_max=1.75, kernel="wendland-c2", h_factor=1.3,
+        correction="gradient", layer_width=0.5, steps=1, model="linear",
+    )  # fmt: skip
+    cases = [
+        ({**cube, "model": "lagrangian"}, 1e-12),
+        ({**cube, "model": "linear", "precision": "float32", "correction": "gradient"}, 2e-5),
+        ({**cube, "model": "linear", "open": "xyz", "layer_width": 2.0}, 1e-12),
+        (sphere, 1e-12),
+    ]
+    for c, _ in cases:
+        c.pop("t_end", None)
+    rows = in_simulator(SIM_3D, json.dumps([c for c, _ in cases]))
+    for (case, tol), row in zip(cases, rows):
+        assert row["moving"] > 1e-6 and row["neighbours"][0] == row["neighbours"][1], (case, row)
+        for c in ("drho", "u", "v", "w", "x", "y", "z"):
+            assert row[c] <= tol, (case, c, row)
+

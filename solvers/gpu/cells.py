@@ -26,13 +26,13 @@ class DeviceCellList(CellList):
         self.counts = xp.zeros(self.ncells, xp.int32)  # cell_begin leaves them at zero again
         self.begin = xp.empty(self.ncells + 1, xp.uint32)  # unsigned: no negative-index wraparound per load
 
-    def bin(self, lx, ly, sx, sy) -> None:
-        """particleIndex, ranks and cellBegin in two launches; cellParticleOrder is written by the scatter
-        that follows (:meth:`scatter_arguments`)."""
+    def bin(self, *positions) -> None:
+        """particleIndex, ranks and cellBegin in two launches for the particles at ``positions`` (lx, ly, sx, sy;
+        in 3D lz and sz too); cellParticleOrder is written by the scatter that follows (:meth:`scatter_arguments`)."""
         from solvers.gpu.cuda_kernels import scan_block
 
         grid = self.grid.index_arguments(self.scene.dx)
-        self.launch("cell_count", lx, ly, sx, sy, self.cell, self.rank, self.counts, *grid)
+        self.launch("cell_count", *positions, self.cell, self.rank, self.counts, *grid)
         self.launch("cell_begin", self.counts, self.begin, grid=(1, scan_block()))
 
     def scatter_arguments(self, src, dst, current: int) -> tuple:
@@ -49,12 +49,12 @@ class DeviceCellList(CellList):
         into its cell order: ``arrays`` and this search untouched."""
         xp, n = self.xp, self.scene.n_particles
         fresh = type(self)(self.scene, self.launch, xp)
-        src = xp.stack([arrays["lx"], arrays["ly"], arrays["sx"], arrays["sy"]])  # a copy: the kernel may wrap it
+        src = xp.stack([arrays[name] for name in self.positions])  # a copy: the kernel may wrap it
         dst = xp.empty_like(src)
-        fresh.bin(src[0], src[1], src[2], src[3])
+        fresh.bin(*src)
         self.launch("scatter", *fresh.scatter_arguments(src, dst, 0))
         fresh.use(1)
         found = xp.zeros(n, xp.int32)
-        positions = dict(zip(("lx", "ly", "sx", "sy"), dst))
+        positions = dict(zip(self.positions, dst))
         self.launch("neighbours", *fresh.arguments(positions), found, k)
         return int(found.astype(xp.int64).sum())

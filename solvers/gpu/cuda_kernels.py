@@ -16,6 +16,7 @@ from solvers.kernels import DEFAULT_KERNEL
 from solvers.kernels.constants import exp_neg_math
 from solvers.physics.backend import pair_sources
 from solvers.physics.pairs import make_pairs
+from solvers.physics.pairs3d import make_pairs3d
 
 
 def _device_function(fastmath: bool):
@@ -46,6 +47,21 @@ KERNELS = (
 )
 
 
+# a 3D scene's own kernels (solvers/loops/gpu3d.py); the rest (the scan, the scatter, the coefficients) are the 2D's
+KERNELS_3D = (
+    "cell_count",
+    "continuity",
+    "momentum",
+    "moments",
+    "neighbours",
+    "kick",
+    "advance",
+    "corrected_velocity",
+    "corrected_continuity",
+    "corrected_momentum",
+)
+
+
 @lru_cache(maxsize=None)
 def device_pairs(precision: str, kernel: str = DEFAULT_KERNEL):
     """The pair functions as device functions (plain Python in the simulator) for ``precision`` and ``kernel``."""
@@ -53,13 +69,20 @@ def device_pairs(precision: str, kernel: str = DEFAULT_KERNEL):
 
 
 @lru_cache(maxsize=None)
-def kernels(precision: str, kernel: str = DEFAULT_KERNEL) -> dict:
+def device_pairs3d(precision: str, kernel: str = DEFAULT_KERNEL):
+    """The 3D pair functions (solvers/physics/pairs3d.py) as device functions, as :func:`device_pairs`."""
+    return make_pairs3d(_device_function(precision == "float32"), exp_neg_math, kernel, precision)
+
+
+@lru_cache(maxsize=None)
+def kernels(precision: str, kernel: str = DEFAULT_KERNEL, dims: int = 2) -> dict:
     """The device kernels for ``precision`` and ``kernel`` (solvers/loops/gpu.py): on a GPU compiled by
     numba-cuda on first launch and cached on disk once per machine and compute capability
     (solvers/jitcache.py); in the simulator run as Python, so nothing is cached.
 
     float32 kernels use fastmath (the hardware's approximate expf, ~2 ulp);
-    float64 kernels use the accurate libdevice exp.
+    float64 kernels use the accurate libdevice exp. ``dims`` 3: a 3D scene's kernels (solvers/loops/gpu3d.py)
+    over the 2D set.
     """
     device_backend()  # the device is usable (or simulated), numba-cuda patched for this NumPy
     from solvers import jitcache
@@ -72,7 +95,18 @@ def kernels(precision: str, kernel: str = DEFAULT_KERNEL) -> dict:
         depends=(*pair_sources(kernel), "solvers.gpu.cuda_kernels"),
         cache=not simulated(),
     )
-    return {name: getattr(loops, name) for name in KERNELS}
+    out = {name: getattr(loops, name) for name in KERNELS}
+    if dims == 3:
+        third = jitcache.specialise(
+            "solvers.loops.gpu3d",
+            bind={"P": f"device_pairs3d({precision!r}, {kernel!r})", "C": f"device_pairs({precision!r}, {kernel!r})"},
+            functions=dict.fromkeys(KERNELS_3D, ("cuda.jit", {"fastmath": precision == "float32"})),
+            imports=("from solvers.gpu.cuda_kernels import device_pairs, device_pairs3d",),
+            depends=(*pair_sources(kernel, 3), *pair_sources(kernel), "solvers.gpu.cuda_kernels"),
+            cache=not simulated(),
+        )
+        out.update({name: getattr(third, name) for name in KERNELS_3D})
+    return out
 
 
 def scan_block() -> int:

@@ -1,25 +1,26 @@
-"""The linked-list CPU solver's interaction loops in 3D over the 27-cell stencil, serial or on numba's thread pool,
-and its per-particle updates. A template of solvers.jitcache, specialised by solvers.linkedlist_cpu.sweeps."""
+"""The linked-list CPU solver's interaction loops in 3D over the trimmed stencil
+(solvers.physics.pairs3d.stencil_rule), serial or on numba's thread pool, and its per-particle updates. A template
+of solvers.jitcache, specialised by solvers.linkedlist_cpu.sweeps."""
 
 from numba import prange
 
 P = None  # the 3D pair functions for numba's CPU target (solvers.physics.backend.cpu_pairs3d), bound by jitcache
 
 
-def continuity(cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, out, k):
+def continuity(cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, out, k):
     for i in prange(lx.shape[0]):
-        out[i] = P.continuity_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k)
+        out[i] = P.continuity_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k)
 
 
-def momentum(cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, mass, pr, ax, ay, az, k):
+def momentum(cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, mass, pr, ax, ay, az, k):
     for i in prange(lx.shape[0]):
-        ax[i], ay[i], az[i] = P.momentum_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, mass, pr, k)
+        ax[i], ay[i], az[i] = P.momentum_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, mass, pr, k)
 
 
-def neighbours(cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, k):
+def neighbours(cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k):
     total = 0
     for i in prange(lx.shape[0]):
-        total += P.neighbours_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, k)
+        total += P.neighbours_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k)
     return total
 
 
@@ -34,9 +35,9 @@ def cell_ids(lx, ly, lz, sx, sy, sz, cell, dx, x_grid, width, height, depth, cw,
         )
 
 
-def moments(cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, vol, mxx, mxy, mxz, myy, myz, mzz, gx, gy, gz, k):
+def moments(cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, vol, mxx, mxy, mxz, myy, myz, mzz, gx, gy, gz, k):
     """The kernel gradient correction's moment matrix (6) and Gamma (3) of every particle (solvers/corrections/)."""
     for i in prange(lx.shape[0]):
         mxx[i], mxy[i], mxz[i], myy[i], myz[i], mzz[i], gx[i], gy[i], gz[i] = P.moments_cells(
-            i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, vol, k
+            i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, vol, k
         )

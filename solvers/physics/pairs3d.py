@@ -8,10 +8,11 @@ physics with a third component,
 
 built as small factories, each one sum over a range of particles j0..j1-1, over one rule for the separation
 (:func:`separation_rule`): r_ij = (l_i - l_j) dx + (s_i - s_j) per axis, the lattice part exact, as in 2D. The
-cell list's stencil is 27 cells: nine rows of three (y and z offsets -1, 0, 1), each one contiguous range of
-particles sorted by cell, shifted across the y and z seams by whole periods (``k[NY]``, ``k[NZ]``), and the
-periodic images across the x seam (``k[NX]``) as a second range per row, as in 2D. :func:`make_pairs3d` assembles
-them into a module object that numba resolves inside the sweeps (solvers/loops/cells3d.py, allpair3d.py).
+cell list's stencil is 25 rows of cells half a cutoff wide (y and z offsets -2..2), each trimmed to the cells the
+cutoff's sphere reaches (:func:`stencil_rule`) and one contiguous range of particles sorted by cell, shifted
+across the y and z seams by whole periods (``k[NY]``, ``k[NZ]``), with the periodic images across the x seam
+(``k[NX]``) as a second range per row, as in 2D. :func:`make_pairs3d` assembles them into a module object that
+numba resolves inside the sweeps (solvers/loops/cells3d.py, allpair3d.py).
 """
 
 import math
@@ -19,6 +20,8 @@ from types import ModuleType
 
 from solvers.kernels import kernel_named
 from solvers.kernels.constants import C0SQ, NONLIN, NX, NY, NZ, ONE, RC2, RHO0, SPACING, ZERO
+
+TRIM_SLACK = 1e-5  # of the cutoff: the stencil's trim never drops a pair the sums' rounding puts within the cutoff
 
 
 def separation_rule(jit):
@@ -36,11 +39,12 @@ def separation_rule(jit):
 
 
 def continuity_sum(jit, separation, gradient):
-    """sum_j vol_j (u_i - u_j) . r_ij G_ij over particles j0..j1-1 (i's coordinates already shifted)."""
+    """``acc`` + sum_j vol_j (u_i - u_j) . r_ij G_ij over particles j0..j1-1 (i's coordinates already shifted;
+    ``fields``: u, v, w, vol)."""
 
     @jit
-    def continuity_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, u, v, w, vol, k):
-        acc = k[ZERO]
+    def continuity_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
+        u, v, w, vol = fields
         for j in range(j0, j1):
             rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
@@ -52,13 +56,12 @@ def continuity_sum(jit, separation, gradient):
 
 
 def momentum_sum(jit, separation, gradient):
-    """sum_j m_j (pr_i + pr_j) G_ij r_ij over particles j0..j1-1, as (x, y, z)."""
+    """``acc`` + sum_j m_j (pr_i + pr_j) G_ij r_ij over particles j0..j1-1, as (x, y, z) (``fields``: mass, pr)."""
 
     @jit
-    def momentum_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, mass, pr, k):
-        ax = k[ZERO]
-        ay = k[ZERO]
-        az = k[ZERO]
+    def momentum_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
+        mass, pr = fields
+        ax, ay, az = acc
         for j in range(j0, j1):
             rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
@@ -73,36 +76,28 @@ def momentum_sum(jit, separation, gradient):
 
 
 def neighbour_count(jit, separation):
-    """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
+    """``acc`` + the particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
 
     @jit
-    def neighbours_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k):
-        count = 0
+    def neighbours_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
         for j in range(j0, j1):
             rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             if rx * rx + ry * ry + rz * rz < k[RC2]:
-                count += 1
-        return count
+                acc += 1
+        return acc
 
     return neighbours_range
 
 
 def moment_sums(jit, separation, gradient):
-    """The kernel gradient correction's sums over particles j0..j1-1: the moment matrix
+    """The kernel gradient correction's sums over particles j0..j1-1 added to ``acc``: the moment matrix
     M = -sum_j vol_j G_ij r_ij (x) r_ij as (M_xx, M_xy, M_xz, M_yy, M_yz, M_zz) and Gamma = sum_j vol_j G_ij r_ij
-    as (x, y, z)."""
+    as (x, y, z) (``fields``: vol)."""
 
     @jit
-    def moments_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, vol, k):
-        mxx = k[ZERO]
-        mxy = k[ZERO]
-        mxz = k[ZERO]
-        myy = k[ZERO]
-        myz = k[ZERO]
-        mzz = k[ZERO]
-        gx = k[ZERO]
-        gy = k[ZERO]
-        gz = k[ZERO]
+    def moments_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
+        (vol,) = fields
+        mxx, mxy, mxz, myy, myz, mzz, gx, gy, gz = acc
         for j in range(j0, j1):
             rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
@@ -156,9 +151,17 @@ def corrected_passes(jit):
 
 
 def stencil_rule(jit, across: bool):
-    """The 27-cell stencil: :func:`stencil_row` gives row (dy, dz) of particle i's stencil as its range of
-    particles, i's coordinates shifted across the y and z seams, and the range across the x seam (empty unless
-    i's cell is at it, or ``across`` False: x has no seam, a compile-time constant)."""
+    """The 3D stencil as a loop: ``over_stencil(range_sum)`` gives the function that adds ``range_sum`` over every
+    particle within the cutoff of particle i (and some beyond, which the sums' own test drops). The grid
+    (solvers.interface.cell_grid_3d) has cells a cutoff over its reach wide along each axis (the ``box``: the
+    lattice spacing, ``x_grid``, the cells' sizes and the reaches, cells a cutoff spans along x, y, z); the rows
+    along x at every y and z offset within the reach are each trimmed to the cells the cutoff's sphere reaches:
+    the row's gap from i in y and z leaves a chord in x, and a row the sphere misses is skipped. A row is one
+    contiguous range of particles sorted by cell, i's coordinates shifted across the y and z seams by whole
+    periods, with the chord's part beyond the x seam as a second range (``across`` False: x has no seam, a
+    compile-time constant). i's cell and place in it are found once per particle, the gap once per slab. The
+    trim is widened by ``TRIM_SLACK`` of the cutoff, so that a particle a rounding within it is never trimmed
+    away."""
 
     @jit
     def shifted(c, n, li, period):
@@ -171,35 +174,69 @@ def stencil_rule(jit, across: bool):
         return c, li
 
     @jit
-    def stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k):
-        """(j0, j1, lyi, lzi, q0, q1, lxq): the row's own range, i's shifted y and z, and the range beyond the x
-        seam with i's column shifted for it."""
-        c = cell[i]
-        cx = c % ncx
-        cy, lyi = shifted(c // ncx % ncy + dy, ncy, ly[i], k[NY])
-        cz, lzi = shifted(c // (ncx * ncy) + dz, ncz, lz[i], k[NZ])
-        if cy < 0 or cz < 0:
-            return 0, 0, lyi, lzi, 0, 0, lx[i]
-        row = (cz * ncy + cy) * ncx
-        x0 = cx - 1 if cx > 0 else 0
-        x1 = cx + 1 if cx < ncx - 1 else ncx - 1
-        q0 = begin[row]
-        q1 = q0
-        lxq = lx[i]
-        if across and k[NX] > 0:
-            if cx == 0:
-                q0, q1 = begin[row + ncx - 1], begin[row + ncx]
-                lxq = lx[i] + k[NX]
-            elif cx == ncx - 1:
-                q0, q1 = begin[row], begin[row + 1]
-                lxq = lx[i] - k[NX]
-        return begin[row + x0], begin[row + x1 + 1], lyi, lzi, q0, q1, lxq
+    def gap(p, d, size):
+        """The distance, m, from a point ``p`` m above its cell's lower face to the slab of cells ``d`` away."""
+        if d > 0:
+            return max(d * size - p, 0.0)
+        if d < 0:
+            return max(p - (d + 1) * size, 0.0)
+        return 0.0
 
-    return stencil_row
+    def over_stencil(range_sum):
+        @jit
+        def stencil_sum(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, acc, fields):
+            c = cell[i]
+            cx = c % ncx
+            cy0 = c // ncx % ncy
+            cz0 = c // (ncx * ncy)
+            spacing = box[0]
+            px = (float(lx[i]) + 0.5) * spacing + float(sx[i]) - box[1] - cx * box[2]  # m above its cell's faces
+            py = (float(ly[i]) + 0.5) * spacing + float(sy[i]) - cy0 * box[3]
+            pz = (float(lz[i]) + 0.5) * spacing + float(sz[i]) - cz0 * box[4]
+            reach = math.sqrt(float(k[RC2])) * (1.0 + TRIM_SLACK)
+            rx, ry, rz = int(box[5]), int(box[6]), int(box[7])
+            for dz in range(-rz, rz + 1):
+                gz = gap(pz, dz, box[4])
+                left = reach * reach - gz * gz
+                if left < 0.0:
+                    continue
+                cz, lzi = shifted(cz0 + dz, ncz, lz[i], k[NZ])
+                if cz < 0:
+                    continue
+                for dy in range(-ry, ry + 1):
+                    gy = gap(py, dy, box[3])
+                    chord2 = left - gy * gy
+                    if chord2 < 0.0:
+                        continue
+                    cy, lyi = shifted(cy0 + dy, ncy, ly[i], k[NY])
+                    if cy < 0:
+                        continue
+                    chord = math.sqrt(chord2)
+                    x0 = max(cx + int(math.floor((px - chord) / box[2])), cx - rx)
+                    x1 = min(cx + int(math.floor((px + chord) / box[2])), cx + rx)
+                    row = (cz * ncy + cy) * ncx
+                    if across and k[NX] > 0:
+                        if x0 < 0:  # the chord's left end lies beyond the seam: the row's last cells, i a period right
+                            a0, a1 = begin[row + ncx + x0], begin[row + ncx]
+                            acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                        elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
+                            a0, a1 = begin[row], begin[row + x1 - ncx + 1]
+                            acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                    x0 = max(x0, 0)
+                    x1 = min(x1, ncx - 1)
+                    if x1 >= x0:
+                        a0, a1 = begin[row + x0], begin[row + x1 + 1]
+                        acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+            return acc
+
+        return stencil_sum
+
+    return over_stencil
 
 
 def minimum_image_rule(jit):
-    """The all-pair search's shift of i's coordinate to the nearest image of j along a periodic axis (exact)."""
+    """The all-pair search as a loop: ``over_all(range_sum)`` adds ``range_sum`` over every particle j, i shifted
+    to the nearest image of j along each periodic axis (exact)."""
 
     @jit
     def nearest(li, lj, period):
@@ -211,13 +248,23 @@ def minimum_image_rule(jit):
                 return li + period
         return li
 
-    return nearest
+    def over_all(range_sum):
+        @jit
+        def all_sum(i, n, lx, ly, lz, sx, sy, sz, k, acc, fields):
+            for j in range(n):
+                lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
+                acc = range_sum(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+            return acc
+
+        return all_sum
+
+    return over_all
 
 
 def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True) -> ModuleType:
-    """The 3D pair functions compiled with ``jit`` for ``kernel`` (normalised in 3D) in ``precision``: the sums
-    over a range, over the 27-cell stencil (``*_cells``) and over every particle (``*_allpair``), and the cell
-    index of a position. ``across``: whether x has a periodic seam (compile-time)."""
+    """The 3D pair functions compiled with ``jit`` for ``kernel`` (normalised in 3D) in ``precision``: each sum
+    over a range, over the stencil (``*_cells``) and over every particle (``*_allpair``), and the cell index of a
+    position. ``across``: whether x has a periodic seam (compile-time)."""
     gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg), dims=3))
     separation = separation_rule(jit)
     continuity_range = continuity_sum(jit, separation, gradient)
@@ -225,115 +272,62 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
     neighbours_range = neighbour_count(jit, separation)
     moments_range = moment_sums(jit, separation, gradient)
     corrected_velocity_at, corrected_continuity_at, corrected_momentum_at = corrected_passes(jit)
-    stencil_row = stencil_rule(jit, across)
-    nearest = minimum_image_rule(jit)
+    over_stencil = stencil_rule(jit, across)
+    over_all = minimum_image_rule(jit)
+    continuity_stencil, continuity_all = over_stencil(continuity_range), over_all(continuity_range)
+    momentum_stencil, momentum_all = over_stencil(momentum_range), over_all(momentum_range)
+    neighbours_stencil, neighbours_all = over_stencil(neighbours_range), over_all(neighbours_range)
+    moments_stencil, moments_all = over_stencil(moments_range), over_all(moments_range)
 
     @jit
-    def moments_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, vol, k):
-        """Particle i's moment matrix (6) and Gamma (3) from the 27 cells around it (solvers/corrections/)."""
-        m0 = m1 = m2 = m3 = m4 = m5 = g0 = g1 = g2 = k[ZERO]
-        for dz in range(-1, 2):
-            for dy in range(-1, 2):
-                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):  # the row, then beyond the x seam
-                    a, b, c, d, e, f, p, q, r = moments_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, vol, k)
-                    m0 += a
-                    m1 += b
-                    m2 += c
-                    m3 += d
-                    m4 += e
-                    m5 += f
-                    g0 += p
-                    g1 += q
-                    g2 += r
-        return m0, m1, m2, m3, m4, m5, g0, g1, g2
+    def moments_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, vol, k):
+        """Particle i's moment matrix (6) and Gamma (3) from the stencil around it (solvers/corrections/)."""
+        z = k[ZERO]
+        acc = (z, z, z, z, z, z, z, z, z)
+        return moments_stencil(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, acc, (vol,))
 
     @jit
     def moments_allpair(i, n, lx, ly, lz, sx, sy, sz, vol, k):
         """Particle i's moment matrix and Gamma summed over all n particles (the nearest image)."""
-        m0 = m1 = m2 = m3 = m4 = m5 = g0 = g1 = g2 = k[ZERO]
-        for j in range(n):
-            lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            a, b, c, d, e, f, p, q, r = moments_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, vol, k)
-            m0 += a
-            m1 += b
-            m2 += c
-            m3 += d
-            m4 += e
-            m5 += f
-            g0 += p
-            g1 += q
-            g2 += r
-        return m0, m1, m2, m3, m4, m5, g0, g1, g2
+        z = k[ZERO]
+        return moments_all(i, n, lx, ly, lz, sx, sy, sz, k, (z, z, z, z, z, z, z, z, z), (vol,))
 
     @jit
-    def continuity_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k):
-        """d(drho_i)/dt from the 27 cells around particle i, kg/m^3/s."""
-        acc = k[ZERO]
-        for dz in range(-1, 2):
-            for dy in range(-1, 2):
-                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):  # the row, then beyond the x seam
-                    acc += continuity_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, u, v, w, vol, k)
+    def continuity_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k):
+        """d(drho_i)/dt from the stencil around particle i, kg/m^3/s."""
+        fields = (u, v, w, vol)
+        acc = continuity_stencil(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, k[ZERO], fields)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
     @jit
-    def momentum_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, mass, pr, k):
-        """du_i/dt from the 27 cells around particle i, m/s^2, as (x, y, z)."""
-        ax = k[ZERO]
-        ay = k[ZERO]
-        az = k[ZERO]
-        for dz in range(-1, 2):
-            for dy in range(-1, 2):
-                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):
-                    bx, by, bz = momentum_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, mass, pr, k)
-                    ax += bx
-                    ay += by
-                    az += bz
+    def momentum_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, mass, pr, k):
+        """du_i/dt from the stencil around particle i, m/s^2, as (x, y, z)."""
+        z = k[ZERO]
+        acc = (z, z, z)
+        ax, ay, az = momentum_stencil(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, acc, (mass, pr))
         return -ax, -ay, -az
 
     @jit
-    def neighbours_cells(i, cell, begin, ncx, ncy, ncz, lx, ly, lz, sx, sy, sz, k):
+    def neighbours_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k):
         """Neighbours of particle i within the cutoff, itself excluded."""
-        count = 0
-        for dz in range(-1, 2):
-            for dy in range(-1, 2):
-                j0, j1, lyi, lzi, q0, q1, lxq = stencil_row(i, dy, dz, cell, begin, ncx, ncy, ncz, lx, ly, lz, k)
-                for a0, a1, lxi in ((j0, j1, lx[i]), (q0, q1, lxq)):
-                    count += neighbours_range(a0, a1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k)
-        return count - 1
+        return neighbours_stencil(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, 0, ()) - 1
 
     @jit
     def continuity_allpair(i, n, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k):
         """d(drho_i)/dt summed over all n particles (the nearest image along periodic axes)."""
-        acc = k[ZERO]
-        for j in range(n):
-            lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            acc += continuity_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, u, v, w, vol, k)
+        acc = continuity_all(i, n, lx, ly, lz, sx, sy, sz, k, k[ZERO], (u, v, w, vol))
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
 
     @jit
     def momentum_allpair(i, n, lx, ly, lz, sx, sy, sz, mass, pr, k):
         """du_i/dt summed over all n particles, as (x, y, z)."""
-        ax = k[ZERO]
-        ay = k[ZERO]
-        az = k[ZERO]
-        for j in range(n):
-            lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            bx, by, bz = momentum_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, mass, pr, k)
-            ax += bx
-            ay += by
-            az += bz
+        z = k[ZERO]
+        ax, ay, az = momentum_all(i, n, lx, ly, lz, sx, sy, sz, k, (z, z, z), (mass, pr))
         return -ax, -ay, -az
 
     @jit
     def neighbours_allpair(i, n, lx, ly, lz, sx, sy, sz, k):
-        count = 0
-        for j in range(n):
-            lxi, lyi, lzi = nearest(lx[i], lx[j], k[NX]), nearest(ly[i], ly[j], k[NY]), nearest(lz[i], lz[j], k[NZ])
-            count += neighbours_range(j, j + 1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k)
-        return count - 1
+        return neighbours_all(i, n, lx, ly, lz, sx, sy, sz, k, 0, ()) - 1
 
     @jit
     def cell_index(lx, ly, lz, sx, sy, sz, dx, x_grid, width, height, depth, cw, ch, cd, ncx, ncy, ncz):
@@ -394,7 +388,6 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
         corrected_velocity_at=corrected_velocity_at,
         corrected_continuity_at=corrected_continuity_at,
         corrected_momentum_at=corrected_momentum_at,
-        stencil_row=stencil_row,
         continuity_cells=continuity_cells,
         momentum_cells=momentum_cells,
         neighbours_cells=neighbours_cells,

@@ -1,7 +1,9 @@
 """The paper's uniform cell list as an object a solver holds (PySPH's NNPS), and the solvers built on it.
 
 Cells are one cutoff wide in x and at least one cutoff tall in y (a whole
-number of rows fills the lattice's height; :class:`CellGrid`). SNP finds each
+number of rows fills the lattice's height; :class:`CellGrid`); in 3D an eighth
+of a cutoff wide in x and a cutoff or half a cutoff in y and z, each stencil
+row trimmed to the cutoff's sphere (:class:`CellGrid3D`). SNP finds each
 particle's cell (particleIndex), orders particles by cell
 (cellParticleOrder) and marks where each cell starts (cellBegin, with the
 end sentinel): that is the search's job (:class:`CellList`). The solver then
@@ -55,9 +57,8 @@ class CellGrid:
         the grid."""
         return dx, self.x_grid, self.width, self.height, self.cw, self.ch, self.ncx, self.ncy
 
-    @property
-    def shape(self) -> tuple:
-        """The cell counts along each axis (what the stencil loops take after cellBegin)."""
+    def stencil_arguments(self, dx: float) -> tuple:
+        """What the stencil loops take after cellBegin: the cell counts along each axis."""
         return self.ncx, self.ncy
 
 
@@ -65,7 +66,7 @@ class CellGrid:
 class CellGrid3D:
     """The uniform grid of a 3D scene (solvers.interface.cell_grid_3d): cells ``cw`` x ``ch`` x ``cd`` m,
     ``ncx`` x ``ncy`` x ``ncz`` of them, numbered (cz ncy + cy) ncx + cx; ``x_grid`` and the periods as in 2D
-    (``depth``: z's, 0 where z is not periodic)."""
+    (``depth``: z's, 0 where z is not periodic); the cells a cutoff spans along each axis (``reach_*``)."""
 
     cw: float
     ch: float
@@ -77,6 +78,9 @@ class CellGrid3D:
     width: float
     height: float
     depth: float
+    reach_x: int
+    reach_y: int
+    reach_z: int
 
     @classmethod
     def of(cls, scene) -> CellGrid3D:
@@ -91,9 +95,13 @@ class CellGrid3D:
         g = self
         return dx, g.x_grid, g.width, g.height, g.depth, g.cw, g.ch, g.cd, g.ncx, g.ncy, g.ncz
 
-    @property
-    def shape(self) -> tuple:
-        return self.ncx, self.ncy, self.ncz
+    def stencil_arguments(self, dx: float) -> tuple:
+        """What the stencil loops take after cellBegin: the cell counts along each axis and the box (float64:
+        the lattice spacing, ``x_grid``, ``cw``, ``ch``, ``cd``, m, and the reaches) by which a row is trimmed to
+        the cutoff's sphere (solvers.physics.pairs3d.stencil_rule)."""
+        g = self
+        box = np.array([dx, g.x_grid, g.cw, g.ch, g.cd, g.reach_x, g.reach_y, g.reach_z], np.float64)
+        return self.ncx, self.ncy, self.ncz, box
 
 
 class CellList:
@@ -110,6 +118,9 @@ class CellList:
         self.grid = CellGrid3D.of(scene) if scene.dims == 3 else CellGrid.of(scene)
         self.positions = POSITIONS[scene.dims]  # the arrays it bins: lattice coordinates, then displacements
         self.ncells = self.grid.ncells
+        self.stencil = tuple(
+            xp.asarray(a) if isinstance(a, np.ndarray) else a for a in self.grid.stencil_arguments(scene.dx)
+        )
         self.valid = False  # whether the cells are those of the current positions
         self.allocate()
 
@@ -154,8 +165,9 @@ class CellList:
         self.cell, self.sorted_cell = self.sorted_cell, self.cell
 
     def arguments(self, arrays) -> tuple:
-        """What every stencil loop takes first: the cells, cellBegin, the grid's shape and the positions."""
-        return (self.cell, self.begin, *self.grid.shape, *(arrays[name] for name in self.positions))
+        """What every stencil loop takes first: the cells, cellBegin, the grid (:meth:`CellGrid.stencil_arguments`)
+        and the positions."""
+        return (self.cell, self.begin, *self.stencil, *(arrays[name] for name in self.positions))
 
     def count(self, arrays, k) -> int:
         """Neighbours within the cutoff summed over particles at the positions in ``arrays``, on a search of

@@ -32,6 +32,7 @@ def rows(df) -> dict | None:
             "dims": scene.dims,
             "dx": float(scene.dx),
             "label": Method.of(scene).numerics,
+            "kernel": scene.kernel,
             "cfl": float(scene.cfl),
             "N": int(r.n_particles),
             "neighbours": float(r.mean_neighbours) if ok else None,
@@ -121,18 +122,28 @@ def text(data, ctx) -> list[str]:
                     f"({fine['N']:,} particles), order {fmt(o, '.2f')} (the issue's target, at most {error:g} and "
                     f"order {least:g}: {'met' if met else 'not met'})."
                 )
-    cost = {r["dims"]: r for r in data["cost"]}
-    if 2 in cost and 3 in cost and pair_ns(cost[2]) and pair_ns(cost[3]):
-        two, three = pair_ns(cost[2]), pair_ns(cost[3])
-        lines.append(
-            f"- **A pair's cost** (Wendland C2, the gather loop, serial, {COST_STEPS} steps, ns per "
-            f"particle-neighbour-step): 3D {three:.3g} ({cost[3]['N']:,} particles, {cost[3]['neighbours']:.0f} "
-            f"neighbours) against 2D {two:.3g} ({cost[2]['N']:,}, {cost[2]['neighbours']:.0f}): {three / two:.2f} "
-            "times (the issue asks at most 1.3; the 27-cell stencil tests about twice the 2D stencil's candidates "
-            "per neighbour)."
-        )
+    lines += cost_text(data["cost"])
     lines += sphere_text(data.get("sphere") or [])
     return lines + [""]
+
+
+def cost_text(runs) -> list[str]:
+    """A pair's cost in 3D against 2D, per kernel (ns per particle-neighbour-step)."""
+    by_kernel: dict = {}
+    for r in runs:
+        by_kernel.setdefault(r["kernel"], {})[r["dims"]] = r
+    lines = []
+    for kernel, cost in by_kernel.items():
+        if not (2 in cost and 3 in cost and pair_ns(cost[2]) and pair_ns(cost[3])):
+            continue
+        two, three = pair_ns(cost[2]), pair_ns(cost[3])
+        lines.append(
+            f"- **A pair's cost, {kernel}** (the gather loop, serial, {COST_STEPS} steps, ns per "
+            f"particle-neighbour-step): 3D {three:.3g} ({cost[3]['N']:,} particles, {cost[3]['neighbours']:.0f} "
+            f"neighbours) against 2D {two:.3g} ({cost[2]['N']:,}, {cost[2]['neighbours']:.0f}): {three / two:.2f} "
+            f"times (the issue asks at most 1.3: {'met' if three / two <= 1.3 else 'not met'})."
+        )
+    return lines
 
 
 def sphere_text(runs) -> list[str]:

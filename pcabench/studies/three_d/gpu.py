@@ -1,0 +1,120 @@
+"""The 3D study on a GPU: linkedlist-gpu against linkedlist-cpu on the 3D scenes (the periodic cube with standard
+SPH, its six open faces, the high-order method, the rigid sphere's weak wall), each model and precision; then the
+3D pulse's time per step on the card from 1 to 27 million particles, standard SPH and the high-order method."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from pcabench.conformance import SCENES
+from pcabench.execute.run import run
+from pcabench.gpu.agreement import agrees, compare_cases
+from pcabench.gpu.plan import GPU_SOLVER
+from pcabench.gpu.stage import Check, Stage
+from pcabench.gpu.tables import scene_agreement
+from pcabench.reports.md import md_table
+from pcabench.spec import RunSpec
+from pcabench.store.record import STEP_STAGES
+from solvers import PRECISIONS, Scene
+
+TITLE = "Sound in three dimensions (the trimmed stencil's kernels)"
+
+STANDARD = {"kernel": "wendland-c2", "h_factor": 1.3, "cfl": 0.5}  # 80 neighbours
+HIGH_ORDER = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0, "correction": "gradient", "cfl": 0.5}
+CORRECTED = {"kernel": "wendland-c2", "h_factor": 1.3, "correction": "gradient", "cfl": 0.5}  # the weak wall's
+PULSE = {"name": "acoustic-pulse-3d"}  # the 16 m periodic cube
+
+
+@dataclass(frozen=True)
+class Cases:
+    """The 3D scenes against the CPU, each (Scene fields, models, precisions), ``steps`` steps; the scale runs: the
+    3D pulse at each of ``scale_dx`` (the 16 m cube: 1, 8 and 27 million particles) with each of
+    ``scale_methods``, float32, lagrangian, ``scale_steps`` steps, while ``scale_floor_s`` seconds of the check are
+    left."""
+
+    scenes: tuple = (
+        ({**PULSE, "dx": 0.5, **STANDARD}, ("lagrangian", "linear"), PRECISIONS),  # 32,768 particles
+        ({**PULSE, "dx": 0.5, "open": "xyz", "layer_width": 2.0, **STANDARD}, ("lagrangian",), ("float64",)),
+        ({**PULSE, "dx": 0.5, **HIGH_ORDER}, ("linear",), PRECISIONS),  # 32,768 particles, 894 neighbours
+        ({"name": "sphere", "dx": 0.125, **CORRECTED}, ("linear",), ("float64",)),  # 97,336 with the layer
+    )
+    steps: int = 5
+    scale_dx: tuple = (0.16, 0.08, 16.0 / 300)
+    scale_methods: tuple = (("standard", STANDARD), ("high-order", HIGH_ORDER))
+    scale_steps: int = 10
+    scale_floor_s: float = 60.0
+    scale_domain: dict | None = None  # the cube and its pulse (None: the scene's 16 m)
+
+
+def cases(rehearse: bool) -> Cases:
+    """A card's cases, or the rehearsal's: the smallest cube (729 particles) against the CPU, one scale run."""
+    if not rehearse:
+        return Cases()
+    tiny = SCENES["acoustic-pulse-3d"]  # check-solver's: 729 particles, every seam acting from the first step
+    domain = {key: value for key, value in tiny.items() if key not in ("name", "dx", "h_factor")}
+    return Cases(
+        (({**tiny, **STANDARD}, ("lagrangian",), ("float64",)),), 2, (1.0,), (("standard", STANDARD),), 2, 0.0, domain
+    )
+
+
+def against_cpu(mine: Cases, out: Path) -> list[dict]:
+    """Each 3D scene ``mine.steps`` steps on the GPU and the CPU, with its models and precisions: their rows."""
+    rows = []
+    for scene, models, precisions in mine.scenes:
+        rows += compare_cases((scene,), mine.steps, out, model=models, precision=precisions)
+    return rows
+
+
+def scale(mine: Cases, c: Check) -> list[dict]:
+    """The 3D pulse's time per step (SNP + PI + SU) on the GPU, float32, lagrangian, at each dx and method while the
+    check has time: N, neighbours, ms a step, ns a particle-step and ns a particle-neighbour-step."""
+    rows = []
+    for dx in mine.scale_dx:
+        for label, method in mine.scale_methods:
+            if c.budget.left() < mine.scale_floor_s:
+                c.budget.say(f"three-d scale: {label} at dx {dx:.4g} left out (the check's time is short)")
+                continue
+            scene = Scene(**{**PULSE, **(mine.scale_domain or {}), "dx": dx, **method}, steps=mine.scale_steps,
+                          precision="float32", model="lagrangian")  # fmt: skip
+            rec = run(RunSpec(GPU_SOLVER, scene))
+            if rec.status != "ok":
+                rows.append(
+                    {"method": label, "dx": dx, "N": scene.n_particles, "status": f"{rec.status} {rec.message}"}
+                )
+                continue
+            t = sum(rec.stages[s] for s in STEP_STAGES) / rec.steps
+            n, nb = scene.n_particles, rec.mean_neighbours
+            rows.append({"method": label, "dx": dx, "N": n, "neighbours": nb, "status": "ok", "step_ms": 1e3 * t,
+                         "ns_particle_step": 1e9 * t / n, "ns_pair": 1e9 * t / (n * nb)})  # fmt: skip
+            c.budget.say(f"three-d scale: {label} N = {n:,}: {1e3 * t:.4g} ms a step")
+    return rows
+
+
+def check(c: Check) -> bool:
+    mine = cases(c.rehearse)
+    c.state["three_d"] = against_cpu(mine, c.out)
+    c.state["three_d_scale"] = scale(mine, c)
+    return agrees(c.state["three_d"]) and all(r["status"] == "ok" for r in c.state["three_d_scale"])
+
+
+def report(results: dict) -> list[str]:
+    lines = scene_agreement(TITLE, results["three_d"]) if results.get("three_d") else []
+    rows = results.get("three_d_scale") or []
+    if rows:
+        table = [
+            [r["method"], f"{r['dx']:.4g}", f"{r['N']:,}", f"{r.get('neighbours', 0):.0f}",
+             *(f"{r[k]:.4g}" if r["status"] == "ok" else r["status"] for k in ("step_ms", "ns_particle_step",
+                                                                               "ns_pair"))]
+            for r in rows
+        ]  # fmt: skip
+        lines += [
+            "",
+            "## The 3D pulse on the GPU (linkedlist-gpu, float32, lagrangian; SNP + PI + SU a step)",
+            "",
+            md_table(["method", "dx", "N", "neighbours", "ms / step", "ns / particle-step", "ns / pair"], table),
+        ]
+    return lines
+
+
+STAGE = Stage("three-d", 90, check, order=35, report=report)
