@@ -1,0 +1,55 @@
+"""A pair's cost in 3D against 2D (issue 65's target: at most 1.3): a same-run ratio.
+
+The 3D pulse at dx 0.5 (the 16 m cube: 32,768 particles) and the 2D pulse on a square of the same particle count
+(dx 0.125 on 22.625 m: 32,761), linkedlist-cpu, the gather loop, serial, linear, one kernel in both: ``kernel``
+Wendland C2 at about 80 neighbours in both (h = 1.3 dx in 3D, 2.5 dx in 2D), ``laguerre-gauss`` the fourth-order
+kernel at h = 1.5 dx cut at 4 h (894 neighbours in 3D, 108 in 2D). Each step's PI timed in turn, best of
+``REPEATS``; returns (3D PI / (N neighbours)) / (2D PI / (N neighbours)): ns per particle-neighbour-step, 3D over
+2D (> 1: a 3D pair dearer)."""
+
+from __future__ import annotations
+
+import time
+
+from .common import Prepared, Unsupported
+
+REPEATS = 8
+HALF = 11.3125  # m: half the 2D square's side (181 x 181 particles at dx 0.125)
+SCENES = {  # kernel: (3D scene, 2D scene) overrides
+    "wendland-c2": (
+        {"name": "acoustic-pulse-3d", "kernel": "wendland-c2", "h_factor": 1.3},
+        {"name": "acoustic-pulse", "kernel": "wendland-c2", "h_factor": 2.5},
+    ),
+    "laguerre-gauss": (
+        {"name": "acoustic-pulse-3d", "kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0},
+        {"name": "acoustic-pulse", "kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0},
+    ),
+}
+SQUARE = {"x_min": -HALF, "x_max": HALF, "y_min": -HALF, "y_max": HALF}
+
+
+class TrackPairCost3D:
+    params = [list(SCENES)]
+    param_names = ["kernel"]
+    unit = "3D pair / 2D pair (same run)"
+    timeout = 900
+
+    def setup(self, kernel):
+        three, two = SCENES[kernel]
+        try:
+            self.prepared = {
+                3: Prepared("linkedlist-cpu", "float64", 0.5, pair_loop="gather", model="linear", **three),
+                2: Prepared("linkedlist-cpu", "float64", 0.125, pair_loop="gather", model="linear", **two, **SQUARE),
+            }
+        except (Unsupported, TypeError, ValueError) as exc:  # a commit before the 3D scenes
+            raise NotImplementedError(str(exc)) from None
+        self.pairs = {d: p.n_particles * p.solver.mean_neighbours() for d, p in self.prepared.items()}
+
+    def track_pair_cost(self, kernel):
+        best = {d: float("inf") for d in self.prepared}
+        for _ in range(REPEATS):
+            for d, p in self.prepared.items():
+                t0 = time.perf_counter()
+                p.stage("pi")
+                best[d] = min(best[d], time.perf_counter() - t0)
+        return (best[3] / self.pairs[3]) / (best[2] / self.pairs[2])
