@@ -4,6 +4,7 @@ orders; and a pair's cost in 3D against 2D."""
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -15,6 +16,7 @@ from pcabench.spec import scene_from_row
 from pcabench.store.rows import latest
 from pcabench.studies.three_d.plan import COST_STEPS, T_END, THREE_D
 from solvers.method import Method
+from solvers.reference.sphere import drho as sphere_drho
 
 TARGET = (1e-3, 0.25, 3.5)  # the issue's: the high-order method at most 1e-3 at dx 0.25, order at least 3.5
 PREDICTED_UP_TO = 300_000  # particles: the prediction's FFT of the symbol is computed up to this lattice
@@ -46,7 +48,11 @@ def rows(df) -> dict | None:
             cost.append(row)
         elif scene.body is not None:  # the sphere: its probes against the exact series (no prediction)
             probes = {k: r.get(f"err_probe_{k}") for k in ("A", "B", "C")}
-            sphere.append({**row, **{k: float(v) if ok and v == v else None for k, v in probes.items()}})
+            series = json.loads(r.probes) if ok and isinstance(r.get("probes"), str) else {}
+            sphere.append(
+                {**row, **{k: float(v) if ok and v == v else None for k, v in probes.items()}, "series": series,
+                 "scene_value": scene}
+            )  # fmt: skip
         elif scene.dims == 3:
             predicted = scene.kind.predict(scene).predicted_error if scene.n_particles <= PREDICTED_UP_TO else None
             accuracy.append({**row, "predicted": predicted})
@@ -213,11 +219,47 @@ def error_figure(data, ctx):
     return path
 
 
+def sphere_figure(data, ctx):
+    """p(t) at the sphere's probes A, B, C over the scored window: the exact series (black) beside the finest run
+    (the high-order method, linear)."""
+    runs = [r for r in (data or {}).get("sphere", []) if r["error"] is not None and r["series"].get("t")]
+    if not runs:
+        return None
+    best = min(runs, key=lambda r: r["dx"])
+    scene, series = best["scene_value"], best["series"]
+    t = np.asarray(series["t"], dtype=np.float64)
+    start, end = scene.kind.window
+    window = (t >= start - 1e-9) & (t <= end + 1e-9)
+    points = scene.probe_points()
+    exact = sphere_drho(
+        np.array([points[k] for k in "ABC"]), t[window], scene.sphere_radius, scene.pulse_center, scene.pulse_width,
+        scene.rho0 * scene.mach, scene.c0,
+    )  # fmt: skip
+    c2 = scene.c0**2
+    path = ctx.out / "three_d_sphere_probes.png"
+    with F.figure(
+        path,
+        f"The pulse scattered by a rigid sphere: p(t) at A, B, C, {best['label']}, CFL {best['cfl']:g}, dx = "
+        f"{best['dx']:g} m ({best['N']:,} particles), linear ({ctx.name}); black: the exact series",
+        "t (s)",
+        "p (Pa, c0^2 drho)",
+        ncols=3,
+        size=(15.5, 4.4),
+    ) as axes:
+        for ax, name, ref in zip(axes, "ABC", exact):
+            ax.plot(t[window], c2 * ref, color="black", lw=2.0, label="exact series")
+            ax.plot(t[window], c2 * np.asarray(series[name], dtype=np.float64)[window], color="tab:green", lw=1.2,
+                    ls="--", label=f"run (error {best[name]:.2g})" if best[name] is not None else "run")  # fmt: skip
+            x, y, z = points[name]
+            ax.set_title(f"{name} ({x:g}, {y:g}, {z:g}) m", fontsize=9)
+    return path
+
+
 SECTION = Section(
     "three-d",
     lambda ctx: rows(ctx.every_run()),
     text,
-    (error_figure,),
+    (error_figure, sphere_figure),
     all_scenes=True,
     order=159,
 )
