@@ -286,6 +286,7 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     from pcabench.studies.three_d import section
     from pcabench.studies.three_d.plan import THREE_D, three_d
     from pcabench.studies.three_d.section import rows, text
+    from solvers.scenes.base import plane_z
 
     monkeypatch.setattr(section, "PREDICTED_UP_TO", 40_000)  # the 262,144-particle lattices not predicted here
 
@@ -304,6 +305,8 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
             rec.measure, rec.headline = "probes_p", rec.mse
             times = np.linspace(0.0, 4.0, 41)
             rec.probes = {"t": times.tolist(), **{k: (1e-3 * np.sin(times)).tolist() for k in "ABC"}}
+        if s.name == "acoustic-pulse-3d" and s.dx == 1.0 and s.kernel == "wendland-c2" and s.t_end:  # a stored plane
+            rec.plane = plane_z(s.kind.exact_fields(s, s.t_end), s.dx, 0.0)
         pi = (3.0 if s.kernel == "wendland-c2" else 1.2) if s.dims == 3 else 1.0  # the cost runs: 3D per 2D pair
         rec.stages = {"input": 0.0, "init": 0.0, "snp": 0.0, "pi": pi * s.n_steps * s.n_particles * 80e-9,
                       "su": 0.0, "output": 0.0}  # fmt: skip
@@ -324,6 +327,8 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     ctx = type("Ctx", (), {"out": tmp_path, "name": "m"})()
     drawn = section.sphere_figure(data, ctx)  # p(t) at A, B, C of the finest run beside the series
     assert drawn == tmp_path / "three_d_sphere_probes.png" and drawn.stat().st_size > 10_000
+    drawn = section.slice_figure(data, ctx)  # the plane z = 0 of the one run that stored it, beside the exact
+    assert drawn == tmp_path / "three_d_slice.png" and drawn.stat().st_size > 10_000
 
 
 @pytest.mark.tier2  # 27,000 particles of the fourth-order method: 15 s
@@ -406,3 +411,33 @@ def test_the_gpu_solver_gives_the_cpu_cell_lists_3d_fields_in_the_simulator():
         for c in ("drho", "u", "v", "w", "x", "y", "z"):
             assert row[c] <= tol, (case, c, row)
 
+
+def test_a_3d_run_stores_its_z_plane_and_a_malformed_plane_reads_back_as_none(tmp_path):
+    """``plane_z``: the lattice plane nearest z = 0 of a 3D run's final drho, every k-th site beyond 64 a side;
+    a 3D run's record holds it (and reads it back), a 2D run's holds none, and a stored plane whose rows are not
+    numbers of one length reads back empty."""
+    from pcabench import store
+    from pcabench.execute.run import run as run_spec
+    from pcabench.spec import RunSpec
+    from pcabench.store.record import RunRecord
+    from solvers.scenes.base import plane_z
+
+    scene = small(t_end=1.0, model="linear")
+    exact = scene.kind.exact_fields(scene, 1.0)
+    plane = plane_z(exact, scene.dx, 0.0)
+    assert plane["z"] == pytest.approx(-0.25) and plane["step"] == scene.dx and len(plane["drho"]) == 16
+    on = np.isclose(exact.z, -0.25) & np.isclose(exact.y, plane["y0"] + 3 * scene.dx)
+    assert plane["drho"][3] == pytest.approx(exact.drho[on][np.argsort(exact.x[on])], rel=1e-5)
+    coarse = plane_z(exact, scene.dx, 0.0, most=5)  # 16 sites a side: every 4th
+    assert coarse["step"] == 4 * scene.dx and len(coarse["drho"]) == 4 == len(coarse["drho"][0])
+    rec = run_spec(RunSpec("linkedlist-cpu", scene))
+    assert rec.status == "ok" and np.array(rec.plane["drho"]).shape == (16, 16)
+    rec.profile_id = "m"
+    path = tmp_path / store.store_name("m", "h")
+    store.append(rec, path)
+    (back,) = store.read_records([path])
+    assert back.plane == rec.plane
+    flat = run_spec(RunSpec("linkedlist-cpu", Scene(1.0, "acoustic-pulse", steps=2)))
+    assert flat.status == "ok" and flat.plane == {}
+    row = {**rec.as_dict(), "plane": {**rec.plane, "drho": [[1.0, "x"], [2.0, 3.0]]}}
+    assert RunRecord.from_row(row).plane == {}

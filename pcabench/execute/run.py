@@ -24,7 +24,7 @@ from solvers.bodies import BodyEntered
 from solvers.corrections import SingularMoments
 from solvers.physics.integrators import step_program
 from solvers.reference.dispersion import predicted_primary
-from solvers.scenes.base import scored_axes
+from solvers.scenes.base import plane_z, scored_axes
 
 FIELD_NAMES = ("x", "y", "u", "v", "drho")  # a run's final fields (solvers.interface.Fields), each one per particle
 FIELD_NAMES_3D = ("z", "w")  # and a 3D run's
@@ -101,7 +101,7 @@ def score(record: RunRecord, scene, fields) -> RunRecord:
     if why:
         record.status, record.failed_step = "error", record.steps or None
         record.mse = record.me = float("nan")
-        record.errors, record.probes, record.mse_isothermal = {}, {}, None
+        record.errors, record.probes, record.plane, record.mse_isothermal = {}, {}, {}, None
         record.measure, record.headline = "", None
         record.message = (record.message + "\n" if record.message else "") + f"the run's result is not usable: {why}"
         return record
@@ -138,6 +138,8 @@ def _measure(record: RunRecord, scene, fields) -> None:
     record.errors = {**measures, **reflected(scene, fields)}  # open edges: what they sent back (linear runs)
     if fields.probes:  # p(t) at the probe points (scored by the scene's errors), kept rounded for the figures
         record.probes = {k: [float(f"{v:.6g}") for v in np.asarray(vals, float)] for k, vals in fields.probes.items()}
+    if scene.dims == 3:  # the final drho on the plane nearest z = 0, for the report's slice
+        record.plane = plane_z(fields, scene.dx, 0.0)
     if scene.kind.has_isothermal:  # every model against the nonlinear physics: which model a scene needs
         record.mse_isothermal = scene.kind.isothermal_errors(scene, fields)
     record.measure = scene.kind.measure(scene, record.t_end)  # the one error that means something at its end

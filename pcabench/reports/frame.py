@@ -59,8 +59,9 @@ def headline_of(row: dict) -> tuple[str, float | None]:
 
 
 def _flat(row: dict) -> dict:
-    r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions", "errors", "probes")}
+    r = {k: v for k, v in row.items() if k not in ("stages", "scene", "versions", "errors", "probes", "plane")}
     r["probes"] = json.dumps(row.get("probes") or {})  # readings at the probe points: one hashable cell
+    r["plane"] = json.dumps(row.get("plane") or {})  # a 3D run's final drho on the plane nearest z = 0: one cell
     for name, value in (row.get("errors") or {}).items():  # the scene's other error measures
         r[f"err_{name}"] = value
     for stage, seconds in (row.get("stages") or {}).items():

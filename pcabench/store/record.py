@@ -45,6 +45,7 @@ class RunRecord:
     headline: float | None = None  # its value (mse, or the error measure of that name): the run's one error
     errors: dict = field(default_factory=dict)  # the scene's other error measures (solvers/scenes/), by name
     probes: dict = field(default_factory=dict)  # {"t": [s], name: [drho, kg/m^3]} at the scene's probe points
+    plane: dict = field(default_factory=dict)  # a 3D run's final drho on the lattice plane nearest z = 0 (plane_z)
     scene: dict = field(default_factory=dict)
     message: str = ""
     profile_id: str = ""
@@ -137,6 +138,7 @@ class RunRecord:
             for k, v in (row.get("probes") or {}).items()
             if isinstance(v, list) and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
         }
+        values["plane"] = _plane(row.get("plane"))
         values["scene"] = dict(row["scene"])
         values["versions"] = dict(row.get("versions") or {})
         return cls(**values)
@@ -251,3 +253,17 @@ class RunRecord:
         if self.message:
             lines.append(f"message          {self.message.splitlines()[0]}")
         return "\n".join(lines)
+
+
+def _plane(value) -> dict:
+    """A stored plane (solvers.scenes.base.plane_z) as it was written, or {} where it is not one: numbers where
+    numbers belong, rows of numbers (or null) of one length."""
+    if not isinstance(value, dict):
+        return {}
+    number = lambda v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)  # noqa: E731
+    rows = value.get("drho")
+    if not all(number(value.get(k)) for k in ("z", "t", "x0", "y0", "step")) or not isinstance(rows, list) or not rows:
+        return {}
+    if not all(isinstance(r, list) and len(r) == len(rows[0]) and all(v is None or number(v) for v in r) for r in rows):
+        return {}
+    return {**{k: float(value[k]) for k in ("z", "t", "x0", "y0", "step")}, "drho": rows}

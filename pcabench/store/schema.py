@@ -109,6 +109,7 @@ FIELDS: dict[str, Field] = {
     "headline": _MEASURE,  # its value: the one error that means something at the run's end
     "errors": Field(("dict",)),  # the scene's other error measures, by name: numbers or null
     "probes": Field(("dict",)),  # readings at the scene's probe points, by name: lists of numbers
+    "plane": Field(("dict",)),  # a 3D run's final drho on the plane nearest z = 0 (solvers.scenes.base.plane_z)
     "scene": Field(("dict",), True),
     "message": Field(("str",), max_len=MAX_MESSAGE),
     "profile_id": _name(required=True, empty=False, path=True),

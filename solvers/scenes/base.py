@@ -130,6 +130,41 @@ def window_probe_errors(scene, probes, window: tuple, exact) -> dict:
     return out
 
 
+PLANE_MOST = 64  # sites a side of a stored plane at most (every k-th site beyond: about 50 kB a record)
+
+
+def plane_z(fields, dx: float, z0: float, most: int = PLANE_MOST) -> dict:
+    """drho on the lattice plane nearest ``z0`` (m) of 3D ``fields``, every k-th site along x and y so that at most
+    ``most`` are kept a side: {"z": the plane's z, "t", "x0", "y0": its first site, m, "step": the kept sites'
+    spacing, m, "drho": rows along y of drho along x, kg/m^3, 6 significant digits}; {} without a third axis or
+    sites there. The report's z = 0 slice (pcabench/studies/three_d/section.py)."""
+    import numpy as np
+
+    z = getattr(fields, "z", None)
+    if z is None or len(z) == 0:
+        return {}
+    x, y, z = (np.asarray(a, dtype=np.float64) for a in (fields.x, fields.y, z))
+    zs = np.round((z - z.min()) / dx)  # each lattice plane's index
+    nearest = zs[np.argmin(np.abs(z - z0))]
+    on = zs == nearest
+    if not on.any():
+        return {}
+    ix = np.round((x[on] - x[on].min()) / dx).astype(np.int64)
+    iy = np.round((y[on] - y[on].min()) / dx).astype(np.int64)
+    grid = np.full((iy.max() + 1, ix.max() + 1), np.nan)
+    grid[iy, ix] = np.asarray(fields.drho, dtype=np.float64)[on]
+    k = max(1, -(-max(grid.shape) // most))
+    kept = grid[::k, ::k]
+    return {
+        "z": float(np.mean(z[on])),
+        "t": float(fields.t),
+        "x0": float(x[on].min()),
+        "y0": float(y[on].min()),
+        "step": float(k * dx),
+        "drho": [[float(f"{v:.6g}") if np.isfinite(v) else None for v in row] for row in kept],
+    }
+
+
 class NoPrediction(ValueError):
     """A scene kind with no prediction of its errors (``accuracy`` and ``advise`` refuse it in one line)."""
 

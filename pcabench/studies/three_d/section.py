@@ -17,6 +17,7 @@ from pcabench.store.rows import latest
 from pcabench.studies.three_d.plan import COST_STEPS, T_END, THREE_D
 from solvers.method import Method
 from solvers.reference.sphere import drho as sphere_drho
+from solvers.scenes.base import plane_z
 
 TARGET = (1e-3, 0.25, 3.5)  # the issue's: the high-order method at most 1e-3 at dx 0.25, order at least 3.5
 PREDICTED_UP_TO = 300_000  # particles: the prediction's FFT of the symbol is computed up to this lattice
@@ -55,7 +56,8 @@ def rows(df) -> dict | None:
             )  # fmt: skip
         elif scene.dims == 3:
             predicted = scene.kind.predict(scene).predicted_error if scene.n_particles <= PREDICTED_UP_TO else None
-            accuracy.append({**row, "predicted": predicted})
+            plane = json.loads(r.plane) if ok and isinstance(r.get("plane"), str) else {}
+            accuracy.append({**row, "predicted": predicted, "plane": plane, "scene_value": scene})
     return {"accuracy": accuracy, "cost": cost, "sphere": sorted(sphere, key=lambda r: -r["dx"])}
 
 
@@ -219,6 +221,48 @@ def error_figure(data, ctx):
     return path
 
 
+def slice_figure(data, ctx):
+    """The 3D pulse's drho on the plane z = 0 at the run's end: the finest run with a stored plane (the most
+    accurate method's), the exact solution there, and their difference (its own scale)."""
+    runs = [r for r in (data or {}).get("accuracy", []) if r["error"] is not None and r.get("plane", {}).get("drho")]
+    if not runs:
+        return None
+    best = min(runs, key=lambda r: (r["dx"], r["error"]))
+    scene, plane = best["scene_value"], best["plane"]
+    exact = plane_z(scene.kind.exact_fields(scene, plane["t"]), scene.dx, 0.0)
+    run = np.array(plane["drho"], dtype=np.float64)
+    ref = np.array(exact["drho"], dtype=np.float64)
+    if run.shape != ref.shape:
+        return None
+    step = plane["step"]
+    extent = (plane["x0"] - step / 2, plane["x0"] + step * (run.shape[1] - 0.5),
+              plane["y0"] - step / 2, plane["y0"] + step * (run.shape[0] - 0.5))  # fmt: skip
+    path = ctx.out / "three_d_slice.png"
+    top = float(np.nanmax(np.abs(ref)))
+    diff = run - ref
+    with F.figure(
+        path,
+        f"The 3D pulse on the plane z = {plane['z']:.3g} m at t = {plane['t']:g} s: {best['label']}, CFL "
+        f"{best['cfl']:g}, dx = {best['dx']:g} m ({best['N']:,} particles; relative RMS {best['error']:.3g}), "
+        f"linear ({ctx.name})",
+        "x (m)",
+        "y (m)",
+        ncols=3,
+        size=(15.5, 4.9),
+    ) as axes:
+        for ax, field, title, scale in (
+            (axes[0], run, "the run's drho", top),
+            (axes[1], ref, "exact drho", top),
+            (axes[2], diff, "run - exact (its own scale)", float(np.nanmax(np.abs(diff))) or top),
+        ):
+            image = ax.imshow(field, origin="lower", extent=extent, cmap="RdBu_r", vmin=-scale, vmax=scale)
+            ax.set_title(title, fontsize=9)
+            ax.set_aspect("equal")
+            ax.grid(False)
+            ax.figure.colorbar(image, ax=ax, shrink=0.8, label="kg/m^3")
+    return path
+
+
 def sphere_figure(data, ctx):
     """p(t) at the sphere's probes A, B, C over the scored window: the exact series (black) beside the finest run
     (the high-order method, linear)."""
@@ -259,7 +303,7 @@ SECTION = Section(
     "three-d",
     lambda ctx: rows(ctx.every_run()),
     text,
-    (error_figure, sphere_figure),
+    (error_figure, slice_figure, sphere_figure),
     all_scenes=True,
     order=159,
 )
