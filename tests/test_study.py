@@ -334,7 +334,7 @@ def _figures_sit_in_their_sections_with_their_data(folder):
         assert home.split("\n", 1)[0] in headings
         data = pd.read_csv(png.with_suffix(".csv"))
         assert f"[{png.stem}.csv]({png.stem}.csv)" in home and len(data) > 0, png.name
-        assert data[["x", "y"]].notna().all(axis=1).any() and set(data.kind) <= {"line", "points", "bar"}
+        assert data[["x", "y"]].notna().all(axis=1).any() and set(data.kind) <= {"line", "points", "bar", "image"}
     fig8 = pd.read_csv(folder / "fig8_error_vs_dx.csv")  # its measured points: the runs' dx and errors
     assert {0.2, 0.1}.issubset(set(fig8.x.round(6)))
 

@@ -280,6 +280,8 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     step) of the 3D run against the 2D one."""
     from dataclasses import replace
 
+    import pandas as pd
+
     from pcabench import store
     from pcabench.execute.sweep import failed_record
     from pcabench.reports.frame import load as load_frame
@@ -329,6 +331,12 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     assert drawn == tmp_path / "three_d_sphere_probes.png" and drawn.stat().st_size > 10_000
     drawn = section.slice_figure(data, ctx)  # the plane z = 0 of the one run that stored it, beside the exact
     assert drawn == tmp_path / "three_d_slice.png" and drawn.stat().st_size > 10_000
+    pixels = pd.read_csv(drawn.with_suffix(".csv"))  # its data beside it: one row per pixel with its value
+    run_panel = pixels[(pixels.kind == "image") & (pixels.panel == 0)]
+    stored = [r for r in data["accuracy"] if r["plane"]][0]["plane"]
+    assert len(run_panel) == np.size(stored["drho"]) == 16 * 16 and np.allclose(
+        np.sort(run_panel.value), np.sort(np.ravel(stored["drho"]))
+    )
 
 
 @pytest.mark.tier2  # 27,000 particles of the fourth-order method: 15 s

@@ -4,8 +4,10 @@ Every figure the report draws is saved with a CSV of the same name beside it (:f
 row per plotted point: the panel (its index and title, its axes' labels), the series (its legend label; the
 lines and points without one, such as reference lines, keep matplotlib's name for them), what it is (``line``,
 ``points`` or ``bar``), and x, y (a bar's end on its value axis, its start in ``base``: a stacked bar's share is
-the difference; a bar whose other axis holds names carries its name in ``category``). Taken from the Figure's
-artists after drawing, so the table is what the PNG shows, whatever section drew it.
+the difference; a bar whose other axis holds names carries its name in ``category``; an image (a field on a
+plane) one row per pixel, ``image``, its centre in x, y and its value in a last column, ``value``, which only a
+figure with an image has). Taken from the Figure's artists after drawing, so the table is what the PNG shows,
+whatever section drew it.
 """
 
 from __future__ import annotations
@@ -66,7 +68,22 @@ def figure_data(fig) -> pd.DataFrame:
                     centre = x0 + w / 2
                     row = {"x": centre, "y": y0 + h, "base": y0, "category": names_x.get(round(centre, 9), "")}
                 rows.append({**panel, "series": label, "kind": "bar", **row})
-    return pd.DataFrame(rows, columns=COLUMNS)
+        for image in ax.images:
+            values = np.ma.filled(np.ma.asarray(image.get_array(), dtype=float), np.nan)
+            x0, x1, y0, y1 = image.get_extent()
+            ny, nx = values.shape[:2]
+            xs = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
+            ys = y0 + (np.arange(ny) + 0.5) * (y1 - y0) / ny
+            if image.origin == "upper":
+                ys = ys[::-1]
+            title = panel["panel_title"]
+            rows += [
+                {**panel, "series": title, "kind": "image", "x": xs[i], "y": ys[j], "value": values[j, i]}
+                for j in range(ny)
+                for i in range(nx)
+            ]
+    images = any(r["kind"] == "image" for r in rows)
+    return pd.DataFrame(rows, columns=COLUMNS + (["value"] if images else []))
 
 
 def save_figure_data(fig, path) -> Path:

@@ -12,8 +12,9 @@
    neighbours in 3D, 108 in 2D).
 3. The rigid sphere (``--scene sphere``, its weak wall), the high-order method, linear, t = 4 s: the probes A, B, C
    over 1.5 <= t <= 4 s against the exact series at dx 0.125 and 0.1 (97,336 and 185,193 particles with the
-   layer; about 5 and 11 min here). The issue's dx 0.05 (1.3 million particles, about 2.6 h here) is left to a
-   larger machine: `pcabench run --scene sphere --dx 0.05` with the method below.
+   layer; 159 and 401 s here on 2026-12-07). The issue's dx 0.05 (1.3 million particles, sixteen times dx 0.1's
+   particle-steps: about 1.8 h here) is left to a larger machine: `pcabench run --scene sphere --dx 0.05` with the
+   method below.
 """
 
 from __future__ import annotations
@@ -64,6 +65,6 @@ THREE_D_PRESET = Preset(
     flag="three-d",
     help="sound in 3D: the 3D pulse's error against dx with standard SPH, the paper's method and the high-order "
     "method, a pair's cost in 3D against 2D for two kernels, the rigid sphere with the high-order method ({size}; "
-    "about 35 min here, serial)",
+    "about 20 min here, serial)",
     order=59,
 )
