@@ -103,6 +103,22 @@ def test_predictor_fits_the_power_law_and_extrapolates():
     assert predicted_seconds(ll, [dict(one[0], status="error")]) == (None, "")
 
 
+def test_a_3d_run_is_predicted_from_3d_runs_by_the_neighbours_its_sphere_holds():
+    """In 3D a particle's neighbours go as 4 pi / 3 (cutoff / dx)^3: a 3D run of another kernel informs the fit by
+    that ratio (the fourth-order kernel's 894 neighbours against Wendland C2's 80), and the host's 3D runs are
+    used before its 2D ones (whose pairs cost another price)."""
+    cube = dict(name="acoustic-pulse-3d", steps=10, model="linear")
+    row = _ok_row("linkedlist-cpu", 0.5, 0.1, steps=10)
+    three = Scene(0.5, **cube, kernel="wendland-c2", h_factor=1.3)
+    row3 = dict(row, scene=three.as_dict(), n_particles=three.n_particles)
+    high = Scene(0.5, **cube, kernel="laguerre-gauss", h_factor=1.5, cutoff_factor=4.0)
+    spec = RunSpec("linkedlist-cpu", high)
+    ratio = (high.cutoff / three.cutoff) ** 3  # (6 dx / 2.6 dx)^3 the neighbours; the kernel not run here: compiled
+    slow2d = dict(row, stages=dict(row["stages"], pi=100.0))  # a 2D row a hundred times dearer: not used
+    for rows in ([row3], [row3, slow2d]):
+        assert predicted_seconds(spec, rows)[0] == pytest.approx(START_UP + COLD_JIT + 10 * 0.1 * ratio, rel=1e-9)
+
+
 def test_the_eta_counts_only_the_runs_that_will_run():
     """A run predicted past the run budget will be skipped: the ETA counts nothing for it and says so (it said
     12.9 minutes with one left, counting a run the sweep then skipped)."""

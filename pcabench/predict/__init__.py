@@ -1,10 +1,11 @@
 """Predict a run's wall time from the finished runs of the same solver, to skip hopeless sizes.
 
 The time of one step is fitted as ``a * N**b`` over this host's finished runs
-of the same solver, precision, model and threads (any protocol), per
-neighbour for the cell lists: their step time is taken proportional to the
-neighbours per particle, (cutoff / dx)^2, so runs of another kernel or h/dx
-inform the fit. With two or more sizes ``b`` is fitted (bounded to half and
+of the same solver, precision, model and threads (any protocol; of the
+spec's dimension where this host has any), per neighbour for the cell lists:
+their step time is taken proportional to the neighbours per particle, pi
+(cutoff / dx)^2 in 2D and 4 pi / 3 (cutoff / dx)^3 in 3D, so runs of another
+kernel or h/dx inform the fit. With two or more sizes ``b`` is fitted (bounded to half and
 one and a half times the solver's ``order``); with one, ``b`` is the order
 (2 for all-pair, 1 for a cell list). A run's time is
 its steps times the step, plus the child process's start-up, plus its JIT:
@@ -69,13 +70,22 @@ def _same_config(row: dict, spec) -> bool:
     )
 
 
+def _dims(scene: dict) -> int:
+    """The dimension of a stored scene (its kind's; 2 for a name this checkout does not know)."""
+    from solvers import scenes
+
+    kind = scenes().get(scene.get("name") or "plane-pulse")
+    return int(getattr(kind, "dims", 2))
+
+
 def _reach(solver: str, scene: dict) -> float:
-    """The work of a particle's step, relative: (cutoff / dx)^2, which the neighbours per particle scale with (1 for
-    all-pair), times the integrator's sweeps over Verlet's (RK4: 4)."""
+    """The work of a particle's step, relative: the neighbours per particle the cutoff holds, pi (cutoff / dx)^2 in
+    2D and 4 pi / 3 (cutoff / dx)^3 in 3D (1 for all-pair), times the integrator's sweeps over Verlet's (RK4: 4)."""
     sweeps = sweeps_per_step(scene.get("integrator") or "verlet") / sweeps_per_step("verlet")
     if "all-pairs" in solver_class(solver).pair_loops or not scene.get("cutoff") or not scene.get("dx"):
         return sweeps
-    return sweeps * (scene["cutoff"] / scene["dx"]) ** 2
+    ratio = scene["cutoff"] / scene["dx"]
+    return sweeps * (4.0 * math.pi / 3.0 * ratio**3 if _dims(scene) == 3 else math.pi * ratio**2)
 
 
 def step_model(spec, rows: list[dict]):
@@ -83,10 +93,11 @@ def step_model(spec, rows: list[dict]):
     or None without data."""
     pts = {}
     reach = _reach(spec.solver, spec.scene.as_dict())
-    for row in rows:
-        if _same_config(row, spec):
-            scale = reach / _reach(spec.solver, row["scene"])
-            pts.setdefault(int(row["n_particles"]), []).append(scale * step_seconds(row["stages"], row["steps"]))
+    same = [row for row in rows if _same_config(row, spec)]
+    own = [row for row in same if _dims(row["scene"]) == spec.scene.dims]
+    for row in own or same:  # this dimension's runs where there are any
+        scale = reach / _reach(spec.solver, row["scene"])
+        pts.setdefault(int(row["n_particles"]), []).append(scale * step_seconds(row["stages"], row["steps"]))
     pts = {n: float(np.median(v)) for n, v in pts.items() if n > 0 and min(v) > 0}
     if not pts:
         return None
