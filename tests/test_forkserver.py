@@ -129,3 +129,26 @@ print(len(got))
 """
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0 and proc.stdout.strip() == "1", proc.stderr[-2000:]
+
+
+@pytest.mark.tier2  # two sets of loops compiled from an empty cache: about 15 s
+def test_a_sweeps_uncached_loops_are_compiled_ahead_side_by_side_and_its_runs_compile_none(tmp_path):
+    """pcabench/execute/ahead.py: a sweep of two configurations (float64 and float32) whose loops the cache lacks
+    compiles them before its first run, one process each, says so once, and its runs load them (each record
+    ``jit_cached``, a fraction of a second of JIT); a sweep of one configuration starts no such process."""
+    in_a_process_of_its_own(
+        f"""
+        import io, json
+        from pcabench.execute import ahead
+        from pcabench.execute.sweep import sweep
+        os.environ["PCABENCH_CACHE"] = {str(tmp_path / "cache")!r}
+        ahead.cores = lambda: 2  # the grouping on two cores, whatever this machine has
+        specs = [RunSpec("allpair-cpu", Scene(dx=1.0, steps=3, precision=p)) for p in ("float64", "float32")]
+        said = io.StringIO()
+        rows = sweep(specs, {str(tmp_path / "store.jsonl")!r}, 300, 600, stream=said)
+        assert "compiled ahead: 2 sets of loops" in said.getvalue(), said.getvalue()
+        assert [r["status"] for r in rows] == ["ok", "ok"] and all(r["jit_cached"] for r in rows), rows
+        assert max(r["jit_seconds"] for r in rows) < 1.0, [r["jit_seconds"] for r in rows]
+        assert ahead.compile_ahead(specs[:1], stream=said) == (0, 0.0)  # one set: nothing ahead
+        """
+    )

@@ -16,7 +16,7 @@ warnings.filterwarnings("ignore", category=PluginWarning)  # the sweep (the pare
 from pcabench.execute import child  # noqa: E402, F401 - the harness, the solvers, numpy and numba
 
 WARM = "PCABENCH_WARM"  # the forkserver's environment: a JSON list of the sweep's RunSpecs to warm
-WARMED = ("linkedlist-cpu", "allpair-cpu")  # built-in CPU solvers whose serial warm-up starts no thread
+from pcabench.execute.ahead import WARMED  # noqa: E402 - built-in CPU solvers whose serial warm-up starts no thread
 
 
 def warm(specs: list) -> int:

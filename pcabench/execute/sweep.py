@@ -32,6 +32,7 @@ from pathlib import Path
 
 from pcabench import store
 from pcabench.execute import containment, forkserver
+from pcabench.execute.ahead import compile_ahead
 from pcabench.machine.memory import cgroup_memory_folders
 from pcabench.machine.profiles import MACHINE_ID_ENV, machine_id
 from pcabench.predict import predicted_seconds, row_variant, spec_variant
@@ -400,6 +401,9 @@ class Executor(abc.ABC):
     def key(self, spec: RunSpec, code: str) -> str:
         """The spec's store key (:func:`~pcabench.spec.identity`) by ``code`` as this executor places runs."""
 
+    def prepare(self, queue: list[RunSpec]) -> None:
+        """Before the first of the runs ``queue`` holds (those not stored yet): nothing here."""
+
     @abc.abstractmethod
     def row_key(self, row: dict) -> str:
         """:meth:`key` of a stored row."""
@@ -424,6 +428,13 @@ class LocalExecutor(Executor):
     def __init__(self, machine: str, host: str, commit: str, runner=None, stream=sys.stderr):
         self.machine, self.host, self.commit, self.stream = machine, host, commit, stream
         self.runner, self.pending = runner or run_child, []
+
+    def prepare(self, queue):
+        """Runs in child processes: the loops they need compiled ahead, side by side (pcabench/execute/ahead.py),
+        then the children's server started with them loaded (pcabench/execute/forkserver.py)."""
+        if self.runner is run_child and queue:
+            compile_ahead(queue, self.stream)
+            forkserver.prepare(queue)
 
     def key(self, spec, code):
         return spec.key(self.machine, code, self.host)
@@ -491,6 +502,7 @@ def run_specs(
             print(f"{labels[spec]}: already stored", file=stream, flush=True)
         else:
             queue.append(spec)
+    executor.prepare(queue)
     t_start, stored, failed, running, n_todo = time.perf_counter(), [], 0, 0, len(queue)
     while queue or running:
         while queue and running < executor.slots:
@@ -563,8 +575,6 @@ def sweep(
     with store.SweepLock(store_path) as lock:
         store_path = Path(store_path)
         rows = store.read_rows(store_path) if store_path.exists() else []
-        if runner is None:  # the children are forked from a server with the plan's compiled loops loaded
-            forkserver.prepare([s.resolved() for s in specs])
         executor = LocalExecutor(machine_id(), host_id(), git_commit(), runner, stream)
         return run_specs(
             specs, executor, StoreFile(store_path, lock), rows, run_budget, sweep_budget, stream, retry_failed
