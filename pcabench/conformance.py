@@ -136,6 +136,7 @@ class Failure(AssertionError):
 
 # ---------------------------------------------------------------- the solver under test
 SIMULATED_MOST = 4_000  # particles of a case run in numba's CUDA simulator (Python threads: seconds a step)
+QUADRATIC_MOST = 5_000  # particles of a case an all-pair class checks itself on (N^2 pairs a sweep)
 
 
 class Subject:
@@ -164,9 +165,12 @@ class Subject:
 
     def run_scenes(self) -> list[str]:
         """The claimed scene cases the checks run: in numba's CUDA simulator those of at most ``SIMULATED_MOST``
-        particles (a GPU class's larger cases, the 3D body's, are run on a card: ``pcabench gpu-check``)."""
+        particles (a GPU class's larger cases, the 3D body's, are run on a card: ``pcabench gpu-check``); for a
+        class whose cost grows as N^2 (all-pair) those of at most ``QUADRATIC_MOST`` (its larger cases run as the
+        reference of every cell list's agreement)."""
+        most = SIMULATED_MOST if self.simulated else QUADRATIC_MOST if self.cls.order >= 2 else None
         claimed = self.claimed_scenes()
-        return [name for name in claimed if not (self.simulated and self.scene(name=name).n_particles > SIMULATED_MOST)]
+        return [name for name in claimed if most is None or self.scene(name=name).n_particles <= most]
 
     def scene(self, name: str = "plane-pulse", steps: int | None = None, **method) -> Scene:
         """A conformance scene: ``name``'s tiny lattice with the class's defaults and ``method`` on top."""

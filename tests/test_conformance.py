@@ -319,3 +319,17 @@ def test_a_new_scene_kind_is_checked_everywhere_with_no_list_to_edit():
         assert {"name": "short-duct", "dx": 0.5} in walls_gpu.cases(rehearse=False).scenes
         assert {"name": "open-line", "dx": 0.5, "open": "x"} in open_gpu.cases(rehearse=False).scenes
     assert "short-duct" not in scene_cases() and "short-duct" not in str(walls_gpu.cases(rehearse=False).scenes)
+
+
+def test_an_all_pair_class_checks_itself_on_the_cases_its_n_squared_affords():
+    """The all-pair solver (order 2) runs its own checks on the cases of at most QUADRATIC_MOST particles (its
+    larger ones, the 3D body's 13,068, run as every cell list's reference); it still claims them all, and a cell
+    list runs every case it claims."""
+    from pcabench.conformance import QUADRATIC_MOST, Subject
+    from solvers import solver_class
+
+    quadratic, cells = (Subject(solver_class(name), quick=True) for name in ("allpair-cpu", "linkedlist-cpu"))
+    big = [n for n in quadratic.claimed_scenes() if quadratic.scene(name=n).n_particles > QUADRATIC_MOST]
+    assert "sphere" in big and not set(big) & set(quadratic.run_scenes())
+    assert set(quadratic.run_scenes()) | set(big) == set(quadratic.claimed_scenes())
+    assert cells.run_scenes() == cells.claimed_scenes() and "sphere" in cells.run_scenes()
