@@ -19,10 +19,18 @@ import numba
 import numpy as np
 
 
+def capability(text: str) -> tuple:
+    """``MAJOR.MINOR`` (both whole numbers, 3.5 to 12.x) as a tuple, or argparse's one-line error."""
+    parts = text.split(".")
+    if len(parts) != 2 or not all(p.isdigit() for p in parts) or not 3 <= int(parts[0]) <= 12:
+        raise argparse.ArgumentTypeError(f"MAJOR.MINOR, 3.5 to 12.x, such as 9.0 (got {text!r})")
+    return int(parts[0]), int(parts[1])
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(prog="python tools/ptx_check.py", description=__doc__.split("\n")[0])
-    p.add_argument("--cc", default="9.0", help="the compute capability to compile for (default 9.0: H100, H200)")
-    cc = tuple(int(x) for x in p.parse_args(argv).cc.split("."))
+    p.add_argument("--cc", type=capability, default=(9, 0), help="compute capability to compile for (default 9.0)")
+    cc = p.parse_args(argv).cc
 
     from numba import cuda, types
     from numba.cuda import dispatcher
