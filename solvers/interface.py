@@ -349,24 +349,14 @@ class Solver(abc.ABC):
 
     def advance_launch(self, f: float) -> None:
         """The advance's kernel: drho += f dt D and, for moving particles, x += f dt u."""
-        a = self.arrays
-        if self.scene.dims == 3:
-            displacement, velocity = (a[n] for n in ("sx", "sy", "sz")), (a[n] for n in ("u", "v", "w"))
-            self.launch(
-                "advance", a["drho"], a["dd"], *displacement, *velocity, self.dtype.type(f * self.scene.dt), self.moving
-            )
-            return
-        self.launch(
-            "advance",
-            a["drho"],
-            a["dd"],
-            a["sx"],
-            a["sy"],
-            a["u"],
-            a["v"],
-            self.dtype.type(f * self.scene.dt),
-            self.moving,
-        )
+        self.launch("advance", *self.advance_arguments(f))
+
+    def advance_arguments(self, f: float) -> tuple:
+        """What the advance's kernel takes: drho, its rate, the displacements and velocities of the scene's axes,
+        f dt (s) and whether the particles move."""
+        a, dims = self.arrays, self.scene.dims
+        moved = (a[name] for name in (*POSITIONS[dims][dims:], *VELOCITY[dims]))
+        return a["drho"], a["dd"], *moved, self.dtype.type(f * self.scene.dt), self.moving
 
     def moved(self) -> None:
         """Moving particles have new positions: what was computed from the old ones (the layer's factors) goes."""

@@ -27,7 +27,6 @@ import numpy as np
 
 from solvers.gpu.cells import DeviceCellList
 from solvers.gpu.device import device_backend, simulated
-from solvers.interface import POSITIONS, VELOCITY
 from solvers.scene import SceneError
 from solvers.search.celllist import CellListSolver
 
@@ -142,23 +141,8 @@ class LinkedListGPU(CellListSolver):
 
     def advance_launch(self, f: float) -> None:
         """drho (and x) += f dt (D, u), with the coefficients of the new drho in the same launch."""
-        a, dims = self.arrays, self.scene.dims
-        displacement = (a[name] for name in POSITIONS[dims][dims:])
-        velocity = (a[name] for name in VELOCITY[dims])
-        c = self.dtype.type(f * self.scene.dt)
-        self.launch(
-            "advance",
-            a["drho"],
-            a["dd"],
-            *displacement,
-            *velocity,
-            c,
-            self.moving,
-            a["mass"],
-            a["vol"],
-            a["pr"],
-            self.k,
-        )
+        a = self.arrays
+        self.launch("advance", *self.advance_arguments(f), a["mass"], a["vol"], a["pr"], self.k)
         self.coefficients_fresh = True
 
     def absorb(self, f: float, fields: str) -> None:

@@ -17,13 +17,12 @@ from pcabench.gpu.tables import scene_agreement
 from pcabench.reports.md import md_table
 from pcabench.spec import RunSpec
 from pcabench.store.record import STEP_STAGES
+from pcabench.studies.three_d.plan import HIGH_ORDER, STANDARD  # the study's methods: 80 and 894 neighbours
 from solvers import PRECISIONS, Scene
 
 TITLE = "Sound in three dimensions (the trimmed stencil's kernels)"
 
-STANDARD = {"kernel": "wendland-c2", "h_factor": 1.3, "cfl": 0.5}  # 80 neighbours
-HIGH_ORDER = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0, "correction": "gradient", "cfl": 0.5}
-CORRECTED = {"kernel": "wendland-c2", "h_factor": 1.3, "correction": "gradient", "cfl": 0.5}  # the weak wall's
+CORRECTED = {**STANDARD, "correction": "gradient"}  # the weak wall's at 80 neighbours
 PULSE = {"name": "acoustic-pulse-3d"}  # the 16 m periodic cube
 
 
