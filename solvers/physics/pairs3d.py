@@ -8,10 +8,11 @@ physics with a third component,
 
 built as small factories, each one sum over a range of particles j0..j1-1, over one rule for the separation
 (:func:`separation_rule`): r_ij = (l_i - l_j) dx + (s_i - s_j) per axis, the lattice part exact, as in 2D. The
-cell list's stencil is 25 rows of cells half a cutoff wide (y and z offsets -2..2), each trimmed to the cells the
-cutoff's sphere reaches (:func:`stencil_rule`) and one contiguous range of particles sorted by cell, shifted
-across the y and z seams by whole periods (``k[NY]``, ``k[NZ]``), with the periodic images across the x seam
-(``k[NX]``) as a second range per row, as in 2D. :func:`make_pairs3d` assembles them into a module object that
+cell list's stencil is the rows along x at the y and z offsets the grid's reach allows
+(solvers.interface.stencil_reach), each trimmed to the cells the cutoff's sphere reaches (:func:`stencil_rule`)
+and one contiguous range of particles sorted by cell, shifted across the y and z seams by whole periods
+(``k[NY]``, ``k[NZ]``), with the periodic images across the x seam (``k[NX]``) as a second range per row, as in
+2D. :func:`make_pairs3d` assembles them into a module object that
 numba resolves inside the sweeps (solvers/loops/cells3d.py, allpair3d.py).
 """
 
