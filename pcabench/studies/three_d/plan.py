@@ -12,16 +12,19 @@
    neighbours in 3D, 108 in 2D).
 3. The rigid sphere (``--scene sphere``, its weak wall), the high-order method, linear, t = 4 s: the probes A, B, C
    over 1.5 <= t <= 4 s against the exact series at dx 0.125 and 0.1 (97,336 and 185,193 particles with the
-   layer; 159 and 401 s here on 2026-12-07). The issue's dx 0.05 (1.3 million particles, sixteen times dx 0.1's
-   particle-steps: about 1.8 h here) is left to a larger machine: `pcabench run --scene sphere --dx 0.05` with the
-   method below.
+   layer; 159 and 401 s here on 2026-12-07).
+
+``pcabench study --three-d fine`` is the issue's target run on its own: the sphere at dx 0.05 (1,481,544 particles
+with the layer, 160 steps, 0.97 GiB resident; 48 s a step on one core here), on every core.
 """
 
 from __future__ import annotations
 
+from pcabench.spec import ALL_CORES
 from pcabench.studies.preset import Preset, spec_of
 
 THREE_D = "three-d"
+THREE_D_FINE = "three-d-fine"
 T_END = 5.0
 PULSE = {"name": "acoustic-pulse-3d", "model": "linear", "t_end": T_END}
 STANDARD = {"kernel": "wendland-c2", "h_factor": 1.3, "cfl": 0.5}
@@ -42,6 +45,7 @@ COST_KERNELS = (
 COST_2D_SIDE = 22.625  # m: 181 x 181 = 32,761 particles at dx 0.125, beside the cube's 32,768
 SPHERE = {"name": "sphere", "model": "linear", "t_end": 4.0}
 SPHERE_DX = (0.125, 0.1)
+SPHERE_FINE_DX = 0.05  # the issue's target: at most 2 % at the probes
 
 
 def three_d() -> list:
@@ -58,13 +62,30 @@ def three_d() -> list:
     return runs
 
 
+def three_d_fine() -> list:
+    """The sphere at the issue's dx, on every core (module docstring)."""
+    return [spec_of(dx=SPHERE_FINE_DX, threads=ALL_CORES, **SPHERE, **HIGH_ORDER)]
+
+
 THREE_D_PRESET = Preset(
     THREE_D,
     three_d,
     3600.0,
     flag="three-d",
+    choice="coarse",
     help="sound in 3D: the 3D pulse's error against dx with standard SPH, the paper's method and the high-order "
     "method, a pair's cost in 3D against 2D for two kernels, the rigid sphere with the high-order method ({size}; "
     "about 20 min here, serial)",
     order=59,
+)
+
+THREE_D_FINE_PRESET = Preset(
+    THREE_D_FINE,
+    three_d_fine,
+    4 * 3600.0,
+    flag="three-d",
+    choice="fine",
+    help="the rigid sphere at dx 0.05 (the issue's target: 1.5 million particles), the high-order method, "
+    "every core (about 1 h on two cores here)",
+    order=59.5,
 )

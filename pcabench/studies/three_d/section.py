@@ -14,7 +14,7 @@ from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import latest
-from pcabench.studies.three_d.plan import COST_STEPS, T_END, THREE_D
+from pcabench.studies.three_d.plan import COST_STEPS, T_END, THREE_D, THREE_D_FINE
 from solvers.method import Method
 from solvers.reference.sphere import drho as sphere_drho
 from solvers.scenes.base import plane_z
@@ -28,7 +28,7 @@ def rows(df) -> dict | None:
     if df is None or df.empty or "preset" not in df or not (df.preset == THREE_D).any():
         return None
     accuracy, cost, sphere = [], [], []
-    for _, r in latest(df[df.preset == THREE_D]).iterrows():
+    for _, r in latest(df[df.preset.isin((THREE_D, THREE_D_FINE))]).iterrows():
         scene = scene_from_row(r)
         ok = r.status == "ok" and np.isfinite(r.mse)
         row = {
