@@ -99,8 +99,30 @@ def test_predictor_fits_the_power_law_and_extrapolates():
     assert predicted_seconds(f32, f32_rows, cached=False)[0] == pytest.approx(START_UP + COLD_JIT + 10 * 2e-3 * 4)
     measured = [dict(one[0], jit_cached=False, jit_seconds=9.0), dict(one[0], jit_cached=True, jit_seconds=0.25)]
     assert jit_seconds(ll, measured, cached=False) == 9.0 and jit_seconds(ll, measured, cached=True) == 0.25
-    assert predicted_seconds(RunSpec("linkedlist-cpu", Scene(dx=0.5), 2), one) == (None, "")
+    assert predicted_seconds(RunSpec("allpair-cpu", Scene(dx=0.5, steps=10)), one) == (None, "")
     assert predicted_seconds(ll, [dict(one[0], status="error")]) == (None, "")
+
+
+def test_a_threaded_run_is_predicted_from_serial_runs_by_the_hosts_measured_efficiency():
+    """A first run on two threads: the serial runs inform it, each thread beyond one gaining what this host measured
+    on a scene run at both counts (the 3D sphere on two threads was predicted 194 s from 2D pair-list rows on
+    two threads; it takes about an hour). Rows of the spec's own loop come before another loop's."""
+    ll2 = RunSpec("linkedlist-cpu", Scene(dx=0.5, steps=10), 2).resolved()
+    serial = _ok_row("linkedlist-cpu", 1.0, 2e-3)
+    serial["pair_loop"] = ll2.pair_loop
+    # ideal without a measured pair: half the serial step
+    assert predicted_seconds(ll2, [serial], cached=True)[0] == pytest.approx(START_UP + CACHED_JIT + 10 * 1e-3 * 4)
+    # a scene at both counts: 1.6 times faster on two threads is an efficiency of 0.8
+    pair = [dict(serial, scene=dict(serial["scene"], t_end=None, steps=3)), None]
+    pair[1] = dict(pair[0], threads=2, stages=dict(pair[0]["stages"], pi=pair[0]["stages"]["pi"] / 1.6))
+    seconds = predicted_seconds(ll2, [serial, *pair], cached=True)[0]
+    assert seconds == pytest.approx(START_UP + CACHED_JIT + 10 * 2e-3 * 4 / 1.6), seconds
+    # a row on the spec's threads but another loop (ten times cheaper) is not used while its own loop has rows
+    other = dict(serial, threads=2, pair_loop="gather" if ll2.pair_loop == "list" else "list")
+    other["stages"] = dict(serial["stages"], pi=serial["stages"]["pi"] / 10)
+    assert predicted_seconds(ll2, [serial, other], cached=True)[0] == pytest.approx(
+        START_UP + CACHED_JIT + 10 * 1e-3 * 4
+    )
 
 
 def test_a_3d_run_is_predicted_from_3d_runs_by_the_neighbours_its_sphere_holds():

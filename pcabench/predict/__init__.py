@@ -1,8 +1,11 @@
 """Predict a run's wall time from the finished runs of the same solver, to skip hopeless sizes.
 
 The time of one step is fitted as ``a * N**b`` over this host's finished runs
-of the same solver, precision, model and threads (any protocol; of the
-spec's dimension where this host has any), per neighbour for the cell lists:
+of the same solver, precision and model (any protocol), the closest kind
+first: of the spec's dimension, then its pair loop (a 2D linear run's pair
+list costs a tenth of a gather), then its thread count; a run of another
+thread count is scaled by the thread ratio times this host's measured parallel
+efficiency (the same scene at two counts; ideal where none). Per neighbour for the cell lists:
 their step time is taken proportional to the neighbours per particle, pi
 (cutoff / dx)^2 in 2D and 4 pi / 3 (cutoff / dx)^3 in 3D, so runs of another
 kernel or h/dx inform the fit. With two or more sizes ``b`` is fitted (bounded to half and
@@ -19,12 +22,13 @@ into the wall.
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
 
 from pcabench.store.record import step_seconds
-from solvers import solver_class
+from solvers import resolve_pair_loop, solver_class
 from solvers.physics.integrators import sweeps_per_step
 
 START_UP = 2.0  # s: a child process's start, imports, scoring and hand-back, JIT aside (1.9 s measured here)
@@ -63,13 +67,31 @@ def _same_config(row: dict, spec) -> bool:
     return (
         row.get("status") == "ok"
         and row.get("solver") == spec.solver
-        and int(row.get("threads") or 1) == int(spec.threads)
         and rs.get("precision") == scene.precision
         and rs.get("model") == scene.model
         and (row.get("steps") or 0) > 0
     )
 
 
+def _threads(row: dict) -> int:
+    return int(row.get("threads") or 1)
+
+
+def parallel_efficiency(rows: list[dict]) -> float:
+    """This host's speed-up per thread, measured: the median over scenes run at one thread and at more (same solver,
+    loop and scene) of (serial step / threaded step) / threads; 1 (ideal) where it ran none."""
+    serial, threaded = {}, []
+    for row in rows:
+        if row.get("status") != "ok" or not (row.get("steps") or 0) > 0:
+            continue
+        key = (row.get("solver"), row.get("pair_loop"), json.dumps(row.get("scene") or {}, sort_keys=True))
+        step = step_seconds(row["stages"], row["steps"])
+        if _threads(row) == 1:
+            serial.setdefault(key, []).append(step)
+        else:
+            threaded.append((key, _threads(row), step))
+    ratios = [min(serial[k]) / step / n for k, n, step in threaded if k in serial and step > 0]
+    return float(np.median(ratios)) if ratios else 1.0
 def _dims(scene: dict) -> int:
     """The dimension of a stored scene (its kind's; 2 for a name this checkout does not know)."""
     from solvers import scenes
@@ -88,15 +110,32 @@ def _reach(solver: str, scene: dict) -> float:
     return sweeps * (4.0 * math.pi / 3.0 * ratio**3 if _dims(scene) == 3 else math.pi * ratio**2)
 
 
+def _kinship(row: dict, spec, loop: str) -> tuple:
+    """How far a stored run is from ``spec``: (another dimension, another pair loop, another thread count)."""
+    return (
+        _dims(row["scene"]) != spec.scene.dims,
+        row.get("pair_loop") not in (None, loop),
+        _threads(row) != int(spec.threads),
+    )
+
+
 def step_model(spec, rows: list[dict]):
-    """``(a, b, sizes)`` of the fitted step time ``a * N**b`` (s) at ``spec``'s neighbours per particle,
-    or None without data."""
+    """``(a, b, sizes)`` of the fitted step time ``a * N**b`` (s) at ``spec``'s neighbours per particle and
+    threads, or None without data; fitted to the closest kind of stored run there is (:func:`_kinship`)."""
     pts = {}
     reach = _reach(spec.solver, spec.scene.as_dict())
     same = [row for row in rows if _same_config(row, spec)]
-    own = [row for row in same if _dims(row["scene"]) == spec.scene.dims]
-    for row in own or same:  # this dimension's runs where there are any
+    if not same:
+        return None
+    loop = resolve_pair_loop(spec.solver, spec.scene, spec.pair_loop)
+    closest = min(_kinship(row, spec, loop) for row in same)
+    efficiency = parallel_efficiency(rows) if closest[2] else 1.0
+    for row in same:
+        if _kinship(row, spec, loop) != closest:
+            continue
         scale = reach / _reach(spec.solver, row["scene"])
+        if _threads(row) != int(spec.threads):  # each thread beyond one gains the host's measured efficiency
+            scale *= _speedup(_threads(row), efficiency) / _speedup(int(spec.threads), efficiency)
         pts.setdefault(int(row["n_particles"]), []).append(scale * step_seconds(row["stages"], row["steps"]))
     pts = {n: float(np.median(v)) for n, v in pts.items() if n > 0 and min(v) > 0}
     if not pts:
@@ -113,6 +152,10 @@ def step_model(spec, rows: list[dict]):
         b = solver_class(spec.solver).order
     a = float(t[-1] / n[-1] ** b)
     return a, b, [int(k) for k in n]
+
+
+def _speedup(threads: int, efficiency: float) -> float:
+    return threads * efficiency if threads > 1 else 1.0
 
 
 def predicted_seconds(spec, rows: list[dict], cached: bool | None = None):
