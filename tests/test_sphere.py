@@ -53,15 +53,16 @@ def test_the_bodys_particles_are_massless_and_stay_silent():
     assert np.all(np.isfinite(a["drho"][fluid])) and np.abs(a["u"][fluid]).max() > 0
 
 
-@pytest.mark.parametrize("command", ["accuracy", "advise"])
-def test_the_commands_that_predict_refuse_the_sphere_in_one_line(command, capsys):
+@pytest.mark.tier2  # the series' spectrum, 7 s
+def test_accuracy_predicts_the_sphere_at_its_own_end_time(capsys):
+    """``accuracy --scene sphere``: the bulk's share of the probes' error (the series with the method's dispersion,
+    the wall exact), at the scene's own --t-end (the window's end, 4 s) when none is given."""
+    import json
+
     from .conftest import cli_main
 
-    args = ["--scene", "sphere", "--t-end", "4"]
-    args += (
-        ["--error", "0.02"]
-        if command == "advise"
-        else ["--dx", "0.1", *"--kernel laguerre-gauss --cutoff 4 --h-factor 1.5 --correction gradient".split()]
-    )
-    rc, out, err = cli_main(command, *args, capsys=capsys)
-    assert rc == 2 and "no prediction yet" in err and len(err.strip().splitlines()) == 1, err
+    method = "--kernel laguerre-gauss --cutoff 4 --h-factor 1.5 --correction gradient --cfl 0.5".split()
+    rc, out, err = cli_main("accuracy", "--scene", "sphere", "--dx", "0.1", *method, "--json", capsys=capsys)
+    assert rc == 0, err
+    got = json.loads(out)
+    assert got["t_end"] == pytest.approx(4.0) and 0.05 < got["predicted_error"] < 0.5, got

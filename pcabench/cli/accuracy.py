@@ -9,6 +9,7 @@ from pcabench.spec import OptionError
 from solvers import (
     DEFAULT_SCENE,
     Scene,
+    scene_kind,
 )
 
 
@@ -19,7 +20,7 @@ def cmd_accuracy(args) -> int:
     check_wall_option([given.get("name", DEFAULT_SCENE)], "x_max" in given)
     scene = Scene(  # the prediction builds the scene's lattice: bounded by this process's memory, as a run is
         dx=args.dx,
-        t_end=args.t_end,
+        t_end=args.t_end if args.t_end is not None else scene_kind(given.get("name", DEFAULT_SCENE)).t_end,
         model="linear",
         memory_limit_bytes=memory.available_memory_bytes(),
         probes=tuple(getattr(args, "probe", None) or ()),  # checked as a run checks them (in the body: refused)

@@ -224,6 +224,8 @@ def _advise(args) -> int:
 
     if not 0 < args.error <= 1:
         raise OptionError(f"--error is a relative RMS error in (0, 1] (got {args.error:g})")
+    if args.t_end is None:
+        args.t_end = scene_kind(args.scene).t_end
     if not args.t_end > 0:
         raise OptionError(f"--t-end is a physical time in s, > 0 (got {args.t_end:g})")
     if args.domain == "strip" and not scene_kind(args.scene).strip:  # before any work, as a run refuses it

@@ -30,9 +30,17 @@ from solvers import (
     MODELS,
     Scene,
     registry,
+    scene_kind,
     scene_names,
 )
 from solvers.edges import OPEN_EDGES
+
+
+def t_end_words() -> str:
+    """The scenes' own --t-end for accuracy and advise, as help says it: "10 s; sphere 4 s"."""
+    usual = scene_kind(DEFAULT_SCENE).t_end
+    other = [f"{name} {scene_kind(name).t_end:g} s" for name in scene_names() if scene_kind(name).t_end != usual]
+    return "; ".join([f"{usual:g} s", *other])
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -184,7 +192,7 @@ def add_accuracy(sub) -> None:
         "with no simulation (for fixed and lagrangian: their linear part).",
     )
     p.add_argument("--dx", type=number("--dx"), required=True, help="lattice spacing, m")
-    p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical end time, s (default 10)")
+    p.add_argument("--t-end", type=number("--t-end"), help=f"physical end time, s (default: the scene's, {t_end_words()})")
     add_problem_options(p)
     add_method_options(p)
     p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")
@@ -206,7 +214,7 @@ def add_advise(sub, results_help: str) -> None:
         required=True,
         help="relative RMS error of the scene's primary field (u; drho in 2D), e.g. 0.01",
     )
-    p.add_argument("--t-end", type=number("--t-end"), default=10.0, help="physical time, s (default 10)")
+    p.add_argument("--t-end", type=number("--t-end"), help=f"physical time, s (default: the scene's, {t_end_words()})")
     p.add_argument(
         "--model",
         choices=MODELS,

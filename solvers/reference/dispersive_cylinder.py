@@ -35,10 +35,11 @@ def isotropic_symbol(scene, k) -> np.ndarray:
     return magnitude @ weights / weights.sum()
 
 
-def method_factor(scene):
+def method_factor(scene, magnitude=isotropic_symbol):
     """(k, t) -> array (len(t), len(k)): drho of a standing mode of wavenumber k from rest (drho 1, u 0) after
     the steps that reach each time ``t`` (a multiple of the scene's dt), stepped by the scene's integrator with
-    the direction-averaged symbol: the method's cos(c0 k t)."""
+    the direction-averaged symbol ``magnitude(scene, k)`` (1/m; the square lattice's by default): the method's
+    cos(c0 k t)."""
     dt, integrator = scene.dt, scene.integrator
 
     def factor(k, t) -> np.ndarray:
@@ -47,7 +48,7 @@ def method_factor(scene):
         n = np.rint(t / dt).astype(np.int64)
         if np.any(n < 0) or np.any(np.abs(n * dt - t) > 1e-6 * dt + 1e-9 * np.abs(t)):
             raise ValueError(f"the method's evolution is known at multiples of dt = {dt:g} s only")
-        d = isotropic_symbol(scene, k)
+        d = magnitude(scene, k)
         first = step_matrices(integrator, d, scene.rho0, scene.c0, dt, first=True)
         rest = step_matrices(integrator, d, scene.rho0, scene.c0, dt)
         state = np.zeros((k.size, 4), dtype=complex)

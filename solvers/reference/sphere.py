@@ -142,10 +142,13 @@ def drho(
     orders: int | None = None,
     k_nodes: int = K_NODES,
     r_nodes: int = R_NODES,
+    factor=None,
 ) -> np.ndarray:
     """drho (kg/m^3) at ``points`` ((m, 3), m, the sphere's centre at the origin, outside it) and ``times`` (s):
     an (m, len(times)) array, for the pulse of ``width`` b and ``amplitude`` A centred at (``distance``, 0, 0)
-    about a rigid sphere of ``radius`` a."""
+    about a rigid sphere of ``radius`` a. ``factor(k, t)`` (an array (len(t), len(k))) replaces each wavenumber's
+    cos(c0 k t), the free pulse's included (then by its k integral, :func:`free_pulse`): a method's own evolution
+    (solvers/reference/dispersive_sphere.py)."""
     sp = _special()
     pts = np.atleast_2d(np.asarray(points, dtype=np.float64))
     ts = np.atleast_1d(np.asarray(times, dtype=np.float64))
@@ -155,7 +158,8 @@ def drho(
     cos_theta = np.clip(pts[:, 0] / np.maximum(r, 1e-300), -1.0, 1.0)
     orders = orders_needed(radius, distance, width) if orders is None else orders
     k, wk, coef_j, coef_y = _spectrum(radius, distance, width, orders, k_nodes, r_nodes)
-    waves = np.cos(c0 * k[:, None] * ts[None, :]) * wk[:, None]  # (k, t)
+    evolution = np.cos(c0 * k[:, None] * ts[None, :]) if factor is None else np.asarray(factor(k, ts)).T
+    waves = evolution * wk[:, None]  # (k, t)
     kr = r[:, None] * k[None, :]
     out = np.zeros((len(r), len(ts)))
     for n in range(orders):
@@ -164,7 +168,21 @@ def drho(
             term = sp.spherical_jn(n, kr) * coef_j[n] + np.where(coef_y[n] != 0.0, y * coef_y[n], 0.0)
         term = np.nan_to_num(term, nan=0.0, posinf=0.0, neginf=0.0)
         out += ((2 * n + 1) * sp.eval_legendre(n, cos_theta))[:, None] * (term @ waves)
-    free = np.array(
-        [open_pulse(np.linalg.norm(pts - [distance, 0.0, 0.0], axis=1), t, width, 1.0, 1.0, c0)[0] for t in ts]
-    ).T
+    from_source = np.linalg.norm(pts - [distance, 0.0, 0.0], axis=1)
+    if factor is None:
+        free = np.array([open_pulse(from_source, t, width, 1.0, 1.0, c0)[0] for t in ts]).T
+    else:
+        free = free_pulse(from_source, width, k, wk, evolution)
     return amplitude * (free + out)
+
+
+def free_pulse(distance, width: float, k, wk, evolution) -> np.ndarray:
+    """The free unit Gaussian exp(-ln2 R^2 / b^2) (b = ``width``, m) at ``distance`` R (m) from its centre, evolved
+    by ``evolution``
+    (an array (len(k), len(t)), cos(c0 k t) for the exact pulse): (1 / 2 pi^2) int g(k) j_0(k R) evolution k^2 dk,
+    g(k) = (pi / alpha)^1.5 exp(-k^2 / 4 alpha), alpha = ln2 / b^2, on the series' k nodes (``wk``: the weights
+    times (2 / pi) k^2). An (len(R), len(t)) array."""
+    sp = _special()
+    alpha = LN2 / width**2
+    spectrum = (math.pi / alpha) ** 1.5 * np.exp(-(k**2) / (4.0 * alpha)) * wk / (4.0 * math.pi)
+    return sp.spherical_jn(0, np.multiply.outer(np.asarray(distance, float), k)) @ (spectrum[:, None] * evolution)

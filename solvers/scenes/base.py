@@ -184,6 +184,7 @@ class SceneKind:
     primary: str = "u"
     has_isothermal: bool = False  # scored against the isothermal solution too (the lagrangian model's physics)
     strip: bool = False  # whether a y-periodic strip gives the same answer (the fields do not depend on y)
+    t_end: float = 10.0  # s: the physical time ``accuracy`` and ``advise`` ask about when --t-end is not given
 
     # the periodic axes whose seams are the images of an open problem (a square of images), so that an open
     # edge there gives the open problem itself; a strip's y is a slice of a plane wave and stays periodic
