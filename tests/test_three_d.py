@@ -449,3 +449,20 @@ def test_a_3d_run_stores_its_z_plane_and_a_malformed_plane_reads_back_as_none(tm
     assert flat.status == "ok" and flat.plane == {}
     row = {**rec.as_dict(), "plane": {**rec.plane, "drho": [[1.0, "x"], [2.0, 3.0]]}}
     assert RunRecord.from_row(row).plane == {}
+
+
+def test_the_3d_pulses_front_is_sized_for_a_cube_and_a_body_scene_names_its_own_study():
+    """`study --front --scene acoustic-pulse-3d`: every run a valid scene on the 16 m cube (the 2D product's dx and
+    h would ask for 4 million particles and cutoffs wider than the cube allows), every kernel, the paper's method
+    beside; the sphere's front is refused in one line naming the 3D study."""
+    from pcabench import studies
+    from pcabench.studies.front.plan import front
+    from solvers import kernel_names
+
+    runs = studies.preset("front", "acoustic-pulse-3d")
+    assert runs and {s.scene.name for s in runs} == {"acoustic-pulse-3d"}
+    assert max(s.scene.n_particles for s in runs) <= 32_768 and {s.scene.kernel for s in runs} == set(kernel_names())
+    assert any(s.scene.kernel == "gaussian" and s.scene.h_factor == Scene.default("h_factor") for s in runs)
+    with pytest.raises(SceneError) as err:
+        front("quick", "sphere")
+    assert "pcabench study --three-d" in str(err.value) and "\n" not in str(err.value)

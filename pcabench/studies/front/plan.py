@@ -1,4 +1,5 @@
-"""The speed-accuracy fronts (``--front quick``, ``--front full``): time to solution against error at t = 10 s."""
+"""The speed-accuracy fronts (``--front quick``, ``--front full``): time to solution against error at t = 10 s, on
+the strip, a 2D scene or a 3D one."""
 
 from __future__ import annotations
 
@@ -70,6 +71,33 @@ FRONT_2D = {
     ),
 }
 PAPER_METHOD_2D_DX = (0.2, 0.1)
+# The 3D pulse's front (its 16 m triply periodic cube, t = 10 s, serial): the 2D pulse's axes at the cube's
+# sizes (dx 1 and 0.5: 4,096 and 32,768 particles) and at the smaller h a 3D neighbourhood affords (h 1.6 dx
+# holds 4 pi / 3 (3 h / dx)^3 = 463 neighbours for the Gaussian; the paper's h 2.13 dx, 1,093, and a 3 h cutoff
+# 19 m across at dx 1: wider than the cube's 3 cutoffs allow), the paper's method at dx 0.5 beside them.
+FRONT_3D = {
+    "quick": dict(
+        h_factor=(1.3, 1.6),
+        cfl=(0.2, 1.0, 3.0),
+        dx=(1.0, 0.5),
+        precision=("float64",),
+        model=("linear", "lagrangian"),
+    ),
+    "full": dict(
+        h_factor=(1.0, 1.3, 1.6),
+        cfl=(0.2, 0.5, 1.0, 2.0, 3.0, 4.0),
+        dx=(1.0, 0.5, 0.25),
+        precision=("float64", "float32"),
+        model=("linear", "lagrangian"),
+    ),
+}
+PAPER_METHOD_3D_DX = (0.5,)
+# a scene with a body: its runs against dx are its own study's (its dx must resolve the body)
+BODY_STUDIES = {
+    "cylinder": "`pcabench study --cylinder` (kernels and boundary methods against dx at the workshop's probes)",
+    "sphere": "`pcabench study --three-d` (the high-order method against dx at the probes; `--three-d fine` the "
+    "issue's dx 0.05)",
+}
 # Which model a scene needs: the paper's method at these amplitudes, linear against lagrangian, scored against
 # the isothermal physics (its error floor for `linear` grows with the amplitude).
 MODEL_MACH = (0.005, 0.05, 0.15)
@@ -89,8 +117,9 @@ def model_needs(scene: str) -> list[RunSpec]:
 
 def front_axes(size: str = "quick", scene: str = DEFAULT_SCENE) -> dict:
     """The front's axes on ``scene``: every registered kernel (solvers/kernels/), then FRONT's (a scene a strip
-    serves: the plane pulses) or FRONT_2D's."""
-    return {"kernel": kernel_names(), **(FRONT if scene_kind(scene).strip else FRONT_2D)[size]}
+    serves: the plane pulses), FRONT_3D's (a 3D scene) or FRONT_2D's."""
+    kind = scene_kind(scene)
+    return {"kernel": kernel_names(), **(FRONT if kind.strip else FRONT_3D if kind.dims == 3 else FRONT_2D)[size]}
 
 
 def front(size: str = "quick", scene: str = DEFAULT_SCENE, fast: bool = True) -> list[RunSpec]:
@@ -100,13 +129,11 @@ def front(size: str = "quick", scene: str = DEFAULT_SCENE, fast: bool = True) ->
     other: its own product (FRONT_2D) on its own domain and the paper's method beside it. Then, on a scene with
     an isothermal reference, which model it needs at several amplitudes."""
     kind = scene_kind(scene)
-    if kind.body:  # its dx must resolve the body: its front is the cylinder preset (with the advised method)
+    if kind.body:  # its dx must resolve the body: its front is its own study's (with the advised method)
         from solvers import SceneError
 
-        raise SceneError(
-            f"--front: the {scene} scene's front is `pcabench study --cylinder` (kernels and boundary methods "
-            "against dx at the workshop's probes); advise reads it"
-        )
+        study = BODY_STUDIES.get(scene, "its own study")
+        raise SceneError(f"--front: the {scene} scene's runs against dx are {study}; advise reads them")
     axes = front_axes(size, scene)
     names = [k for k in axes if k != "dx"]
     runs = [
@@ -123,7 +150,7 @@ def front(size: str = "quick", scene: str = DEFAULT_SCENE, fast: bool = True) ->
         runs += [
             spec_of(name=scene, dx=dx, t_end=FRONT_T_END, model=model)
             for model in ("linear", "lagrangian")
-            for dx in PAPER_METHOD_2D_DX
+            for dx in (PAPER_METHOD_3D_DX if kind.dims == 3 else PAPER_METHOD_2D_DX)
         ]
     return runs + (model_needs(scene) if kind.has_isothermal else [])
 
