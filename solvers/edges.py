@@ -114,12 +114,6 @@ class Edges:
         except ValueError as exc:
             yield str(exc)
             return
-        if split and scene.kind.dims == 3:
-            yield (
-                f"--absorber {self.absorber_used(scene)}: a 3D scene's faces take --absorber sponge "
-                "(its PML is to come)"
-            )
-            return
         for name in ("layer_width", "absorber_strength"):
             value = getattr(self, name)
             if value is None:

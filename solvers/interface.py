@@ -370,16 +370,15 @@ class Solver(abc.ABC):
         for model in self.boundary_models:
             model.damp(self, f, fields)
 
-    def continuity_x(self) -> None:
-        """The x part of the continuity rate into ``ddx`` (a split absorber's: the PML): the same sweep with
-        v = 0, the rate being linear in the velocities (the coefficients are the ones just computed)."""
-        a = self.arrays
-        v, dd = a["v"], a["dd"]
-        a["v"], a["dd"] = self.no_velocity, a["ddx"]
-        try:
-            self._sweep(True, False)
-        finally:
-            a["v"], a["dd"] = v, dd
+    def continuity_parts(self) -> None:
+        """A split absorber's (the PML's) parts of the continuity rate: the x part into ``ddx`` (and in 3D the y
+        part into ``ddy``), each the same sweep with the other velocity components zero, the rate being linear in
+        the velocities (the coefficients are the ones just computed)."""
+        a, velocity = self.arrays, VELOCITY[self.scene.dims]
+        for axis, rate in enumerate(self.layer.rates):
+            others = {name: self.no_velocity for i, name in enumerate(velocity) if i != axis}
+            with self.swapped(dd=a[rate], **others):
+                self._sweep(True, False)
 
     def save(self) -> None:
         """Keep a copy of the state (for two-stage integrators)."""

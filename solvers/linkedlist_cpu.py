@@ -155,10 +155,10 @@ class LinkedListCPU(CellListSolver):
         self.spare = arr
         return out
 
-    def continuity_x(self) -> None:
+    def continuity_parts(self) -> None:
         """The pair list computed the x part with the rate (:meth:`_sweep`); the gather loop sweeps again."""
         if self.pairs is None:
-            super().continuity_x()
+            super().continuity_parts()
 
     def moments(self) -> tuple:
         """The gradient correction's moments. Moving particles (at every search): from the pair list (its
@@ -182,7 +182,7 @@ class LinkedListCPU(CellListSolver):
         a = self.arrays
         if continuity:
             parts = [(a["v"], a["dd"])]  # (v, the rate): the whole rate, and a split absorber's x part (v = 0)
-            if self.split and a["dd"] is not a["ddx"]:  # the x part in the same pass (continuity_x: nothing left)
+            if self.split and a["dd"] is not a["ddx"]:  # the x part in the same pass (continuity_parts: nothing left)
                 parts.append((self.no_velocity, a["ddx"]))
                 self.pairs.continuity_split(a["u"], a["v"], a["vol"], a["drho"], a["dd"], a["ddx"], self.k)
             else:

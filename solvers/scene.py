@@ -64,6 +64,7 @@ PAPER_DEPTH = {"z_min": -10.0, "z_max": 10.0}  # a 3D kind's where it states non
 # Arrays a 3D particle holds beyond a 2D one's: its z lattice coordinate and displacement, w, the z rate (and their
 # copies and sums), counted generously like FLOAT_ARRAYS_PER_PARTICLE
 FLOAT_ARRAYS_3D = 8
+PML_ARRAYS_3D = 5  # drho_x, drho_y, ddx, ddy and the zero velocity of a part's sweep
 # Parameters whose default is the scene kind's where it states one (SceneKind.defaults), else these (the paper's;
 # a body's radius only where the kind has a body).
 PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
@@ -731,8 +732,15 @@ class Scene:
 
     @property
     def arrays_3d(self) -> int:
-        """Arrays per particle a 3D scene holds beyond a 2D one's (FLOAT_ARRAYS_3D; 0 in 2D)."""
-        return FLOAT_ARRAYS_3D if self.dims == 3 else 0
+        """Arrays per particle a 3D scene holds beyond a 2D one's (FLOAT_ARRAYS_3D, and a PML's parts and rates
+        of drho and its zero velocity, PML_ARRAYS_3D; 0 in 2D)."""
+        if self.dims != 3:
+            return 0
+        try:
+            split = bool(self.open) and self.edges.absorber_model(self).split
+        except ValueError:  # an unknown absorber: refused by the edges' check
+            split = False
+        return FLOAT_ARRAYS_3D + (PML_ARRAYS_3D if split else 0)
 
     @property
     def extra_arrays(self) -> int:

@@ -103,13 +103,13 @@ def test_every_cpu_solver_and_pair_loop_runs_free_y_edges_alike(model, absorber)
 
 
 class TwoSweeps(LinkedListCPU):
-    """The pair list with the PML's x part by a second sweep with v = 0 (``Solver.continuity_x``, as the gather
-    loop, the all-pair and the GPU solvers compute it) instead of in the rate's own pass."""
+    """The pair list with the PML's x part by a second sweep with v = 0 (``Solver.continuity_parts``, as the
+    gather loop, the all-pair and the GPU solvers compute it) instead of in the rate's own pass."""
 
     name = "two-sweeps"
 
-    def continuity_x(self):
-        Solver.continuity_x(self)
+    def continuity_parts(self):
+        Solver.continuity_parts(self)
 
 
 @pytest.mark.parametrize("threads", [1, 2])

@@ -6,9 +6,10 @@ advance of drho), before it and after it, the solver computes for each particle 
 two axes, fx = exp(-sigma(depth_x) h / 2) and fy = exp(-sigma(depth_y) h / 2) (depth: how far the particle is
 beyond the domain's x or y edge, 0 inside; sigma from the absorber's profile and strength, its own default
 unless ``Scene.absorber_strength`` says otherwise; 1 on a closed axis), and the absorber applies them to the
-fields of that update (:meth:`Absorber.damp`): a sponge multiplies them by fx fy; a split-field PML damps each
-field by its own axis's factor and needs the continuity rate split by axis (``split``: the solver then also
-computes the x part of d(drho)/dt, ``ddx``, and carries the x part of drho, ``drho_x``, as particle arrays).
+fields of that update (:meth:`Absorber.damp`): a sponge multiplies them by fx fy (fz); a split-field PML damps
+each field by its own axis's factor and needs the continuity rate split by axis (``split``: the solver then also
+computes the x part of d(drho)/dt, ``ddx``, and carries the x part of drho, ``drho_x``, as particle arrays; in 3D
+the y parts too, ``ddy`` and ``drho_y``, the z part being what is left).
 
 Why around each update and not after the step: an update damped symmetrically, f (u + h a) f, reads
 s (u' - u) + d (u' + u) = h a with s = cosh(sigma h / 2) >= 1 and d = sinh(sigma h / 2) >= 0 per particle, the
@@ -28,9 +29,9 @@ FIELDS = {"velocity": ("u", "v", "w"), "density": ("drho",)}  # what each update
 class Absorber:
     """An absorbing layer: ``sigma(depth, width, strength, xp)`` in 1/s, ``depth`` and ``width`` in m (arrays of
     the solver's module: numpy or CuPy), 0 at depth 0; ``default_strength(scene)``: the strength (1/s) a scene
-    gets when it names none; ``damp(arrays, fx, fy, fields)``: ``fields`` ("velocity": u and v; "density":
-    drho) damped by the factors, in place (a GPU solver's arrays are views of one block). The base class damps
-    like a sponge."""
+    gets when it names none; ``damp(arrays, factors, fields)``: ``fields`` ("velocity": u, v (and w); "density":
+    drho) damped by the factors, one per axis (fx, fy, and fz in 3D), in place (a GPU solver's arrays are views of
+    one block). The base class damps like a sponge."""
 
     name: str = ""
     summary: str = ""
@@ -48,9 +49,11 @@ class Absorber:
     def sigma(self, depth, width: float, strength: float, xp):
         raise NotImplementedError
 
-    def damp(self, arrays, fx, fy, fields: str) -> None:
-        """The fields times fx fy: every field damped at the rate of both axes together."""
-        factor = fx * fy
+    def damp(self, arrays, factors: tuple, fields: str) -> None:
+        """The fields times fx fy (fz): every field damped at the rate of every axis together."""
+        factor = factors[-1]
+        for f in reversed(factors[:-1]):  # fx (fy fz): the product in one order for every solver
+            factor = f * factor
         for name in FIELDS[fields]:
             if name in arrays:
                 arrays[name] *= factor

@@ -13,7 +13,7 @@ from __future__ import annotations
 from solvers.bodies.base import ENTRY_DEPTH, FLUID, INERT, BodyEntered
 from solvers.boundaries.base import Boundary
 
-FIELDS = ("u", "v", "w", "drho")
+FIELDS = ("u", "v", "w", "drho", "drho_x", "drho_y")  # with a PML's parts of drho where the layer carries them
 
 
 class RigidBody3D(Boundary):
@@ -36,7 +36,8 @@ class RigidBody3D(Boundary):
         inside = (x - self.x0) ** 2 + (y - self.y0) ** 2 + z**2 < self.a**2
         a["role"] = xp.where(inside, INERT, FLUID).astype(dt)
         for name in FIELDS:
-            a[name][inside] = 0
+            if name in a:
+                a[name][inside] = 0
         a["mass"][inside] = 0  # no volume: no sum counts the inert particles
         self.n_inert = int(inside.sum())
 
@@ -49,7 +50,8 @@ class RigidBody3D(Boundary):
         a = solver.arrays
         inert = self.inert(solver)
         for name in FIELDS:
-            a[name][inert] = 0
+            if name in a:
+                a[name][inert] = 0
         if solver.moving:
             self.check_entered(solver, inert)
         return True

@@ -5,7 +5,8 @@ holds the layer's columns (rows) beyond the domain (``Scene.n_layer``), whose pa
 each kick and advance the layer damps its fields by half of the update's decay, before and after it (stable at
 the closed scene's CFL: solvers/absorbers/base.py), with a rate sigma rising with each particle's depth beyond the
 domain's edges (:meth:`OpenLayer.factors`). A split absorber (the PML) carries drho's x part ``drho_x`` and its
-rate ``ddx`` (the continuity sweep with v = 0: ``Solver.continuity_x``) as arrays of the state.
+rate ``ddx`` (the continuity sweep with v = 0: ``Solver.continuity_parts``) as arrays of the state; in 3D the y
+part too (``drho_y``, ``ddy``: the sweep with u = w = 0), the z part being what is left.
 """
 
 from __future__ import annotations
@@ -24,8 +25,9 @@ class OpenLayer(Boundary):
         super().__init__(scene)
         self.absorber = absorber_named(scene.absorber_used)
         self.split = bool(self.absorber.split)
-        self.state = ("drho_x",) if self.split else ()
-        self.rates = ("ddx",) if self.split else ()
+        parts = scene.dims - 1 if self.split else 0  # the parts carried: every axis's but the last
+        self.state = ("drho_x", "drho_y")[:parts]
+        self.rates = ("ddx", "ddy")[:parts]
         self.key, self.sigma, self.cache = None, (), {}
 
     @classmethod
@@ -33,28 +35,27 @@ class OpenLayer(Boundary):
         return bool(scene.open)
 
     def start(self, solver, x, y, drho, z=None) -> None:
-        """A split absorber's x parts of drho (half of it) and of its rate (drho_y = drho - drho_x)."""
+        """A split absorber's parts of drho (each axis an equal share: the last axis's is what is left) and of its
+        rate."""
         self.key, self.sigma, self.cache = None, (), {}
         if self.split:
             xp, dt, n = solver.xp, solver.dtype, self.scene.n_particles
-            solver.arrays["drho_x"] = (0.5 * drho).astype(dt)
-            solver.arrays["ddx"] = xp.zeros(n, dt)
-            solver.no_velocity = xp.zeros(n, dt)  # v = 0 for the x part's sweep (never permuted)
+            for part, rate in zip(self.state, self.rates):
+                solver.arrays[part] = (drho / self.scene.dims).astype(dt)
+                solver.arrays[rate] = xp.zeros(n, dt)
+            solver.no_velocity = xp.zeros(n, dt)  # the other components zero in a part's sweep (never permuted)
 
     def damp(self, solver, f: float, fields: str) -> None:
-        factors = self.factors(solver, f)
-        if len(factors) == 3:  # a 3D scene's faces (a sponge: y and z damp together)
-            factors = (factors[0], factors[1] * factors[2])
-        self.absorber.damp(solver.arrays, *factors, fields)
+        self.absorber.damp(solver.arrays, self.factors(solver, f), fields)
 
     def advanced(self, solver, f: float) -> None:
-        """drho_x += f dt ddx: a split absorber's x part of drho, updated with drho."""
-        if self.split:
-            a = solver.arrays
-            a["drho_x"] += solver.dtype.type(f * self.scene.dt) * a["ddx"]
+        """drho_x += f dt ddx (and drho_y += f dt ddy): a split absorber's parts of drho, updated with drho."""
+        a, c = solver.arrays, solver.dtype.type(f * self.scene.dt)
+        for part, rate in zip(self.state, self.rates):
+            a[part] += c * a[rate]
 
     def factors(self, solver, f: float) -> tuple:
-        """(fx, fy): exp(-sigma f dt / 2) of each axis, sigma from each particle's depth beyond the domain's edges
+        """(fx, fy) (and fz in 3D): exp(-sigma f dt / 2) of each axis, sigma from each particle's depth beyond the domain's edges
         (0 inside the domain; 1 on a closed axis), kept until the particles move or are put in a new order."""
         key = (solver.reordered, solver.moves)
         if self.key != key:

@@ -35,10 +35,10 @@ class Correction:
         return continuity, momentum
 
     def sweep(self, solver, continuity: bool, momentum: bool) -> None:
-        """PI's sweeps: dd (continuity, with ddx for a split absorber) and/or ax, ay (momentum)."""
+        """PI's sweeps: dd (continuity, with a split absorber's parts) and/or ax, ay (momentum)."""
         solver._sweep(continuity, momentum)
         if continuity and solver.split:
-            solver.continuity_x()
+            solver.continuity_parts()
 
     def lattice_factor(self, scene) -> float:
         """The factor on the lattice symbol D(k) in a periodic interior (1: none)."""

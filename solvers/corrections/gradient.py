@@ -65,7 +65,7 @@ class GradientCorrection(Correction):
             with solver.swapped(u=wx, v=wy):
                 solver._sweep(True, False)
                 if solver.split:
-                    solver.continuity_x()
+                    solver.continuity_parts()
             # the x part: w's x terms (in the interior, L u_x's); without a split absorber an array never written (the
             # same array twice is two copies in numba's CUDA simulator, the second written back last)
             ddx = a["ddx"] if solver.split else self.unused(solver)
@@ -76,7 +76,8 @@ class GradientCorrection(Correction):
             solver.launch("corrected_momentum", a["ax"], a["ay"], a["drho"], lxx, lxy, lyy, gx, gy, k)
 
     def sweep_3d(self, solver, continuity: bool, momentum: bool) -> None:
-        """:meth:`sweep` in 3D: L (six components) and Gamma (three) from :meth:`factors_3d` (no split absorber)."""
+        """:meth:`sweep` in 3D: L (six components) and Gamma (three) from :meth:`factors_3d`; a split absorber's
+        parts of the rate each w's own component's terms (the sweep's and the pass's, the others zero)."""
         a, k = solver.arrays, solver.k
         lxx, lxy, lxz, lyy, lyz, lzz, gx, gy, gz = factors = self.factors_3d(solver)
         wx, wy, wz = self.scratch(solver, 3)
@@ -84,7 +85,12 @@ class GradientCorrection(Correction):
             solver.launch("corrected_velocity", a["u"], a["v"], a["w"], *factors[:6], wx, wy, wz)
             with solver.swapped(u=wx, v=wy, w=wz):
                 solver._sweep(True, False)
+                if solver.split:
+                    solver.continuity_parts()
             solver.launch("corrected_continuity", a["dd"], a["drho"], wx, wy, wz, gx, gy, gz, k)
+            for axis, rate in enumerate(solver.layer.rates if solver.split else ()):
+                w = tuple(c if i == axis else solver.no_velocity for i, c in enumerate((wx, wy, wz)))
+                solver.launch("corrected_continuity", a[rate], a["drho"], *w, gx, gy, gz, k)
         if momentum:
             with solver.swapped(mass=a["vol"], pr=a["drho"]):
                 solver._sweep(False, True)

@@ -15,7 +15,7 @@ TITLE = "A rigid cylinder (ghost particles)"
 
 @dataclass(frozen=True)
 class Cases:
-    """Every 2D scene kind with a body (the GPU solver's 3D is to come) at its card size (the workshop's cylinder
+    """Every 2D scene kind with a body (the sphere's is the three-d stage's) at its card size (the workshop's cylinder
     at 5 particles a pulse width: 102,400 particles), each boundary method (its ghosts filled from the fluid on the
     host), model and precision."""
 
