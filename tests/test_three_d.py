@@ -304,7 +304,7 @@ def test_the_pml_sends_back_less_than_the_sponge_of_the_same_width():
     assert left["pml"] < 0.5 * left["sponge"] and left["sponge"] < 0.05, left
 
 
-def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_path, monkeypatch):
+def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_path):
     """The report section of ``study --three-d`` from stored records: each method's errors by dx with the
     prediction beside them, the orders, the issue's target line, and a pair's cost (ns per particle-neighbour-
     step) of the 3D run against the 2D one."""
@@ -319,8 +319,6 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     from pcabench.studies.three_d.plan import THREE_D, three_d
     from pcabench.studies.three_d.section import rows, text
     from solvers.scenes.base import plane_z
-
-    monkeypatch.setattr(section, "PREDICTED_UP_TO", 40_000)  # the 262,144-particle lattices not predicted here
 
     path = tmp_path / "results" / store.store_name("m", "h")
     path.parent.mkdir()
@@ -346,7 +344,7 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     data = rows(load_frame(path.parent))
     assert len(data["accuracy"]) == 6 and sorted(r["dims"] for r in data["cost"]) == [2, 2, 3, 3]
     predicted = {r["dx"]: r["predicted"] for r in data["accuracy"] if r["label"].startswith("wendland")}
-    assert predicted[0.25] is None and 0.2 < predicted[1.0] < 0.25 and 0.09 < predicted[0.5] < 0.1  # 0.223, 0.0933
+    assert 0.2 < predicted[1.0] < 0.25 and 0.09 < predicted[0.5] < 0.1 and 0.05 < predicted[0.25] < 0.06  # 0.0564
     words = "\n".join(text(data, None))
     assert "0.000228 at dx 0.25 (262,144 particles), order 4.57 (the issue's target" in words
     assert "at most 0.001 and order 3.5: met)" in words and "| 1.00 / 1.00 |" in words  # Wendland's orders
@@ -498,3 +496,20 @@ def test_the_3d_pulses_front_is_sized_for_a_cube_and_a_body_scene_names_its_own_
     with pytest.raises(SceneError) as err:
         front("quick", "sphere")
     assert "pcabench study --three-d" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_the_3d_prediction_evolves_only_the_pulses_modes_and_loses_nothing():
+    """The periodic cube's prediction evolves the modes holding more than 1e-16 of the spectrum's largest (a ball
+    of a few thousand whatever dx): the same error as every mode evolved, to 1e-12 (the floor at 0 evolves them
+    all, as before)."""
+    from solvers.reference import dispersion3d
+
+    scene = small(model="linear", t_end=2.0)
+    kept = dispersion3d.predict(scene, scene.kind).predicted_error
+    every = dispersion3d.SPECTRUM_FLOOR
+    try:
+        dispersion3d.SPECTRUM_FLOOR = -1.0
+        full = dispersion3d.predict(scene, scene.kind).predicted_error
+    finally:
+        dispersion3d.SPECTRUM_FLOOR = every
+    assert kept == pytest.approx(full, rel=1e-12) and 0 < full < 1, (kept, full)

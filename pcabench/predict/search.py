@@ -124,7 +124,9 @@ def suggest(
                     closest = (trial, p)
                 if p.predicted_error > asked:
                     continue
-                cost = (1 / dx) ** (1 if kind.strip else 2) * trial.n_steps * (trial.cutoff / dx) ** 2
+                # particles x steps x neighbours: a strip's particles go as 1 / dx, a plane's as its square, a
+                # cube's as its cube, and the neighbours as the cutoff's disc or ball
+                cost = (1 / dx) ** (1 if kind.strip else kind.dims) * trial.n_steps * (trial.cutoff / dx) ** kind.dims
                 cost *= step_weight(trial)
                 if best is None or cost < best[0]:
                     best = (cost, trial, p)
@@ -170,7 +172,8 @@ def suggest(
                     *method_words(s),
                     "--dx",
                     f"{s.dx:g}",
-                    *([] if kind.body else [f"{s.dx / 2:g}"]),  # a body's dx is fine already: its own run only
+                    # a body's dx is fine already, and half a 3D dx is eight times its particles: its own run only
+                    *([] if kind.body or kind.dims == 3 else [f"{s.dx / 2:g}"]),
                 ]
             ),
         )
