@@ -110,7 +110,7 @@ class Edges:
                     return
             return
         try:
-            split = self.absorber_model(scene).split  # first: a known absorber (the default layer is the absorber's)
+            self.absorber_model(scene)  # first: a known absorber (the default layer is the absorber's)
         except ValueError as exc:
             yield str(exc)
             return

@@ -192,7 +192,9 @@ def add_accuracy(sub) -> None:
         "with no simulation (for fixed and lagrangian: their linear part).",
     )
     p.add_argument("--dx", type=number("--dx"), required=True, help="lattice spacing, m")
-    p.add_argument("--t-end", type=number("--t-end"), help=f"physical end time, s (default: the scene's, {t_end_words()})")
+    p.add_argument(
+        "--t-end", type=number("--t-end"), help=f"physical end time, s (default: the scene's, {t_end_words()})"
+    )
     add_problem_options(p)
     add_method_options(p)
     p.add_argument("--json", action="store_true", help="one JSON object: predicted_error, stable_cfl, ...")

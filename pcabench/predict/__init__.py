@@ -92,6 +92,8 @@ def parallel_efficiency(rows: list[dict]) -> float:
             threaded.append((key, _threads(row), step))
     ratios = [min(serial[k]) / step / n for k, n, step in threaded if k in serial and step > 0]
     return float(np.median(ratios)) if ratios else 1.0
+
+
 def _dims(scene: dict) -> int:
     """The dimension of a stored scene (its kind's; 2 for a name this checkout does not know)."""
     from solvers import scenes
