@@ -19,8 +19,8 @@ class PML(Absorber):
 
     drho = drho_x + drho_y; in 3D the same with w, sigma_z and drho_z, drho_x and drho_y carried and drho_z the
     rest (the 3D faces' PML: the sweep's x and y parts, two sweeps with the other components zero). In the
-    continuum a wave enters it without reflection at any angle and frequency and decays as exp(-int sigma_x dx / (c0 cos theta)); the sponge damps every field at sigma_x + sigma_y, which
-    reflects at the onset and at low frequency (the 2D pulse's wake). The x part of the SPH continuity sum is
+    continuum a wave enters it without reflection at any angle and frequency and decays as
+    exp(-int sigma_x dx / (c0 cos theta)); the sponge damps every field at sigma_x + sigma_y, which reflects at the onset and at low frequency (the 2D pulse's wake). The x part of the SPH continuity sum is
     the same sweep with v = 0 (the rate is linear in the velocities), computed by the solver (``split``) and
     carried in ``drho_x`` through the integrator's updates; each field is damped around its own updates
     (solvers/absorbers/base.py). The profile is the sponge's, sigma = strength (depth / width)^2."""

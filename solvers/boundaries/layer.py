@@ -56,7 +56,8 @@ class OpenLayer(Boundary):
 
     def factors(self, solver, f: float) -> tuple:
         """(fx, fy) (and fz in 3D): exp(-sigma f dt / 2) of each axis, sigma from each particle's depth beyond the
-        domain's edges (0 inside the domain; 1 on a closed axis), kept until the particles move or are put in a new order."""
+        domain's edges (0 inside the domain; 1 on a closed axis), kept until the particles move or are put in a
+        new order."""
         key = (solver.reordered, solver.moves)
         if self.key != key:
             self.key, self.sigma, self.cache = key, self.rates_now(solver), {}
