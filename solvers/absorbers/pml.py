@@ -17,13 +17,14 @@ class PML(Absorber):
         d(drho_x)/dt = -rho0 du/dx - sigma_x drho_x,   d(drho_y)/dt = -rho0 dv/dy - sigma_y drho_y,
         du/dt = -(c0^2 / rho0) d(drho)/dx - sigma_x u,  dv/dt = -(c0^2 / rho0) d(drho)/dy - sigma_y v,
 
-    drho = drho_x + drho_y; in 3D the same with w, sigma_z and drho_z, drho_x and drho_y carried and drho_z the
-    rest (the 3D faces' PML: the sweep's x and y parts, two sweeps with the other components zero). In the
-    continuum a wave enters it without reflection at any angle and frequency and decays as
-    exp(-int sigma_x dx / (c0 cos theta)); the sponge damps every field at sigma_x + sigma_y, which reflects at the onset and at low frequency (the 2D pulse's wake). The x part of the SPH continuity sum is
-    the same sweep with v = 0 (the rate is linear in the velocities), computed by the solver (``split``) and
-    carried in ``drho_x`` through the integrator's updates; each field is damped around its own updates
-    (solvers/absorbers/base.py). The profile is the sponge's, sigma = strength (depth / width)^2."""
+    drho = drho_x + drho_y; in 3D the same with w, sigma_z and drho_z, drho_x and drho_y carried and drho_z the rest
+    (the 3D faces' PML: the sweep's x and y parts, two sweeps with the other components zero). In the continuum a
+    wave enters it without reflection at any angle and frequency and decays as exp(-int sigma_x dx / (c0 cos
+    theta)); the sponge damps every field at sigma_x + sigma_y, which reflects at the onset and at low frequency
+    (the 2D pulse's wake). The x part of the SPH continuity sum is the same sweep with v = 0 (the rate is linear in
+    the velocities), computed by the solver (``split``) and carried in ``drho_x`` through the integrator's updates;
+    each field is damped around its own updates (solvers/absorbers/base.py). The profile is the sponge's, sigma =
+    strength (depth / width)^2."""
 
     name = "pml"
     summary = "split-field perfectly matched layer: u, drho_x damped by sigma_x, v, drho_y by sigma_y"

@@ -16,7 +16,8 @@ apart (the lattice's phase error depends on the direction of travel).
 With ``--open xyz`` its six faces open onto a sponge layer (solvers/absorbers/sponge.py; ``--absorber pml`` the
 split-field PML, which sends back a quarter of the sponge's energy at the same width): the pulse is alone in open
 space (no images), scored against the closed form at the scored sites while it is inside the cube (``rms_drho``),
-then by what the faces left behind (``left_energy``, the error's acoustic energy over the initial pulse's, and ``left_amplitude``).
+then by what the faces left behind (``left_energy``, the error's acoustic energy over the initial pulse's, and
+``left_amplitude``).
 """
 
 from __future__ import annotations
