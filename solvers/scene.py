@@ -440,12 +440,12 @@ class Scene:
             method = boundary_method_named(self.boundary_method_used)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
-        if self.dims == 3:  # a body in 3D: the weak wall alone (the ghost bodies place particles in a plane)
+        if self.dims == 3:  # a body in 3D: the weak walls alone (the ghost bodies place particles in a plane)
             need(
-                method.name == CORRECTED_BODY_3D,
+                3 in getattr(method, "dims", (2,)),
                 ("" if self.boundary_method else "standard SPH's body, ")
                 + f"--boundary-method {method.name}: the {self.name} scene's body is 3D, whose wall is "
-                f"--boundary-method {CORRECTED_BODY_3D} alone (the ghost bodies are 2D's); it needs a kernel "
+                f"--boundary-method {CORRECTED_BODY_3D} (or cut) alone (the ghost bodies are 2D's); it needs a kernel "
                 "correction: add --correction gradient (the high-order method: --kernel laguerre-gauss --cutoff 4 "
                 "--h-factor 1.5 --correction gradient)",
             )

@@ -18,6 +18,7 @@ FLUID, GHOST, INERT = 0.0, 1.0, 2.0  # a particle's role (the solver's ``role`` 
 # A fluid particle has entered the body once it is this many spacings below the surface: where the ghosts' outer
 # ring sits (a lattice site can start on the surface itself and move in by round-off, which is no entry).
 ENTRY_DEPTH = 0.5
+SUBCELLS = {2: 16, 3: 12}  # points a side at which a cell the surface may cut is sampled (256 and 1,728 a cell)
 
 
 class BodyEntered(RuntimeError):
@@ -38,6 +39,7 @@ class BoundaryMethod:
 
     name: str = ""
     summary: str = ""
+    dims: tuple = (2,)  # the dimensions of the bodies it models (the ghost bodies place particles in a plane)
     needs_correction: bool = False  # whether it makes a wall only with a kernel correction (solvers/corrections/)
     # Where its wall is known to blow up with a kernel correction: what was measured, one clause ("" where it holds)
     fails_with_correction: str = ""
@@ -47,6 +49,15 @@ class BoundaryMethod:
         sites are ghosts and which inert (boolean arrays), and the ghosts' positions (m, in the order of their
         sites)."""
         raise NotImplementedError
+
+    def entry_depth(self, dims: int) -> float:
+        """How many spacings below the surface a fluid particle has entered the body (:data:`ENTRY_DEPTH`)."""
+        return ENTRY_DEPTH
+
+    def volume_fractions(self, scene, x, y, z=None):
+        """Each site's volume as a fraction of dx^d (a float64 array in site order), or None: every fluid site a
+        whole cell, every body site none (the default)."""
+        return None
 
     def sample_points(self, scene, gx, gy) -> tuple:
         """(sx, sy, nx, ny): where the fluid is sampled for each ghost at ``gx``, ``gy`` and the wall's outward
@@ -72,3 +83,24 @@ def sites_inside(scene, x, y):
 def ring_count(radius: float, dx: float) -> int:
     """Particles on a ring of ``radius`` m about dx apart."""
     return max(int(round(2.0 * math.pi * radius / dx)), 1)
+
+
+def cell_fractions(scene, x, y, z=None) -> np.ndarray:
+    """The fraction of each site's cell (a square of side dx centred on the site; a cube in 3D, about a sphere
+    centred at z = 0) that lies outside the body: 1 and 0 where the surface is more than half a cell's diagonal
+    away, else the share of SUBCELLS points a side that are outside (float64, site order): a site up to half a
+    cell's diagonal inside the surface can hold fluid in its cell's corner."""
+    x0, y0, a = scene.body
+    dx, dims = scene.dx, 2 if z is None else 3
+    offsets = [np.asarray(x, float) - x0, np.asarray(y, float) - y0] + ([] if z is None else [np.asarray(z, float)])
+    r = np.sqrt(sum(c * c for c in offsets))
+    out = (r >= a).astype(np.float64)
+    near = np.flatnonzero(np.abs(r - a) < 0.5 * math.sqrt(dims) * dx)
+    count = SUBCELLS[dims]
+    s = ((np.arange(count) + 0.5) / count - 0.5) * dx
+    grid = [g.ravel() for g in np.meshgrid(*([s] * dims), indexing="ij")]
+    for chunk in np.array_split(near, max(1, near.size // 4096)):
+        if chunk.size:
+            r2 = sum((c[chunk][:, None] + g[None, :]) ** 2 for c, g in zip(offsets, grid))
+            out[chunk] = (r2 >= a * a).mean(axis=1)
+    return out

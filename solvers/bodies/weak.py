@@ -26,6 +26,7 @@ class Weak(BoundaryMethod):
     summary = (
         "no ghosts: the body's sites carry no volume, the corrected operators make the wall (--correction gradient)"
     )
+    dims = (2, 3)
     needs_correction = True
 
     def place(self, scene, x, y) -> tuple:

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solvers.bodies.base import ENTRY_DEPTH, FLUID, GHOST, INERT, BodyEntered
+from solvers.bodies.base import FLUID, GHOST, INERT, BodyEntered
 from solvers.boundaries.base import Boundary
 from solvers.sampling import mls_weights
 
@@ -79,11 +79,12 @@ class RigidBody(Boundary):
         pos = np.stack([to_host(px[near_dev]), to_host(py[near_dev])], axis=1)
         fluid = role == FLUID
         r = np.hypot(pos[:, 0] - self.x0, pos[:, 1] - self.y0)
-        entered = fluid & (r < self.a - ENTRY_DEPTH * s.dx)
+        depth = self.method.entry_depth(2)
+        entered = fluid & (r < self.a - depth * s.dx)
         if entered.any():
             raise BodyEntered(
-                f"{int(entered.sum())} fluid particle(s) inside the cylinder, past half a spacing below its "
-                f"surface (r < {self.a - ENTRY_DEPTH * s.dx:.4g} m, the deepest at r = {r[entered].min():.4g} m): "
+                f"{int(entered.sum())} fluid particle(s) inside the cylinder, past {depth:g} spacings below its "
+                f"surface (r < {self.a - depth * s.dx:.4g} m, the deepest at r = {r[entered].min():.4g} m): "
                 "the wall let them through"
             )
         body = near[~fluid]
@@ -143,6 +144,9 @@ class RigidBody(Boundary):
         for name in ("u", "v", "drho"):
             a[name][role != 0] = 0
         a["mass"][role == INERT] = 0  # no volume: no sum counts the inert particles
+        fractions = self.method.volume_fractions(self.scene, solver.to_host(x), solver.to_host(y))
+        if fractions is not None:  # cut cells: each site its cell's fluid volume
+            a["mass"] *= xp.asarray(fractions.astype(dt))
 
     def before_sweep(self, solver) -> bool:
         self.fill(solver)

@@ -10,7 +10,7 @@ and a fluid particle half a spacing inside the sphere stops the run (BodyEntered
 
 from __future__ import annotations
 
-from solvers.bodies.base import ENTRY_DEPTH, FLUID, INERT, BodyEntered
+from solvers.bodies.base import FLUID, INERT, BodyEntered
 from solvers.boundaries.base import Boundary
 
 FIELDS = ("u", "v", "w", "drho", "drho_x", "drho_y")  # with a PML's parts of drho where the layer carries them
@@ -24,7 +24,10 @@ class RigidBody3D(Boundary):
     kind = "body"
 
     def __init__(self, scene):
+        from solvers.bodies import boundary_method_named
+
         super().__init__(scene)
+        self.method = boundary_method_named(scene.boundary_method_used)
         self.x0, self.y0, self.a = scene.body
 
     @classmethod
@@ -33,7 +36,13 @@ class RigidBody3D(Boundary):
 
     def start(self, solver, x, y, drho, z=None) -> None:
         a, xp, dt = solver.arrays, solver.xp, solver.dtype
-        inside = (x - self.x0) ** 2 + (y - self.y0) ** 2 + z**2 < self.a**2
+        host = [solver.to_host(c) for c in (x, y, z)]
+        fractions = self.method.volume_fractions(self.scene, *host)
+        if fractions is None:
+            inside = (x - self.x0) ** 2 + (y - self.y0) ** 2 + z**2 < self.a**2
+        else:  # cut cells: a site inert where its cell has no fluid, else its cell's fluid volume
+            inside = xp.asarray(fractions == 0.0)
+            a["mass"] *= xp.asarray(fractions.astype(dt))
         a["role"] = xp.where(inside, INERT, FLUID).astype(dt)
         for name in FIELDS:
             if name in a:
@@ -62,12 +71,13 @@ class RigidBody3D(Boundary):
             (lo + (a[f"l{c}"].astype(xp.float64) + 0.5) * s.dx + a[f"s{c}"] - c0) ** 2
             for lo, c, c0 in ((s.x_lo, "x", self.x0), (s.y_lo, "y", self.y0), (s.z_lo, "z", 0.0))
         )
-        deep = (self.a - ENTRY_DEPTH * s.dx) ** 2
+        depth = self.method.entry_depth(3)
+        deep = (self.a - depth * s.dx) ** 2
         entered = (r2 < deep) & ~inert
         if bool(entered.any()):
             raise BodyEntered(
-                f"{int(entered.sum())} fluid particle(s) inside the sphere, past half a spacing below its surface "
-                f"(r < {self.a - ENTRY_DEPTH * s.dx:.4g} m): the wall let them through"
+                f"{int(entered.sum())} fluid particle(s) inside the sphere, past {depth:g} spacings below its surface "
+                f"(r < {self.a - depth * s.dx:.4g} m): the wall let them through"
             )
 
     def moved(self, solver) -> None:
