@@ -20,7 +20,6 @@ import numpy as np
 from solvers.bodies.base import cell_fractions
 from solvers.bodies.weak import Weak
 
-
 ENTRY_MARGIN = 0.05  # spacings: round-off never reads a cut site's own place as an entry
 
 
