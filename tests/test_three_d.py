@@ -352,9 +352,15 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     pairs = "(32,768 particles, 80 neighbours) against 2D 1 (32,761, 80)"
     assert f"3D 3 {pairs}: 3.00 times (the issue asks at most 1.3: not met)" in words, words
     assert f"3D 1.2 {pairs}: 1.20 times (the issue asks at most 1.3: met)" in words, words
-    assert [r["dx"] for r in data["sphere"]] == [0.125, 0.1]
+    assert [(r["wall"], r["dx"]) for r in data["sphere"]] == [
+        ("weak", 0.125),
+        ("weak", 0.1),
+        ("cut", 0.125),
+        ("cut", 0.1),
+    ]
     bulk = 0.118  # the sphere's bulk share at dx 0.1, predicted
-    assert "| 0.1 | 185,193 |" in words and f"| 0.154 | 0.154 | 0.154 | 0.154 | {bulk} | 2.66 |" in words, words
+    for wall in ("weak", "cut"):  # each wall's order from its own coarser run
+        assert f"| 0.1 | 185,193 | {wall} |" in words and f"| 0.154 | 0.154 | 0.154 | 0.154 | {bulk} | 2.66 |" in words
     ctx = type("Ctx", (), {"out": tmp_path, "name": "m"})()
     drawn = section.sphere_figure(data, ctx)  # p(t) at A, B, C of the finest run beside the series
     assert drawn == tmp_path / "three_d_sphere_probes.png" and drawn.stat().st_size > 10_000
