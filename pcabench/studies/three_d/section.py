@@ -186,9 +186,9 @@ def sphere_text(runs) -> list[str]:
         "The rigid sphere (`--scene sphere`: b = 0.4 m at (1.5, 0, 0) about a sphere of radius 0.5 m; the weak wall's "
         "staircase and its cut cells, `--boundary-method cut`), linear, t = 4 s: relative RMS of p at the probes "
         "over 1.5 <= t <= 4 s against the exact series (solvers/reference/sphere.py); beside it the bulk's share, "
-        "predicted: the series with the method's own dispersion and an exact wall (solvers/reference/dispersive_sphere.py, `pcabench accuracy --scene sphere`), "
-        "so that what the run has beyond it is the wall's. The issue's target (2 % at dx 0.05, order 2.5 from dx "
-        f"0.1) needs dx 0.05: 1.5 million particles with the layer{cost} (`pcabench study --three-d fine`).",
+        "predicted: the series with the method's own dispersion and an exact wall "
+        "(solvers/reference/dispersive_sphere.py, `pcabench accuracy --scene sphere`), so that what the run has "
+        "beyond it is the wall's. The issue's target (2 % at dx 0.05, order 2.5 from dx 0.1) needs dx 0.05: 1.5 million particles with the layer{cost} (`pcabench study --three-d fine`).",
         "",
         md_table(["dx", "N", "wall", "method", "A", "B", "C", "probes", "bulk (predicted)", "order", "s"], table),
     ]
