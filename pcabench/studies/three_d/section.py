@@ -188,7 +188,8 @@ def sphere_text(runs) -> list[str]:
         "over 1.5 <= t <= 4 s against the exact series (solvers/reference/sphere.py); beside it the bulk's share, "
         "predicted: the series with the method's own dispersion and an exact wall "
         "(solvers/reference/dispersive_sphere.py, `pcabench accuracy --scene sphere`), so that what the run has "
-        "beyond it is the wall's. The issue's target (2 % at dx 0.05, order 2.5 from dx 0.1) needs dx 0.05: 1.5 million particles with the layer{cost} (`pcabench study --three-d fine`).",
+        "beyond it is the wall's. The issue's target (2 % at dx 0.05, order 2.5 from dx 0.1) needs dx 0.05: 1.5 "
+        f"million particles with the layer{cost} (`pcabench study --three-d fine`).",
         "",
         md_table(["dx", "N", "wall", "method", "A", "B", "C", "probes", "bulk (predicted)", "order", "s"], table),
     ]
