@@ -19,11 +19,12 @@ HIGH_ORDER = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0,
 @dataclass(frozen=True)
 class Cases:
     """The corrected scenes (Scene fields): the correction's moments sweep and passes, RK4's sums, the weak
-    wall; each model and precision."""
+    wall's staircase and its cut cells; each model and precision."""
 
     scenes: tuple = (
         {"dx": 0.25, "integrator": "rk4", "cfl": 1.0, **HIGH_ORDER},
         {"name": "cylinder", "dx": 0.04, "boundary_method": "weak", "cfl": 0.5, **HIGH_ORDER},
+        {"name": "cylinder", "dx": 0.04, "boundary_method": "cut", "cfl": 0.5, **HIGH_ORDER},  # cut cells' volumes
     )
     models: tuple = ("linear", "lagrangian")
     precisions: tuple = ("float64", "float32")
