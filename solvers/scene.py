@@ -64,14 +64,15 @@ PAPER_DEPTH = {"z_min": -10.0, "z_max": 10.0}  # a 3D kind's where it states non
 # Arrays a 3D particle holds beyond a 2D one's: its z lattice coordinate and displacement, w, the z rate (and their
 # copies and sums), counted generously like FLOAT_ARRAYS_PER_PARTICLE
 FLOAT_ARRAYS_3D = 8
-PML_ARRAYS_3D = 5  # drho_x, drho_y, ddx, ddy and the zero velocity of a part's sweep
+# a PML's parts of drho and their rates (drho_x, drho_y, ddx, ddy: twice, as a GPU solver keeps its state's rows
+# and their sorted copies) and the zero velocity of a part's sweep
+PML_ARRAYS_3D = 9
 # Parameters whose default is the scene kind's where it states one (SceneKind.defaults), else these (the paper's;
 # a body's radius only where the kind has a body).
 PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
 PER_KIND = ("pulse_width", "pulse_center", "cylinder_radius", "sphere_radius")
 LAYER_UNSET = Edges.layer_unset()  # a closed scene's layer options
 DEFAULT_METHOD = Method.paper()  # Scene's method unless given (solvers/method.py: the paper's)
-CORRECTED_BODY_3D = "weak"  # the one wall a 3D body has (solvers/boundaries/body.py)
 
 
 class SceneError(ValueError):
@@ -435,17 +436,18 @@ class Scene:
             )
             return
         try:
-            from solvers.bodies import boundary_method_named
+            from solvers.bodies import boundary_method_named, boundary_method_names
 
             method = boundary_method_named(self.boundary_method_used)
         except ValueError as exc:
             raise SceneError(str(exc)) from None
         if self.dims == 3:  # a body in 3D: the weak walls alone (the ghost bodies place particles in a plane)
+            walls = [name for name in boundary_method_names() if 3 in getattr(boundary_method_named(name), "dims", ())]
             need(
                 3 in getattr(method, "dims", (2,)),
                 ("" if self.boundary_method else "standard SPH's body, ")
                 + f"--boundary-method {method.name}: the {self.name} scene's body is 3D, whose wall is "
-                f"--boundary-method {CORRECTED_BODY_3D} (or cut) alone (the ghost bodies are 2D's); it needs a kernel "
+                f"--boundary-method {' or '.join(walls)} alone (the ghost bodies are 2D's); it needs a kernel "
                 "correction: add --correction gradient (the high-order method: --kernel laguerre-gauss --cutoff 4 "
                 "--h-factor 1.5 --correction gradient)",
             )

@@ -274,7 +274,7 @@ def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_pa
 @pytest.mark.parametrize(
     "words, says",
     [
-        (["study", "--front", "--scene", "cylinder"], "front is `pcabench study --cylinder`"),
+        (["study", "--front", "--scene", "cylinder"], "runs against dx are `pcabench study --cylinder`"),
         (
             ["run", "--solver", "linkedlist-cpu", "--scene", "cylinder", "--dx", "0.05", "--probe", "0.6,0"],
             "--probe 0.6,0 is inside the body",

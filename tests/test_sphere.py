@@ -18,7 +18,7 @@ HIGH = dict(kernel="laguerre-gauss", h_factor=1.5, cutoff_factor=4.0, correction
     "changes, words",
     [
         ({}, "--boundary-method rings: the sphere scene's body is 3D"),  # standard SPH: no wall in 3D
-        (dict(**HIGH, boundary_method="lattice"), "whose wall is --boundary-method weak (or cut) alone"),
+        (dict(**HIGH, boundary_method="lattice"), "whose wall is --boundary-method cut or weak alone"),
         (dict(**HIGH, open="x"), "its six faces are always open"),
         (dict(**HIGH, probes=((0.3, 0.0, 0.0),)), "--probe 0.3,0,0 is inside the body"),
         (dict(**HIGH, pulse_center=0.7), "--pulse-center: the pulse's centre must be at least a pulse width"),

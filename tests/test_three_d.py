@@ -522,3 +522,23 @@ def test_the_3d_prediction_evolves_only_the_pulses_modes_and_loses_nothing():
     finally:
         dispersion3d.SPECTRUM_FLOOR = every
     assert kept == pytest.approx(full, rel=1e-12) and 0 < full < 1, (kept, full)
+
+
+def test_an_absorber_of_the_earlier_damp_signature_still_damps_and_in_3d_takes_y_and_z_together():
+    """A plug-in absorber written for ``damp(arrays, fx, fy, fields)`` (before the 3D faces): the layer calls it so,
+    with fy fz as its fy in 3D; its run equals the sponge's, whose damp is the product of the three."""
+    from solvers.absorbers import ABSORBERS
+    from solvers.absorbers.sponge import Sponge
+
+    class Legacy(Sponge):
+        name = "legacy-sponge"
+
+        def damp(self, arrays, fx, fy, fields):
+            super().damp(arrays, (fx, fy), fields)
+
+    scene = small(dx=1.0, open="xyz", layer_width=2.0, model="linear", steps=6, t_end=None)
+    with ABSORBERS.registered(Legacy):
+        legacy = evolve(make_solver("linkedlist-cpu"), scene.replace(absorber="legacy-sponge")).output()
+    sponge = evolve(make_solver("linkedlist-cpu"), scene).output()
+    assert np.abs(legacy.drho - sponge.drho).max() <= 1e-15 * np.abs(sponge.drho).max()
+    assert np.abs(legacy.u - sponge.u).max() <= 1e-15 * np.abs(sponge.u).max()

@@ -77,9 +77,10 @@ def _threads(row: dict) -> int:
     return int(row.get("threads") or 1)
 
 
-def parallel_efficiency(rows: list[dict]) -> float:
+def parallel_efficiency(rows: list[dict], threads: int | None = None) -> float:
     """This host's speed-up per thread, measured: the median over scenes run at one thread and at more (same solver,
-    loop and scene) of (serial step / threaded step) / threads; 1 (ideal) where it ran none."""
+    loop and scene) of (serial step / threaded step) / threads, at ``threads`` where the host ran that count (else
+    at every count); 1 (ideal) where it ran none."""
     serial, threaded = {}, []
     for row in rows:
         if row.get("status") != "ok" or not (row.get("steps") or 0) > 0:
@@ -90,8 +91,12 @@ def parallel_efficiency(rows: list[dict]) -> float:
             serial.setdefault(key, []).append(step)
         else:
             threaded.append((key, _threads(row), step))
-    ratios = [min(serial[k]) / step / n for k, n, step in threaded if k in serial and step > 0]
-    return float(np.median(ratios)) if ratios else 1.0
+    ratios = {}
+    for key, n, step in threaded:
+        if key in serial and step > 0:
+            ratios.setdefault(n, []).append(min(serial[key]) / step / n)
+    chosen = ratios.get(threads) or [r for values in ratios.values() for r in values]
+    return float(np.median(chosen)) if chosen else 1.0
 
 
 def _dims(scene: dict) -> int:
@@ -113,35 +118,39 @@ def _reach(solver: str, scene: dict) -> float:
 
 
 def _kinship(row: dict, spec, loop: str) -> tuple:
-    """How far a stored run is from ``spec``: (another dimension, another pair loop, another thread count)."""
+    """How far a stored run is from ``spec``: (another dimension, another pair loop, another thread count); a row
+    that names no loop (stored before rows did) is of any."""
     return (
         _dims(row["scene"]) != spec.scene.dims,
-        row.get("pair_loop") not in (None, loop),
+        row.get("pair_loop") not in (None, "", loop),
         _threads(row) != int(spec.threads),
     )
 
 
 def step_model(spec, rows: list[dict]):
     """``(a, b, sizes)`` of the fitted step time ``a * N**b`` (s) at ``spec``'s neighbours per particle and
-    threads, or None without data; fitted to the closest kind of stored run there is (:func:`_kinship`)."""
-    pts = {}
+    threads, or None without data; fitted to the closest kind of stored run there is (:func:`_kinship`), the next
+    kind where the closest has no usable timing."""
     reach = _reach(spec.solver, spec.scene.as_dict())
     same = [row for row in rows if _same_config(row, spec)]
-    if not same:
-        return None
     loop = resolve_pair_loop(spec.solver, spec.scene, spec.pair_loop)
-    closest = min(_kinship(row, spec, loop) for row in same)
-    efficiency = parallel_efficiency(rows) if closest[2] else 1.0
+    kinds: dict = {}
     for row in same:
-        if _kinship(row, spec, loop) != closest:
-            continue
-        scale = reach / _reach(spec.solver, row["scene"])
-        if _threads(row) != int(spec.threads):  # each thread beyond one gains the host's measured efficiency
-            scale *= _speedup(_threads(row), efficiency) / _speedup(int(spec.threads), efficiency)
-        pts.setdefault(int(row["n_particles"]), []).append(scale * step_seconds(row["stages"], row["steps"]))
-    pts = {n: float(np.median(v)) for n, v in pts.items() if n > 0 and min(v) > 0}
+        kinds.setdefault(_kinship(row, spec, loop), []).append(row)
+    pts: dict = {}
+    for kind in sorted(kinds):
+        efficiency = parallel_efficiency(rows, int(spec.threads)) if kind[2] else 1.0
+        for row in kinds[kind]:
+            scale = reach / _reach(spec.solver, row["scene"])
+            if _threads(row) != int(spec.threads):  # each thread beyond one gains the host's measured efficiency
+                scale *= _speedup(_threads(row), efficiency) / _speedup(int(spec.threads), efficiency)
+            pts.setdefault(int(row["n_particles"]), []).append(scale * step_seconds(row["stages"], row["steps"]))
+        pts = {n: v for n, v in pts.items() if n > 0 and min(v) > 0}
+        if pts:
+            break
     if not pts:
         return None
+    pts = {n: float(np.median(v)) for n, v in pts.items()}
     n = np.array(sorted(pts), float)
     t = np.array([pts[k] for k in sorted(pts)])
     if len(n) >= 2:

@@ -11,7 +11,17 @@ part too (``drho_y``, ``ddy``: the sweep with u = w = 0), the z part being what 
 
 from __future__ import annotations
 
+import inspect
+
 from solvers.boundaries.base import Boundary
+
+
+def _product(factors: tuple):
+    """fy (fz): the factors' product in one order (a closed axis's is a scalar 1)."""
+    out = factors[-1]
+    for f in reversed(factors[:-1]):
+        out = f * out
+    return out
 
 
 class OpenLayer(Boundary):
@@ -29,6 +39,7 @@ class OpenLayer(Boundary):
         self.state = ("drho_x", "drho_y")[:parts]
         self.rates = ("ddx", "ddy")[:parts]
         self.key, self.sigma, self.cache = None, (), {}
+        self.legacy = len(inspect.signature(self.absorber.damp).parameters) == 4  # (arrays, fx, fy, fields)
 
     @classmethod
     def applies(cls, scene) -> bool:
@@ -46,7 +57,11 @@ class OpenLayer(Boundary):
             solver.no_velocity = xp.zeros(n, dt)  # the other components zero in a part's sweep (never permuted)
 
     def damp(self, solver, f: float, fields: str) -> None:
-        self.absorber.damp(solver.arrays, self.factors(solver, f), fields)
+        factors = self.factors(solver, f)
+        if self.legacy:  # a plug-in's damp(arrays, fx, fy, fields) of before 3D: y and z damp together
+            self.absorber.damp(solver.arrays, factors[0], _product(factors[1:]), fields)
+            return
+        self.absorber.damp(solver.arrays, factors, fields)
 
     def advanced(self, solver, f: float) -> None:
         """drho_x += f dt ddx (and drho_y += f dt ddy): a split absorber's parts of drho, updated with drho."""
