@@ -444,8 +444,10 @@ def test_the_gpu_solver_gives_the_cpu_cell_lists_3d_fields_in_the_simulator():
         ({**cube, "model": "lagrangian"}, 1e-12),
         ({**cube, "model": "linear", "precision": "float32", "correction": "gradient"}, 2e-5),
         ({**cube, "model": "linear", "open": "xyz", "layer_width": 2.0}, 1e-12),
-        ({**cube, "model": "linear", "open": "xyz", "layer_width": 2.0, "absorber": "pml", "correction": "gradient"},
-         1e-12),
+        (
+            {**cube, "model": "linear", "open": "xyz", "layer_width": 2.0, "absorber": "pml", "correction": "gradient"},
+            1e-12,
+        ),
         (sphere, 1e-12),
     ]  # fmt: skip (the cut wall's volumes are arrays the GPU reads as any: the sphere's weak case covers its path)
     for c, _ in cases:
