@@ -19,7 +19,14 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from solvers.reference.dispersion import Prediction, phase_errors, stable_cfl, step_matrices, symbol
+from solvers.reference.dispersion import (
+    Prediction,
+    phase_errors,
+    scored_prediction,
+    stable_cfl,
+    step_matrices,
+    symbol,
+)
 
 DIRECTIONS = 9  # angles in [0, pi/4] (the lattice's symmetry covers the rest) over which |D(k)| is averaged
 
@@ -124,14 +131,4 @@ def predict_cylinder(scene, field: bool = True) -> Prediction:
         measures = kind.probe_errors(scene, predicted_probes(scene, method))
         measures.update(mse=measures["probe_rms"], me=measures.pop("probe_max"))
     axis, diagonal = phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4)
-    return Prediction(
-        predicted_error=measures.pop("mse"),
-        predicted_me=measures.pop("me"),
-        stable_cfl=stable_cfl(scene),
-        t_end=scene.t_final,
-        lattice_phase_error=axis[0],
-        step_phase_error=axis[1],
-        lattice_phase_error_diagonal=diagonal[0],
-        step_phase_error_diagonal=diagonal[1],
-        measures=measures,
-    )
+    return scored_prediction(measures, stable_cfl(scene), scene.t_final, axis, diagonal)

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from solvers.reference.dispersion import Prediction
+from solvers.reference.dispersion import Prediction, scored_prediction
 from solvers.reference.dispersion3d import phase_errors, stable_cfl, symbol
 from solvers.reference.dispersive_cylinder import method_factor
 from solvers.reference.pulse2d import gauss_legendre
@@ -44,7 +44,7 @@ def isotropic_symbol(scene, k) -> np.ndarray:
 def predicted_probes(scene) -> dict:
     """{"t": times, name: drho}: the series with the method's evolution at the scene's probes at every step of the
     window, as a run records them."""
-    from solvers.reference.sphere import drho
+    from solvers.reference.sphere import scene_drho
 
     steps = np.arange(1, scene.n_steps + 1)
     times = steps[steps * scene.dt >= scene.kind.window[0] - 1e-9] * scene.dt
@@ -52,16 +52,7 @@ def predicted_probes(scene) -> dict:
     points = scene.probe_points()
     if not points or not times.size:
         return probes
-    values = drho(
-        np.array(list(points.values()), dtype=np.float64),
-        times,
-        scene.sphere_radius,
-        scene.pulse_center,
-        scene.pulse_width,
-        scene.rho0 * scene.mach,
-        scene.c0,
-        factor=method_factor(scene, isotropic_symbol),
-    )
+    values = scene_drho(scene, list(points.values()), times, factor=method_factor(scene, isotropic_symbol))
     for i, name in enumerate(points):
         probes[name] = values[i]
     return probes
@@ -72,15 +63,6 @@ def predict_sphere(scene) -> Prediction:
     as a run's; the phase errors along the lattice's axis and its body diagonal."""
     scene = scene.replace(model="linear")
     measures = scene.kind.probe_errors(scene, predicted_probes(scene))
+    measures.update(mse=measures.pop("probe_rms"), me=measures.pop("probe_max"))
     axis, diagonal = phase_errors(scene, (1.0, 0.0, 0.0)), phase_errors(scene, (1.0, 1.0, 1.0))
-    return Prediction(
-        predicted_error=measures.pop("probe_rms"),
-        predicted_me=measures.pop("probe_max"),
-        stable_cfl=stable_cfl(scene),
-        t_end=scene.t_final,
-        lattice_phase_error=axis[0],
-        step_phase_error=axis[1],
-        lattice_phase_error_diagonal=diagonal[0],
-        step_phase_error_diagonal=diagonal[1],
-        measures=measures,
-    )
+    return scored_prediction(measures, stable_cfl(scene), scene.t_final, axis, diagonal)

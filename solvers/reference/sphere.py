@@ -186,3 +186,12 @@ def free_pulse(distance, width: float, k, wk, evolution) -> np.ndarray:
     alpha = LN2 / width**2
     spectrum = (math.pi / alpha) ** 1.5 * np.exp(-(k**2) / (4.0 * alpha)) * wk / (4.0 * math.pi)
     return sp.spherical_jn(0, np.multiply.outer(np.asarray(distance, float), k)) @ (spectrum[:, None] * evolution)
+
+
+def scene_drho(scene, points, times, factor=None) -> np.ndarray:
+    """:func:`drho` of a sphere scene's pulse and body (its radius, the pulse's centre, width and amplitude
+    rho0 Ma, c0) at ``points`` ((m, 3), m) and ``times`` (s): an (m, len(times)) array, kg/m^3."""
+    return drho(
+        np.atleast_2d(np.asarray(points, dtype=np.float64)), times, scene.sphere_radius, scene.pulse_center,
+        scene.pulse_width, scene.rho0 * scene.mach, scene.c0, factor=factor,
+    )  # fmt: skip

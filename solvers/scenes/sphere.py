@@ -75,20 +75,12 @@ class Sphere(SceneKind):
     def probe_errors(self, scene, probes) -> dict:
         """The probes' errors over the window 1.5 <= t <= 4 s (:func:`window_probe_errors`) against the exact
         series (solvers/reference/sphere.py)."""
-        from solvers.reference.sphere import drho as exact_drho
+        from solvers.reference.sphere import scene_drho
 
         points = scene.probe_points()
 
         def exact(names, times):
-            return exact_drho(
-                np.array([points[k] for k in names]),
-                times,
-                scene.sphere_radius,
-                scene.pulse_center,
-                scene.pulse_width,
-                scene.rho0 * scene.mach,
-                scene.c0,
-            )
+            return scene_drho(scene, [points[k] for k in names], times)
 
         return window_probe_errors(scene, probes, WINDOW, exact)
 

@@ -16,7 +16,7 @@ from pcabench.spec import scene_from_row
 from pcabench.store.rows import latest
 from pcabench.studies.three_d.plan import COST_STEPS, T_END, THREE_D, THREE_D_FINE
 from solvers.method import Method
-from solvers.reference.sphere import drho as sphere_drho
+from solvers.reference.sphere import scene_drho
 from solvers.scenes.base import plane_z
 
 TARGET = (1e-3, 0.25, 3.5)  # the issue's: the high-order method at most 1e-3 at dx 0.25, order at least 3.5
@@ -298,10 +298,7 @@ def sphere_figure(data, ctx):
     start, end = scene.kind.window
     window = (t >= start - 1e-9) & (t <= end + 1e-9)
     points = scene.probe_points()
-    exact = sphere_drho(
-        np.array([points[k] for k in "ABC"]), t[window], scene.sphere_radius, scene.pulse_center, scene.pulse_width,
-        scene.rho0 * scene.mach, scene.c0,
-    )  # fmt: skip
+    exact = scene_drho(scene, [points[k] for k in "ABC"], t[window])
     c2 = scene.c0**2
     path = ctx.out / "three_d_sphere_probes.png"
     with F.figure(
