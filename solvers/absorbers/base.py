@@ -23,6 +23,15 @@ outer (free) end and back.
 
 from __future__ import annotations
 
+
+def product(factors: tuple):
+    """fx (fy fz): the per-axis factors' product, in one order for every solver (a closed axis's is a scalar 1)."""
+    out = factors[-1]
+    for f in reversed(factors[:-1]):
+        out = f * out
+    return out
+
+
 FIELDS = {"velocity": ("u", "v", "w"), "density": ("drho",)}  # what each update changes (w: a 3D scene's)
 
 
@@ -51,9 +60,7 @@ class Absorber:
 
     def damp(self, arrays, factors: tuple, fields: str) -> None:
         """The fields times fx fy (fz): every field damped at the rate of every axis together."""
-        factor = factors[-1]
-        for f in reversed(factors[:-1]):  # fx (fy fz): the product in one order for every solver
-            factor = f * factor
+        factor = product(factors)
         for name in FIELDS[fields]:
             if name in arrays:
                 arrays[name] *= factor

@@ -13,15 +13,8 @@ from __future__ import annotations
 
 import inspect
 
+from solvers.absorbers.base import product
 from solvers.boundaries.base import Boundary
-
-
-def _product(factors: tuple):
-    """fy (fz): the factors' product in one order (a closed axis's is a scalar 1)."""
-    out = factors[-1]
-    for f in reversed(factors[:-1]):
-        out = f * out
-    return out
 
 
 class OpenLayer(Boundary):
@@ -59,7 +52,7 @@ class OpenLayer(Boundary):
     def damp(self, solver, f: float, fields: str) -> None:
         factors = self.factors(solver, f)
         if self.legacy:  # a plug-in's damp(arrays, fx, fy, fields) of before 3D: y and z damp together
-            self.absorber.damp(solver.arrays, factors[0], _product(factors[1:]), fields)
+            self.absorber.damp(solver.arrays, factors[0], product(factors[1:]), fields)
             return
         self.absorber.damp(solver.arrays, factors, fields)
 
