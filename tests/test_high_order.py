@@ -23,6 +23,7 @@ from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene, SceneError, make_solver
 from solvers.corrections import SingularMoments
+from solvers.kernels import kernel_named
 from solvers.reference.dispersion import largest_stable_z, predict, stable_cfl
 
 from .conftest import in_simulator
@@ -200,16 +201,34 @@ def test_the_high_order_method_is_fourth_order_and_its_runs_equal_the_prediction
     assert corrected < 1e-4 < plain
 
 
+def test_the_sixth_order_kernel_is_sixth_order_where_the_step_allows_and_its_runs_equal_the_prediction(tmp_path):
+    """Laguerre-Gauss of sixth order (h 1.5 dx, cut at 5 h, corrected), RK4 at CFL 0.5 on the plane pulse: order
+    about 5 from dx 0.4 to 0.2 (RK4's fourth-order step bends it), a run at dx 0.4 equal to the prediction, and
+    twenty times below the fourth-order kernel's error there."""
+    six = {"kernel": "laguerre-gauss-6", "cutoff_factor": 5.0, "cfl": 0.5}
+    coarse, fine = (predict(plane(dx, **six)).predicted_error for dx in (0.4, 0.2))
+    assert math.log2(coarse / fine) >= 4.7
+    assert measured(plane(0.4, **six), tmp_path) == pytest.approx(coarse, rel=2e-3)
+    assert coarse < predict(plane(0.4, cfl=0.5)).predicted_error / 20
+
+
 @pytest.mark.parametrize(
     "kernel,h_factor",
-    [("gaussian", 2.13), ("gaussian", 1.0), ("wendland-c2", 2.0), ("wendland-c4", 1.6), ("laguerre-gauss", 1.5)],
+    [
+        ("gaussian", 2.13),
+        ("gaussian", 1.0),
+        ("wendland-c2", 2.0),
+        ("wendland-c4", 1.6),
+        ("laguerre-gauss", 1.5),
+        ("laguerre-gauss-6", 1.5),
+    ],
 )
 def test_every_kernel_converges_at_fixed_h_over_dx_once_corrected(kernel, h_factor):
     """Predicted (exact for the linear model; the runs equal it, above): order >= 1.9 between dx 0.2 and 0.1
     with the correction; standard SPH's phase-speed error holds the Gaussian at h = dx near order 1."""
 
     def error(dx, correction):
-        cut = 4.0 if kernel == "laguerre-gauss" else 3.0
+        cut = kernel_named(kernel).order_cutoff or 3.0
         scene = plane(dx, kernel=kernel, h_factor=h_factor, correction=correction, cutoff_factor=cut)
         if kernel.startswith("wendland"):
             scene = scene.replace(cutoff_factor=Scene.default("cutoff_factor"))

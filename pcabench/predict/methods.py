@@ -18,13 +18,14 @@ from functools import lru_cache
 
 from pcabench.predict.stability import MARGIN
 from solvers import DEFAULT_SCENE, Scene, kernel_names
-from solvers.kernels import truncated
+from solvers.kernels import kernel_named, truncated
 from solvers.physics.integrators import sweeps_per_step
 from solvers.reference.dispersion import lattice_stable_cfl, predict
 
 H_FACTORS = (1.0, 1.1, 1.2, 1.3, 1.4, 1.6, 2.0, 2.13)
 # High-order SPH (solvers/corrections/gradient.py, design.md 1c): each kernel with the gradient correction at
-# h = 1.5 dx, a truncated kernel cut at 4 h (where the Laguerre-Gauss kernel's operator is fourth order), with
+# h = 1.5 dx, a truncated kernel cut where it keeps its order (its ``order_cutoff``: the fourth-order Laguerre-Gauss
+# kernel at 4 h, the sixth-order one at 5 h; 4 h for one that states none), with
 # Verlet and with RK4. A fourth-order operator is most accurate at a short step (Verlet's phase lead no longer
 # offsets a second-order lag): shares of the stable CFL down to a quarter.
 HIGH_ORDER_H = (1.5,)
@@ -52,7 +53,7 @@ def high_order_methods() -> tuple[dict, ...]:
         {
             "kernel": kernel,
             "h_factor": h,
-            **({"cutoff_factor": HIGH_ORDER_CUTOFF} if truncated(kernel) else {}),
+            **({"cutoff_factor": kernel_named(kernel).order_cutoff or HIGH_ORDER_CUTOFF} if truncated(kernel) else {}),
             "correction": "gradient",
             "integrator": integrator,
         }

@@ -47,6 +47,17 @@ CYLINDER_HIGH_ORDER = {
 CYLINDER_HIGH_ORDER_CFL = 0.5
 CYLINDER_HIGH_ORDER_DX = (0.04, 0.03, 0.0225, 0.02)
 CYLINDER_HIGH_ORDER_LONG_T_END = 100.0
+# 8. The wall and the bulk (issue 67; `--cylinder wall`): part 7's method with cut cells (solvers/bodies/cut.py: the
+# sites the surface cuts carry their cells' fluid volume) against dx, and the sixth-order Laguerre-Gauss kernel
+# (cut at 5 h, where it keeps its order) with RK4 at CFL 1 with cut cells and with the staircase (`weak`), at CFL
+# 0.5 at the workshop's dx, and its long run (t = 100 s) at dx 0.04: which error, the bulk's or the wall's,
+# limits each method (the report's "The wall and the bulk").
+CYLINDER_WALL = "cylinder-wall"
+CYLINDER_CUT = {**CYLINDER_HIGH_ORDER, "boundary_method": "cut"}
+CYLINDER_SIXTH = {**CYLINDER_CUT, "kernel": "laguerre-gauss-6", "cutoff_factor": 5.0, "integrator": "rk4"}
+CYLINDER_SIXTH_CFL = 1.0
+CYLINDER_SIXTH_SHORT_CFL = 0.5
+CYLINDER_WALL_DX = (0.04, 0.03, 0.025, 0.02)
 
 
 def advised_cfl() -> float:
@@ -75,6 +86,24 @@ def high_order(dx, **more):
     """A run of part 7's method (CYLINDER_HIGH_ORDER) at ``dx``."""
     method = {**CYLINDER_HIGH_ORDER, "cfl": CYLINDER_HIGH_ORDER_CFL, **more}
     return _run(dx, method.pop("boundary_method"), method.pop("kernel"), method.pop("h_factor"), **method)
+
+
+def sixth_order(dx, **more):
+    """A run of part 8's sixth-order method (CYLINDER_SIXTH, RK4 at CFL 1) at ``dx``."""
+    method = {**CYLINDER_SIXTH, "cfl": CYLINDER_SIXTH_CFL, **more}
+    return _run(dx, method.pop("boundary_method"), method.pop("kernel"), method.pop("h_factor"), **method)
+
+
+def cylinder_wall() -> list:
+    """Part 8 (CYLINDER_WALL_DX ...): the fourth- and sixth-order methods with cut cells against dx, the sixth's
+    staircase and short step beside them, its long run; smallest first within each part."""
+    runs = [high_order(dx, boundary_method="cut") for dx in CYLINDER_WALL_DX]
+    runs += [sixth_order(dx) for dx in CYLINDER_WALL_DX]
+    coarse, fine = CYLINDER_WALL_DX[0], CYLINDER_WALL_DX[-1]
+    runs += [sixth_order(dx, boundary_method="weak") for dx in (coarse, fine)]
+    runs += [sixth_order(fine, cfl=CYLINDER_SIXTH_SHORT_CFL)]
+    runs += [sixth_order(coarse, t_end=CYLINDER_HIGH_ORDER_LONG_T_END)]
+    return runs
 
 
 def cylinder() -> list:
@@ -109,8 +138,21 @@ CYLINDER_PRESET = Preset(
     cylinder,
     1800.0,
     flag="cylinder",
+    choice="all",
     help="sound around an object: the workshop's pulse scattered by a rigid cylinder, each boundary method's "
     "error at the probes A, B, C and near the body against dx and the kernel, lagrangian beside linear, the "
     "stable CFL with the body, the high-order method (corrected Laguerre-Gauss, the weak wall) ({size})",
     order=57,
+)
+
+CYLINDER_WALL_PRESET = Preset(
+    CYLINDER_WALL,
+    cylinder_wall,
+    1800.0,
+    flag="cylinder",
+    choice="wall",
+    help="the wall and the bulk: the high-order method with cut cells against dx, the sixth-order Laguerre-Gauss "
+    "kernel with RK4 (cut cells and the staircase, a short step, a long run): which error limits each method "
+    "({size}; about 40 min here, serial)",
+    order=57.5,
 )
