@@ -156,8 +156,9 @@ class LinkedListCPU(CellListSolver):
         return out
 
     def continuity_parts(self) -> None:
-        """The pair list computed the x part with the rate (:meth:`_sweep`); the gather loop sweeps again."""
-        if self.pairs is None:
+        """The pair list and the 3D gather loop computed the parts with the rate (:meth:`_sweep`); the 2D gather
+        loop sweeps again."""
+        if not self.fused_split():
             super().continuity_parts()
 
     def moments(self) -> tuple:
@@ -174,7 +175,20 @@ class LinkedListCPU(CellListSolver):
             self.walls.mirror_moments(self, out)
         return out
 
+    def fused_split(self) -> bool:
+        """Whether a split absorber's parts of the continuity rate come out of the rate's own pass: the pair list
+        (2D: its x part), the 3D gather loop (the x and y parts); else (the 2D gather loop) a sweep each."""
+        return self.split and (self.pairs is not None or self.scene.dims == 3)
+
     def _sweep(self, continuity: bool, momentum: bool) -> None:
+        if self.pairs is None and continuity and self.split and self.scene.dims == 3:
+            a = self.arrays
+            if a["dd"] is not a["ddx"]:  # the whole rate and its parts in one pass (continuity_parts: nothing left)
+                self.launch(
+                    "continuity_split", *self.geometry(), a["u"], a["v"], a["w"], a["vol"], a["drho"], a["dd"],
+                    a["ddx"], a["ddy"], self.k,
+                )  # fmt: skip
+                continuity = False
         if self.pairs is None:
             return super()._sweep(continuity, momentum)
         if self.threads > 1:

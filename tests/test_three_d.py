@@ -30,8 +30,9 @@ def small(**changes) -> Scene:
 
 @pytest.mark.parametrize("name", THREE_D)
 def test_the_built_in_kernels_are_normalised_in_3d(name):
-    """Each integrates to 1 over space, G = W'(r) / r, and the Laguerre-Gauss kernel's second moment vanishes in
-    3D too (its (5/2 - q^2) is not the 2D (2 - q^2): the normalisation is per dimension, not a constant)."""
+    """Each integrates to 1 over space, G = W'(r) / r, and the Laguerre-Gauss kernels' second moment vanishes in
+    3D too (its (5/2 - q^2) is not the 2D (2 - q^2): the normalisation is per dimension, not a constant), the
+    sixth-order one's fourth moment too."""
     kern, h = kernel_named(name), 0.7
     reach = (kern.support or 8.0) * h
     assert set(kern.dimensions) == {2, 3}
@@ -41,7 +42,9 @@ def test_the_built_in_kernels_are_normalised_in_3d(name):
     slope = (kern.value(r + e, h, dims=3) - kern.value(r - e, h, dims=3)) / (2 * e)
     assert np.allclose(slope, r * kern.gradient(r, h, dims=3), rtol=1e-6, atol=1e-9 * abs(kern.grad0(h, dims=3)))
     second, _ = integrate.quad(lambda r: 4 * math.pi * r**4 * kern.value(r, h, dims=3), 0, reach, epsabs=1e-14)
-    assert (abs(second) < 1e-10) is (name == "laguerre-gauss")
+    assert (abs(second) < 1e-10) is (name in ("laguerre-gauss", "laguerre-gauss-6"))
+    fourth, _ = integrate.quad(lambda r: 4 * math.pi * r**6 * kern.value(r, h, dims=3), 0, reach, epsabs=1e-14)
+    assert (abs(fourth) < 1e-10) is (name == "laguerre-gauss-6")  # the sixth-order kernel's
 
 
 def test_the_open_closed_form_and_the_periodic_fft_agree_while_the_images_are_far():
@@ -360,7 +363,7 @@ def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_pat
     ]
     bulk = 0.118  # the sphere's bulk share at dx 0.1, predicted
     for wall in ("weak", "cut"):  # each wall's order from its own coarser run
-        assert f"| 0.1 | 185,193 | {wall} |" in words and f"| 0.154 | 0.154 | 0.154 | 0.154 | {bulk} | 2.66 |" in words
+        assert f"| 0.1 | 226,981 | {wall} |" in words and f"| 0.154 | 0.154 | 0.154 | 0.154 | {bulk} | 2.66 |" in words
     ctx = type("Ctx", (), {"out": tmp_path, "name": "m"})()
     drawn = section.sphere_figure(data, ctx)  # p(t) at A, B, C of the finest run beside the series
     assert drawn == tmp_path / "three_d_sphere_probes.png" and drawn.stat().st_size > 10_000

@@ -43,6 +43,12 @@ HIGH_ORDER_DX_BODY = (0.04, 0.03, 0.025, 0.0225, 0.02, 0.01)
 # times the prediction at dx 0.04, 0.03, 0.0225, 0.02 (the lattice's staircase about the circle: first order). A
 # body's suggestion asks the prediction for this share of the target.
 BODY_MARGIN = 0.5
+# A corrected method's suggestion near a body has cut cells (solvers/bodies/cut.py: the sites the surface cuts carry
+# their cells' fluid volume), whose wall is second order. Measured (2026-12-07, `pcabench study --cylinder wall`):
+# the probes 1.00 to 1.02 times the prediction with the fourth-order kernel (Verlet CFL 0.5, dx 0.04 to 0.02), 1.04
+# and 1.43 with the sixth-order one (RK4 CFL 1, dx 0.04 and 0.02: where the bulk's is 0.1 %, the wall's shows).
+CUT_WALL = {"boundary_method": "cut"}
+CUT_MARGIN = 0.7
 
 
 def search_grid(kind, model: str = "linear") -> tuple:
@@ -87,19 +93,20 @@ def suggest(
     x neighbours x the step's sweeps: on the thinnest strip where a strip serves the scene, else on its own
     domain), the one predicted closest to it, and the paper configuration's dx. A scene with a body is predicted
     with its wall exact (the bulk's dispersion alone: a lower bound of a run's error), a corrected method with
-    the weak wall (solvers/bodies/weak.py: the ghosts' walls grow with a corrected negative-lobe kernel); the
+    cut cells (solvers/bodies/cut.py: the ghosts' walls grow with a corrected negative-lobe kernel); the
     search says how far it is on stderr, every 2 s. The study command it names makes runs that advise, asked
     again, reads: ``problem`` (the study options of the problem asked about: ``--open x``, ``--mach 0.1``) goes into
     it, and a strip only where ``domain`` is not ``full``."""
     kind = scene_kind(scene)
     dxs, hs, shares = search_grid(kind, model)
-    asked = error * (BODY_MARGIN if kind.body else 1.0)  # the prediction's target (a body's: with its margin)
     best, paper, closest = None, None, None
     methods = candidates(kind, dxs, hs, shares)
     said = [time.monotonic()]  # when progress was last printed: every PROGRESS_S (a quick search prints none)
     for i, (method, method_shares, method_dxs) in enumerate(methods, 1):
         corrected = method.get("correction", "none") != "none"
-        wall = {"boundary_method": "weak"} if kind.body and corrected else {}
+        wall = CUT_WALL if kind.body and corrected else {}
+        # the prediction's target (a body's: with its wall's margin)
+        asked = error * ((CUT_MARGIN if corrected else BODY_MARGIN) if kind.body else 1.0)
         if time.monotonic() - said[0] >= PROGRESS_S:
             said[0] = time.monotonic()
             label = Method.of(method).numerics
@@ -143,7 +150,12 @@ def suggest(
         "paper_dx": None if paper is None else paper.dx,
         "smallest_dx_searched": min(dxs),
         "note": "predicted from the dispersion relation of the linear part"
-        + (f", the wall exact, asked for {BODY_MARGIN:g} of the target (the wall's own error)" if kind.body else ""),
+        + (
+            f", the wall exact, asked for {BODY_MARGIN:g} of the target with ghosts and {CUT_MARGIN:g} with cut cells "
+            "(the wall's own error)"
+            if kind.body
+            else ""
+        ),
     }
     if closest is not None:
         c, p = closest

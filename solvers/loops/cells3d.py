@@ -12,6 +12,14 @@ def continuity(cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w,
         out[i] = P.continuity_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k)
 
 
+def continuity_split(cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, out, outx, outy, k):
+    """The continuity rate and its x and y parts (a split absorber's ddx and ddy) in one pass."""
+    for i in prange(lx.shape[0]):
+        out[i], outx[i], outy[i] = P.continuity_split_cells(
+            i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k
+        )
+
+
 def momentum(cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, mass, pr, ax, ay, az, k):
     for i in prange(lx.shape[0]):
         ax[i], ay[i], az[i] = P.momentum_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, mass, pr, k)

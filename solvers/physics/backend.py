@@ -106,7 +106,7 @@ COMPILED = {
         "cell_ids",
     ),
     "allpair": ("continuity", "momentum", "moments", "neighbours"),
-    "cells3d": ("continuity", "momentum", "moments", "neighbours", "cell_ids"),
+    "cells3d": ("continuity", "continuity_split", "momentum", "moments", "neighbours", "cell_ids"),
     "allpair3d": ("continuity", "momentum", "moments", "neighbours"),
     "updates3d": ("kick", "advance", "corrected_velocity", "corrected_continuity", "corrected_momentum"),
     "pairlist": ("build", "continuity", "continuity_split", "momentum", "moments"),

@@ -56,6 +56,29 @@ def continuity_sum(jit, separation, gradient):
     return continuity_range
 
 
+def continuity_split_sum(jit, separation, gradient):
+    """:func:`continuity_sum` and its x and y parts (the terms in u and in v: a split absorber's, the PML's) in one
+    pass, ``acc`` = (whole, x part, y part); the whole summed as :func:`continuity_sum` sums it (the same
+    rounding), each part as that sum does with the other components zero."""
+
+    @jit
+    def continuity_split_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
+        u, v, w, vol = fields
+        whole, xpart, ypart = acc
+        for j in range(j0, j1):
+            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
+            r2 = rx * rx + ry * ry + rz * rz
+            if r2 < k[RC2]:
+                weight = vol[j] * gradient(r2, k)
+                ux, vy = (u[i] - u[j]) * rx, (v[i] - v[j]) * ry
+                whole += weight * (ux + vy + (w[i] - w[j]) * rz)
+                xpart += weight * ux
+                ypart += weight * vy
+        return whole, xpart, ypart
+
+    return continuity_split_range
+
+
 def momentum_sum(jit, separation, gradient):
     """``acc`` + sum_j m_j (pr_i + pr_j) G_ij r_ij over particles j0..j1-1, as (x, y, z) (``fields``: mass, pr)."""
 
@@ -269,6 +292,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
     gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg), dims=3))
     separation = separation_rule(jit)
     continuity_range = continuity_sum(jit, separation, gradient)
+    continuity_split_range = continuity_split_sum(jit, separation, gradient)
     momentum_range = momentum_sum(jit, separation, gradient)
     neighbours_range = neighbour_count(jit, separation)
     moments_range = moment_sums(jit, separation, gradient)
@@ -276,6 +300,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
     over_stencil = stencil_rule(jit, across)
     over_all = minimum_image_rule(jit)
     continuity_stencil, continuity_all = over_stencil(continuity_range), over_all(continuity_range)
+    continuity_split_stencil = over_stencil(continuity_split_range)
     momentum_stencil, momentum_all = over_stencil(momentum_range), over_all(momentum_range)
     neighbours_stencil, neighbours_all = over_stencil(neighbours_range), over_all(neighbours_range)
     moments_stencil, moments_all = over_stencil(moments_range), over_all(moments_range)
@@ -299,6 +324,18 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
         fields = (u, v, w, vol)
         acc = continuity_stencil(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, k[ZERO], fields)
         return (k[RHO0] + k[NONLIN] * drho[i]) * acc
+
+    @jit
+    def continuity_split_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, u, v, w, vol, drho, k):
+        """d(drho_i)/dt and its x and y parts (the terms in u, in v) from the stencil around particle i,
+        kg/m^3/s."""
+        z = k[ZERO]
+        fields = (u, v, w, vol)
+        whole, xpart, ypart = continuity_split_stencil(
+            i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, (z, z, z), fields
+        )
+        factor = k[RHO0] + k[NONLIN] * drho[i]
+        return factor * whole, factor * xpart, factor * ypart
 
     @jit
     def momentum_cells(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, mass, pr, k):
@@ -390,6 +427,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True)
         corrected_continuity_at=corrected_continuity_at,
         corrected_momentum_at=corrected_momentum_at,
         continuity_cells=continuity_cells,
+        continuity_split_cells=continuity_split_cells,
         momentum_cells=momentum_cells,
         neighbours_cells=neighbours_cells,
         continuity_allpair=continuity_allpair,
