@@ -17,6 +17,7 @@ import os
 from dataclasses import dataclass
 
 from solvers import Scene, SceneError, check_pair_loop, resolve_pair_loop, solver_class
+from solvers.edges import default_absorber
 from solvers.scene import PAPER_PULSE, PER_KIND
 from solvers.scenes import scene_kind
 
@@ -24,6 +25,9 @@ SERIAL = 1
 # Every absorber's default layer, in pulse widths, for the rows stored before a row kept its layer's width (the
 # derived key ``layer``, m) and the sponge's default became 1.5 pulse widths (2026-12-05): :func:`stored_parameters`.
 LAYER_WIDTHS_BEFORE = 2.0
+# The absorber a 3D scene's open faces took by default before a row kept the one it ran (the derived key
+# ``absorber_used``) and the 3D default became the PML (2026-12-07): :func:`stored_parameters`.
+ABSORBER_3D_BEFORE = "sponge"
 ALL_CORES = "all"
 
 
@@ -171,6 +175,9 @@ def stored_parameters(scene: dict) -> dict:
     for k in PER_KIND:  # parameters whose default is the scene kind's: the value a Scene resolves
         if out[k] is None:
             out[k] = kind.defaults.get(k, PAPER_PULSE.get(k))
+    absorber = _absorber_ran(scene, out, kind)
+    if absorber is not None and absorber != default_absorber(kind):  # a default since changed: named
+        out["absorber"] = absorber
     if ran is not None:
         out["layer_width"] = _default_unless_changed(out, ran)
     return out
@@ -186,6 +193,17 @@ def _layer_ran(scene: dict, parameters: dict) -> float | None:
         return float(scene["layer"])
     pulse = parameters.get("pulse_width")
     return LAYER_WIDTHS_BEFORE * pulse if isinstance(pulse, (int, float)) else None
+
+
+def _absorber_ran(scene: dict, parameters: dict, kind) -> str | None:
+    """The absorber a stored open row that names none ran by default: its derived key ``absorber_used``, or for a
+    3D row stored before rows kept it, ABSORBER_3D_BEFORE; None for any other row (closed, an absorber of its own,
+    a 2D row before the key, or a scene dict that is not a stored row)."""
+    if not parameters.get("open") or parameters.get("absorber") or "n_particles" not in scene:
+        return None
+    if isinstance(scene.get("absorber_used"), str) and scene["absorber_used"]:
+        return scene["absorber_used"]
+    return ABSORBER_3D_BEFORE if kind.dims == 3 else None
 
 
 def _default_unless_changed(parameters: dict, ran: float) -> float | None:

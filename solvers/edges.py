@@ -18,6 +18,15 @@ from solvers.method import is_finite_number
 OPEN_EDGES = ("", "x", "y", "xy", "xyz")  # none, the x edges, the y edges, all four; a 3D scene's six faces
 
 
+
+def default_absorber(kind) -> str:
+    """The absorber a scene of ``kind`` gets when it names none: the split-field PML (2D and 3D), except on a strip
+    (a plane wave along x), where the sponge gives the PML's answer (measured: the same to three digits; there is
+    no y part to split) for less work and a thinner default layer (docs/accuracy.md). 3D scenes took the sponge
+    until 2026-12-07 (the PML's parts then cost a sweep each: twice PI; now summed in the rate's pass); a stored
+    row says which it ran (its ``absorber_used``; pcabench.spec.stored_parameters reads older ones)."""
+    return "sponge" if kind.strip else "pml"
+
 @dataclass(frozen=True)
 class Edges:
     """The open edges and their layer: ``open`` ("" closed; a Scene resolves "" to its kind's), ``layer_width``
@@ -56,13 +65,10 @@ class Edges:
         return "y" in self.open
 
     def absorber_used(self, scene) -> str:
-        """The absorber that damps the layer: ``absorber``, or by default the split-field PML, except on a
-        strip (a plane wave along x), where the sponge gives the PML's answer (measured: the same to three
-        digits; there is no y part to split) for less work (no x part of the rate to compute and carry) and a
-        thinner default layer (docs/accuracy.md)."""
+        """The absorber that damps the layer: ``absorber``, or the scene kind's default (:func:`default_absorber`)."""
         if self.absorber:
             return self.absorber
-        return "sponge" if scene.kind.strip or scene.kind.dims == 3 else "pml"
+        return default_absorber(scene.kind)
 
     def absorber_model(self, scene):
         """The absorber of :meth:`absorber_used` (solvers/absorbers/); ValueError naming --absorber and the

@@ -856,6 +856,7 @@ class Scene:
             cutoff=self.cutoff,
             height=self.height,
             layer=self.layer,
+            absorber_used=self.absorber_used if self.open else "",
         )
         return d
 

@@ -253,21 +253,21 @@ def test_the_periodic_pulse_is_smooth_across_the_cubes_faces():
 
 
 def test_open_faces_absorb_the_spherical_wave_and_every_solver_agrees_there():
-    """``--open xyz``: the cube's six faces open onto a sponge layer; the free faces' stencils (fewer neighbours
+    """``--open xyz --absorber sponge``: the cube's six faces open onto a sponge layer; the free faces' stencils (fewer neighbours
     there) agree between the cell list and every pair tested, and once the wave has left, what the faces sent
     back is a few per cent of its energy (scored against the open closed form), where the periodic cube keeps it
     all."""
     from pcabench.execute.run import run as run_spec
     from pcabench.spec import RunSpec
 
-    scene = small(dx=1.0, open="xyz", model="linear", t_end=3.0)
+    scene = small(dx=1.0, open="xyz", absorber="sponge", model="linear", t_end=3.0)
     assert scene.boundaries == {"free-x", "free-y", "free-z"} and scene.absorber_used == "sponge"
     a, b = (evolve(make_solver(name), scene).output() for name in ("allpair-cpu", "linkedlist-cpu"))
     assert a.drho.size == 8**3  # the scored cube, the layers left out
     for c in ("drho", "u", "v", "w"):
         assert np.abs(getattr(a, c) - getattr(b, c)).max() < 1e-10 * np.abs(getattr(a, c)).max()
     kw = dict(kernel="wendland-c2", h_factor=1.3, cfl=0.5, model="linear", t_end=16.0)
-    gone = run_spec(RunSpec("linkedlist-cpu", Scene(1.0, "acoustic-pulse-3d", open="xyz", **kw)))
+    gone = run_spec(RunSpec("linkedlist-cpu", Scene(1.0, "acoustic-pulse-3d", open="xyz", absorber="sponge", **kw)))
     assert gone.status == "ok" and gone.errors["left_energy"] < 0.1, gone.errors  # 0.065 measured here
     with pytest.raises(SceneError, match="--open x: the acoustic-pulse-3d scene is 3D"):
         small(open="x")
@@ -540,9 +540,28 @@ def test_an_absorber_of_the_earlier_damp_signature_still_damps_and_in_3d_takes_y
         def damp(self, arrays, fx, fy, fields):
             super().damp(arrays, (fx, fy), fields)
 
-    scene = small(dx=1.0, open="xyz", layer_width=2.0, model="linear", steps=6, t_end=None)
+    scene = small(dx=1.0, open="xyz", absorber="sponge", layer_width=2.0, model="linear", steps=6, t_end=None)
     with ABSORBERS.registered(Legacy):
         legacy = evolve(make_solver("linkedlist-cpu"), scene.replace(absorber="legacy-sponge")).output()
     sponge = evolve(make_solver("linkedlist-cpu"), scene).output()
     assert np.abs(legacy.drho - sponge.drho).max() <= 1e-15 * np.abs(sponge.drho).max()
     assert np.abs(legacy.u - sponge.u).max() <= 1e-15 * np.abs(sponge.u).max()
+
+
+def test_a_3d_scenes_open_faces_take_the_pml_and_a_row_stored_before_reads_as_the_sponge_it_ran():
+    """The 3D default absorber is the PML (its parts summed in the rate's pass); a stored open 3D row says which
+    absorber it ran (``absorber_used``), and one stored before rows said it (the sponge, then the 3D default)
+    reads as the sponge: its layer, its particle count, and a configuration apart from today's default runs."""
+    from pcabench.spec import identity, scene_from_row, stored_parameters
+
+    scene = Scene(0.125, "sphere", correction="gradient")
+    assert scene.absorber_used == "pml" and scene.as_dict()["absorber_used"] == "pml"
+    assert scene_from_row({"scene": scene.as_dict()}) == scene  # today's row: today's default
+    old = Scene(0.125, "sphere", correction="gradient", absorber="sponge").as_dict()
+    old["absorber"] = ""
+    del old["absorber_used"]  # a row stored before the key: the sponge ran
+    read = scene_from_row({"scene": old})
+    assert read.absorber_used == "sponge" and read.n_particles == old["n_particles"] < scene.n_particles
+    keys = {identity("linkedlist-cpu", 1, s, "", "m", "c", "h") for s in (scene, old)}
+    assert len(keys) == 2 and stored_parameters(old)["absorber"] == "sponge"
+    assert Scene(0.5, "acoustic-pulse-3d").as_dict()["absorber_used"] == ""  # closed: none

@@ -3,8 +3,9 @@
 A sphere of radius a = ``sphere_radius`` (0.5 m) at the origin, the Gaussian pulse
 drho = rho0 Ma exp(-ln2 ((x - xp)^2 + y^2 + z^2) / b^2) at rest at (xp, 0, 0) = (``pulse_center``, 0, 0) =
 (1.5, 0, 0) m with b = ``pulse_width`` = 0.4 m, c0 = 1 m/s, in open space: the cube [-2.25, 2.25]^3 m with its six
-faces open (a sponge layer beyond each, solvers/absorbers/sponge.py, by default; ``--absorber pml`` the split-field
-PML, a part of the continuity sweep per axis: about twice PI). The sphere's
+faces open (the split-field PML beyond each, solvers/absorbers/pml.py, by default, as every 3D scene's since
+2026-12-07: its parts of the continuity rate summed in the rate's own pass; ``--absorber sponge`` sends back from
+the +x and +y faces into A's window, docs/accuracy.md). The sphere's
 wall is the weak one (solvers/bodies/weak.py: the body's sites carry no volume, the gradient-corrected operators
 make the wall), which needs ``--correction gradient``. The pulse's flank reaches the sphere at t = 0 (1.3 % of its
 peak at the surface): the fluid's data is the Gaussian cut at the wall, as the exact reference's
