@@ -253,10 +253,10 @@ def test_the_periodic_pulse_is_smooth_across_the_cubes_faces():
 
 
 def test_open_faces_absorb_the_spherical_wave_and_every_solver_agrees_there():
-    """``--open xyz --absorber sponge``: the cube's six faces open onto a sponge layer; the free faces' stencils (fewer neighbours
-    there) agree between the cell list and every pair tested, and once the wave has left, what the faces sent
-    back is a few per cent of its energy (scored against the open closed form), where the periodic cube keeps it
-    all."""
+    """``--open xyz --absorber sponge``: the cube's six faces open onto a sponge layer; the free faces' stencils
+    (fewer neighbours there) agree between the cell list and every pair tested, and once the wave has left, what
+    the faces sent back is a few per cent of its energy (scored against the open closed form), where the periodic
+    cube keeps it all."""
     from pcabench.execute.run import run as run_spec
     from pcabench.spec import RunSpec
 
