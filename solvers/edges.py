@@ -18,7 +18,6 @@ from solvers.method import is_finite_number
 OPEN_EDGES = ("", "x", "y", "xy", "xyz")  # none, the x edges, the y edges, all four; a 3D scene's six faces
 
 
-
 def default_absorber(kind) -> str:
     """The absorber a scene of ``kind`` gets when it names none: the split-field PML (2D and 3D), except on a strip
     (a plane wave along x), where the sponge gives the PML's answer (measured: the same to three digits; there is
@@ -26,6 +25,7 @@ def default_absorber(kind) -> str:
     until 2026-12-07 (the PML's parts then cost a sweep each: twice PI; now summed in the rate's pass); a stored
     row says which it ran (its ``absorber_used``; pcabench.spec.stored_parameters reads older ones)."""
     return "sponge" if kind.strip else "pml"
+
 
 @dataclass(frozen=True)
 class Edges:
