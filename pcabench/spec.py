@@ -17,6 +17,8 @@ import os
 from dataclasses import dataclass
 
 from solvers import Scene, SceneError, check_pair_loop, resolve_pair_loop, solver_class
+from solvers.bodies import CORRECTED_BOUNDARY_METHOD
+from solvers.corrections import DEFAULT_CORRECTION
 from solvers.edges import default_absorber
 from solvers.scene import PAPER_PULSE, PER_KIND
 from solvers.scenes import scene_kind
@@ -28,6 +30,9 @@ LAYER_WIDTHS_BEFORE = 2.0
 # The absorber a 3D scene's open faces took by default before a row kept the one it ran (the derived key
 # ``absorber_used``) and the 3D default became the PML (2026-12-07): :func:`stored_parameters`.
 ABSORBER_3D_BEFORE = "sponge"
+# The wall a corrected method's body took by default before a row kept the one it ran (``boundary_method_used``)
+# and the default became cut cells (2026-12-07).
+CORRECTED_WALL_BEFORE = "weak"
 ALL_CORES = "all"
 
 
@@ -178,6 +183,9 @@ def stored_parameters(scene: dict) -> dict:
     absorber = _absorber_ran(scene, out, kind)
     if absorber is not None and absorber != default_absorber(kind):  # a default since changed: named
         out["absorber"] = absorber
+    wall = _wall_ran(scene, out, kind)
+    if wall is not None and wall != CORRECTED_BOUNDARY_METHOD:
+        out["boundary_method"] = wall
     if ran is not None:
         out["layer_width"] = _default_unless_changed(out, ran)
     return out
@@ -204,6 +212,18 @@ def _absorber_ran(scene: dict, parameters: dict, kind) -> str | None:
     if isinstance(scene.get("absorber_used"), str) and scene["absorber_used"]:
         return scene["absorber_used"]
     return ABSORBER_3D_BEFORE if kind.dims == 3 else None
+
+
+def _wall_ran(scene: dict, parameters: dict, kind) -> str | None:
+    """The wall a stored corrected row on a body that names none ran by default: its derived key
+    ``boundary_method_used``, or for a row stored before rows kept it, CORRECTED_WALL_BEFORE; None for any other
+    row (no body, a wall of its own, uncorrected, or a scene dict that is not a stored row)."""
+    corrected = parameters.get("correction") not in (None, "", DEFAULT_CORRECTION)
+    if not kind.body or parameters.get("boundary_method") or not corrected or "n_particles" not in scene:
+        return None
+    if isinstance(scene.get("boundary_method_used"), str) and scene["boundary_method_used"]:
+        return scene["boundary_method_used"]
+    return CORRECTED_WALL_BEFORE
 
 
 def _default_unless_changed(parameters: dict, ran: float) -> float | None:

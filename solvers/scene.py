@@ -466,7 +466,7 @@ class Scene:
     @property
     def boundary_method_used(self) -> str:
         """How the body's wall is modelled: ``boundary_method``, or the default (solvers/bodies/): standard SPH's
-        (rings), or with a kernel correction the one whose wall holds with it (weak)."""
+        (rings), or with a kernel correction the one whose wall holds with it (the weak wall's cut cells)."""
         from solvers.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD
 
         if self.boundary_method:
@@ -857,6 +857,7 @@ class Scene:
             height=self.height,
             layer=self.layer,
             absorber_used=self.absorber_used if self.open else "",
+            boundary_method_used=self.boundary_method_used if self.body is not None else "",
         )
         return d
 

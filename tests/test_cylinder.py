@@ -271,6 +271,20 @@ def test_the_sections_orders_target_and_figures_come_from_the_stored_runs(tmp_pa
     assert S.probes_figure(data, ctx).exists() and S.error_figure(data, ctx).exists()
 
 
+def test_the_table_says_which_error_limits_each_run():
+    """The wall's share of a run's probes' error is what the bulk's (the prediction with the wall exact) leaves,
+    in quadrature; the larger share limits the run (the sixth-order kernel with cut cells at dx 0.02: the wall;
+    the fourth-order one: the bulk; a run at or below its prediction: the bulk, its wall's share 0)."""
+    from pcabench.studies.cylinder import section as S
+
+    sixth, fourth = {"probes": 0.00139, "predicted": 0.00097}, {"probes": 0.00661, "predicted": 0.0066}
+    assert S.wall_share(sixth) == pytest.approx(math.sqrt(0.00139**2 - 0.00097**2)) and S.limited_by(sixth) == "wall"
+    assert S.wall_share(fourth) < 0.1 * fourth["predicted"] and S.limited_by(fourth) == "bulk"
+    below = {"probes": 0.005, "predicted": 0.006}
+    assert S.wall_share(below) == 0.0 and S.limited_by(below) == "bulk"
+    assert S.wall_share({"probes": 0.1, "predicted": None}) is None and S.limited_by({"probes": None, "predicted": 1}) == "-"
+
+
 @pytest.mark.parametrize(
     "words, says",
     [

@@ -21,19 +21,19 @@ CORRECTED = {"kernel": "laguerre-gauss", "h_factor": 1.5, "cutoff_factor": 4.0, 
 
 
 def test_a_corrected_method_on_a_body_defaults_to_the_wall_that_holds():
-    """Standard SPH keeps its ghost rings; with the correction the default body is the weak wall (ghosts with a
-    corrected kernel blew up at the body: docs/accuracy.md), and nothing is cautioned."""
+    """Standard SPH keeps its ghost rings; with the correction the default body is the weak wall with its cut
+    cells (ghosts with a corrected kernel blew up at the body: docs/accuracy.md), and nothing is cautioned."""
     assert Scene(dx=0.04, name="cylinder").boundary_method_used == "rings"
     corrected = Scene(dx=0.04, name="cylinder", **CORRECTED)
-    assert corrected.boundary_method_used == "weak" and not corrected.known_failure and not corrected.cautions
-    assert "weak wall" in corrected.describe()
+    assert corrected.boundary_method_used == "cut" and not corrected.known_failure and not corrected.cautions
+    assert "cut wall" in corrected.describe()
 
 
 @pytest.mark.parametrize("method", ["rings", "lattice"])
 def test_a_ghost_body_with_a_correction_is_named_as_known_to_blow_up(method, capsys):
     scene = Scene(dx=0.04, name="cylinder", boundary_method=method, **CORRECTED)
     assert f"--boundary-method {method} with --correction gradient is known to blow up" in scene.known_failure
-    assert "--boundary-method weak holds" in scene.known_failure
+    assert "--boundary-method cut holds" in scene.known_failure
     args = ["accuracy", "--scene", "cylinder", "--dx", "0.04", "--t-end", "10", "--boundary-method", method]
     args += ["--kernel", "laguerre-gauss", "--h-factor", "1.5", "--cutoff", "4", "--correction", "gradient"]
     rc, out, err = cli_main(*args, capsys=capsys)
@@ -76,3 +76,22 @@ def test_a_fourth_order_kernel_cut_below_4h_is_named_and_the_cutoff_message_name
     assert not Scene(dx=0.5, name="acoustic-pulse", **CORRECTED).cautions
     with pytest.raises(SceneError, match="truncated kernel laguerre-gauss must be in"):
         Scene(dx=0.5, kernel="laguerre-gauss", cutoff_factor=40.0)
+
+
+def test_a_corrected_row_on_a_body_stored_before_cut_cells_were_the_default_reads_as_the_staircase_it_ran():
+    """A stored corrected row on a body that names no wall says the wall it ran (``boundary_method_used``); one
+    stored before rows said it took the staircase (``weak``, then the default) and reads so: another
+    configuration than today's default runs, whose cut cells it did not have."""
+    from pcabench.spec import identity, scene_from_row
+
+    today = Scene(dx=0.04, name="cylinder", **CORRECTED)
+    assert today.as_dict()["boundary_method_used"] == "cut" and scene_from_row({"scene": today.as_dict()}) == today
+    old = Scene(dx=0.04, name="cylinder", boundary_method="weak", **CORRECTED).as_dict()
+    old["boundary_method"] = ""
+    del old["boundary_method_used"]
+    read = scene_from_row({"scene": old})
+    assert read.boundary_method_used == "weak" and read.boundary_method == "weak"
+    assert identity("linkedlist-cpu", 1, old, "", "m", "c", "h") != identity("linkedlist-cpu", 1, today, "", "m", "c", "h")
+    standard = Scene(dx=0.04, name="cylinder").as_dict()
+    del standard["boundary_method_used"]
+    assert scene_from_row({"scene": standard}).boundary_method == ""  # uncorrected: its default never changed

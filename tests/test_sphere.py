@@ -34,7 +34,7 @@ def test_bad_sphere_input_is_one_line_naming_the_option(changes, words):
 def test_the_sphere_defaults_are_the_issues_problem():
     scene = Scene(0.1, "sphere", t_end=4.0, **HIGH)
     assert scene.body == (0.0, 0.0, 0.5) and scene.pulse_width == 0.4 and scene.pulse_center == 1.5
-    assert scene.open == "xyz" and scene.boundary_method_used == "weak"
+    assert scene.open == "xyz" and scene.boundary_method_used == "cut" and scene.absorber_used == "pml"
     assert scene.probe_points() == {"A": (0.0, 1.5, 0.0), "B": (-1.0607, 1.0607, 0.0), "C": (-1.5, 0.0, 0.0)}
 
 

@@ -138,6 +138,7 @@ SCENE_FIELDS: dict[str, Field] = {
     "t_final": _SCENE_NUMBER,
     "layer": Field(("number",), low=0, high=1e12),  # the open edges' layer, m (0 closed; rows before 2026-12-05: none)
     "absorber_used": _name(max_len=32),  # the absorber the layer ran ("" closed; rows before 2026-12-07: none)
+    "boundary_method_used": _name(max_len=32),  # the body's wall it ran ("" no body; rows before 2026-12-07: none)
     **{
         k: Field(("number",), low=-1e12, high=1e12)
         for k in (

@@ -9,8 +9,10 @@ from solvers.plugins import Registry
 
 ENTRY_POINT_GROUP = "pcabench.boundary_methods"
 DEFAULT_BOUNDARY_METHOD = "rings"  # standard SPH's body
-# A corrected method's body (--correction other than none): the one whose wall holds with it (ghosts blow up)
-CORRECTED_BOUNDARY_METHOD = "weak"
+# A corrected method's body (--correction other than none): the one whose wall holds with it (ghosts blow up), with
+# its cut cells (solvers/bodies/cut.py: second order; the staircase, ``weak``, was the default until 2026-12-07: a
+# stored row says which it ran, ``boundary_method_used``; pcabench.spec.stored_parameters reads older ones)
+CORRECTED_BOUNDARY_METHOD = "cut"
 
 BOUNDARY_METHODS = Registry(
     "boundary method",

@@ -48,8 +48,8 @@ COST_2D_SIDE = 22.625  # m: 181 x 181 = 32,761 particles at dx 0.125, beside the
 # sponge, 0.0116 with the PML)
 SPHERE = {"name": "sphere", "model": "linear", "t_end": 4.0, "absorber": "pml"}
 SPHERE_DX = (0.125, 0.1)
-# the sphere's walls: the weak one's staircase (the corrected method's default) and its cut cells
-SPHERE_WALLS = ({}, {"boundary_method": "cut"})
+# the sphere's walls: the weak one's staircase and its cut cells (the corrected method's default since 2026-12-07)
+SPHERE_WALLS = ({"boundary_method": "weak"}, {"boundary_method": "cut"})
 SPHERE_FINE_DX = 0.05  # the target: at most 2 % at the probes
 
 
