@@ -282,7 +282,8 @@ def test_the_table_says_which_error_limits_each_run():
     assert S.wall_share(fourth) < 0.1 * fourth["predicted"] and S.limited_by(fourth) == "bulk"
     below = {"probes": 0.005, "predicted": 0.006}
     assert S.wall_share(below) == 0.0 and S.limited_by(below) == "bulk"
-    assert S.wall_share({"probes": 0.1, "predicted": None}) is None and S.limited_by({"probes": None, "predicted": 1}) == "-"
+    assert S.wall_share({"probes": 0.1, "predicted": None}) is None
+    assert S.limited_by({"probes": None, "predicted": 1}) == "-"
 
 
 @pytest.mark.parametrize(

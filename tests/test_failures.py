@@ -91,7 +91,8 @@ def test_a_corrected_row_on_a_body_stored_before_cut_cells_were_the_default_read
     del old["boundary_method_used"]
     read = scene_from_row({"scene": old})
     assert read.boundary_method_used == "weak" and read.boundary_method == "weak"
-    assert identity("linkedlist-cpu", 1, old, "", "m", "c", "h") != identity("linkedlist-cpu", 1, today, "", "m", "c", "h")
+    key = {"solver": "linkedlist-cpu", "threads": 1, "preset": "", "profile": "m", "code": "c", "host": "h"}
+    assert identity(scene=old, **key) != identity(scene=today, **key)
     standard = Scene(dx=0.04, name="cylinder").as_dict()
     del standard["boundary_method_used"]
     assert scene_from_row({"scene": standard}).boundary_method == ""  # uncorrected: its default never changed
