@@ -25,12 +25,12 @@ from __future__ import annotations
 import abc
 import contextlib
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from solvers.boundaries import OpenLayer, RigidBody, Walls, boundary_models
 from solvers.corrections import correction_names
+from solvers.fields import Fields
 from solvers.kernels import constants as kernel
 from solvers.kernels import kernel_names
 from solvers.method import INTEGRATORS
@@ -45,26 +45,6 @@ RATES_3D = ("ax", "ay", "az", "dd")
 POSITIONS = {2: ("lx", "ly", "sx", "sy"), 3: ("lx", "ly", "lz", "sx", "sy", "sz")}  # what a search bins
 VELOCITY = {2: ("u", "v"), 3: ("u", "v", "w")}
 ACCELERATION = {2: ("ax", "ay"), 3: ("ax", "ay", "az")}
-
-
-@dataclass
-class Fields:
-    """Final particle fields in particle-id order (id = (lz * ny + ly) * nx + lx). SI units. A 3D scene's carry
-    ``z`` and ``w`` too (None in 2D)."""
-
-    x: np.ndarray
-    y: np.ndarray
-    u: np.ndarray
-    v: np.ndarray
-    drho: np.ndarray
-    t: float
-    probes: dict | None = None  # {"t": times (s), name: drho there (kg/m^3)} recorded at the scene's probe points
-    z: np.ndarray | None = None
-    w: np.ndarray | None = None
-
-    def save(self, path) -> None:
-        third = {} if self.z is None else {"z": self.z, "w": self.w}
-        np.savez(path, x=self.x, y=self.y, u=self.u, v=self.v, drho=self.drho, t=self.t, **third)
 
 
 class SolverUnavailable(RuntimeError):

@@ -190,7 +190,8 @@ LAYERS = (
         "solvers.sampling",
         "solvers.jitcache",
         "solvers.sources",
-    ),  # registries, kernels, absorbers, corrections, boundary methods, sampling between particles
+        "solvers.fields",
+    ),  # registries, kernels, absorbers, corrections, boundary methods, sampling between particles, a run's fields
     ("solvers.physics",),  # the rates per pair and the integrators, for every backend
     ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method", "solvers.edges"),
     ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops

@@ -22,6 +22,7 @@ from pcabench.store.record import RunRecord
 from solvers import SceneError, jitcache, make_solver
 from solvers.bodies import BodyEntered
 from solvers.corrections import SingularMoments
+from solvers.fields import Fields
 from solvers.physics.integrators import step_program
 from solvers.reference.dispersion import predicted_primary
 from solvers.scenes.base import plane_z, scored_axes
@@ -166,7 +167,6 @@ def save_fields(fields, path) -> None:
 def load_fields(path):
     """The fields an .npz of :func:`save_fields` holds (solvers.interface.Fields); OSError or ValueError if it
     is not one."""
-    from solvers.interface import Fields
 
     with np.load(path, allow_pickle=False) as data:
         probes = {k[len("probe.") :]: data[k] for k in data.files if k.startswith("probe.")}

@@ -32,6 +32,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from solvers.fields import Fields
 from solvers.physics.integrators import step_program
 
 STABLE_GROWTH = 1e-9  # spectral radius above 1 + this is unstable
@@ -283,7 +284,6 @@ def predict(scene) -> Prediction:
 def predict_plane(scene) -> Prediction:
     """A plane scene's prediction: the lattice row's spectrum evolved mode by mode (waves along x), scored with
     the scene kind's own measures."""
-    from solvers.interface import Fields
 
     x, u, t = predicted_velocity(scene)
     zero = np.zeros_like(x)
@@ -352,7 +352,6 @@ def predicted_fields_2d(scene) -> tuple:
 def predict_2d(scene, kind) -> Prediction:
     """The error of a periodic 2D scene's run predicted with no simulation (exact for `linear`), scored with
     the scene's own measures against its exact reference; phase errors along the axis and the diagonal."""
-    from solvers.interface import Fields
 
     x, y, drho, u, v, t = predicted_fields_2d(scene.replace(model="linear"))
     fields = Fields(x=x.ravel(), y=y.ravel(), u=u.ravel(), v=v.ravel(), drho=drho.ravel(), t=t)

@@ -18,6 +18,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from solvers.fields import Fields
 from solvers.reference.dispersion import (
     ModeSolver,
     Prediction,
@@ -140,7 +141,6 @@ def predicted_fields(scene) -> tuple:
 def predict(scene, kind) -> Prediction:
     """The error of a periodic 3D scene's `linear` run predicted with no simulation (exact), scored with the
     scene's own measures; the phase errors along the lattice's axis and its body diagonal."""
-    from solvers.interface import Fields
 
     linear = scene.replace(model="linear")
     drho, u, v, w, t = predicted_fields(linear)

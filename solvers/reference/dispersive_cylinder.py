@@ -19,6 +19,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from solvers.fields import Fields
 from solvers.reference.dispersion import (
     Prediction,
     phase_errors,
@@ -102,7 +103,6 @@ def predicted_fields(scene, method=None):
     """drho the method would give with an exact wall (:class:`solvers.interface.Fields` with ``probes``): at the
     scored domain's lattice sites outside the body (every :func:`site_stride`-th) at the run's final time, and
     at the probes at every step of the workshop's window, for the `linear` model."""
-    from solvers.interface import Fields
 
     scene = scene.replace(model="linear")
     kind = scene.kind

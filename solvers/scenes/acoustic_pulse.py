@@ -24,6 +24,7 @@ import math
 
 import numpy as np
 
+from solvers.fields import Fields
 from solvers.reference.analytic import QUIET
 from solvers.scenes.base import PULSE_REACH, SceneKind, left_behind, scored_axes
 
@@ -192,7 +193,6 @@ class AcousticPulse(SceneKind):
         )
 
     def exact_fields(self, scene, t: float):
-        from solvers.interface import Fields
 
         ref = self.reference(scene, t)
         x, y = np.meshgrid(ref.x, ref.y)

@@ -26,6 +26,7 @@ import math
 
 import numpy as np
 
+from solvers.fields import Fields
 from solvers.scenes.base import PULSE_REACH, SceneKind
 
 LN2 = math.log(2.0)
@@ -101,7 +102,6 @@ class AcousticPulse3D(SceneKind):
         )
 
     def exact_fields(self, scene, t: float):
-        from solvers.interface import Fields
 
         if scene.open:
             return self.open_fields(scene, t)
@@ -115,7 +115,6 @@ class AcousticPulse3D(SceneKind):
     def open_fields(self, scene, t: float):
         """The open-space pulse (the closed form, solvers/reference/pulse3d.py) at the scored domain's sites at
         ``t``, in a run's output order, as Fields."""
-        from solvers.interface import Fields
         from solvers.reference.pulse3d import open_pulse
 
         axes = [

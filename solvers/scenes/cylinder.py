@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from solvers.fields import Fields
 from solvers.scenes.base import PULSE_WIDTH_RANGE, SceneKind, window_probe_errors
 
 LN2 = math.log(2.0)
@@ -209,7 +210,6 @@ class Cylinder(SceneKind):
         return gx.ravel(), gy.ravel()
 
     def exact_fields(self, scene, t: float):
-        from solvers.interface import Fields
 
         gx, gy = self.lattice_sites(scene)
         drho = self.reference(scene, t).field(gx, gy, t)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+from solvers.fields import Fields
 from solvers.reference.analytic import errors as analytic_errors
 from solvers.scenes.base import PULSE_REACH, SceneKind, left_behind
 
@@ -33,7 +34,6 @@ class PlanePulse(SceneKind):
     def exact_fields(self, scene, t: float):
         import numpy as np
 
-        from solvers.interface import Fields
         from solvers.reference.analytic import pulse_velocity
 
         x = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx

@@ -23,6 +23,7 @@ simple waves crossing are not one.
 
 from __future__ import annotations
 
+from solvers.fields import Fields
 from solvers.reference.analytic import pulse_velocity, relative_errors
 from solvers.scenes.base import PULSE_REACH, left_behind, wall_measures
 from solvers.scenes.plane_pulse import PlanePulse
@@ -101,8 +102,6 @@ class PlaneWall(PlanePulse):
 
     def exact_fields(self, scene, t: float):
         import numpy as np
-
-        from solvers.interface import Fields
 
         x = scene.x_lo + (np.arange(scene.nx) + 0.5) * scene.dx
         a, b = pulse_velocity(scene, x, t), pulse_velocity(scene, image_x(scene, x), t)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from solvers.fields import Fields
 from solvers.scenes.acoustic_pulse import LN2, AcousticPulse, centre, measures
 from solvers.scenes.base import wall_measures
 from solvers.scenes.plane_wall import DEFAULT_WALL, SMALLEST_WALLED, wall_check
@@ -67,7 +68,6 @@ class PulseWall(AcousticPulse):
         return 2 * scene.nx, self.image_centres(scene)[1:]
 
     def exact_fields(self, scene, t: float):
-        from solvers.interface import Fields
 
         ref = self.reference(scene, t)
         x, y = np.meshgrid(ref.x[: scene.nx], ref.y)

@@ -27,6 +27,7 @@ from pcabench.studies.open_edges.plan import OPEN, OPEN_DX, OPEN_SCENES, open_co
 from pcabench.studies.stability.plan import LONG_T_END
 from pcabench.studies.stability.rows import long_run_limits
 from solvers.absorbers import absorber_named
+from solvers.fields import Fields
 
 TARGET_AMPLITUDE = 1e-2  # the issue's: at most 1 % of the amplitude left behind
 TARGET_ENERGY = 1e-4  # the issue's for the plane pulse: at most 1e-4 of its energy
@@ -90,7 +91,6 @@ def closed_contrast(df) -> dict:
     """{scene: (amplitude, energy, what)}: what the closed scene leaves at the same time. The plane pulse's free
     end from its stored run (``me`` over the amplitude; its energy is not stored: None); the periodic square from
     its linear prediction (exact for the linear run) scored against the open plane."""
-    from solvers.interface import Fields
     from solvers.reference.dispersion import predicted_fields_2d
 
     out = {}
