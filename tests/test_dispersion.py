@@ -14,7 +14,7 @@ import pytest
 from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene
-from solvers.reference.dispersion import largest_stable_z, predict, stable_cfl
+from solvers.reference.dispersion import largest_stable_z, predict, predicted_stable_cfl
 
 from .conftest import cli_main
 
@@ -56,7 +56,7 @@ def test_predicted_error_is_the_measured_error(kw):
 @pytest.mark.filterwarnings("ignore:divide by zero")  # the pulse has left the domain by the last step
 def test_the_step_limit_is_where_runs_blow_up():
     scene = Scene(dx=0.5, steps=60, model="linear", strip_height=Scene.thinnest_strip(0.5))
-    limit = stable_cfl(scene)
+    limit = predicted_stable_cfl(scene)
     assert run(RunSpec("linkedlist-cpu", scene.replace(cfl=0.95 * limit))).status == "ok"
     assert run(RunSpec("linkedlist-cpu", scene.replace(cfl=1.05 * limit))).status == "unstable"
 

@@ -34,7 +34,7 @@ from solvers.kernels import registry as kernel_registry
 from solvers.kernels.constants import GRAD0, INV_H2
 from solvers.method import Method
 from solvers.physics.backend import cpu_pairs
-from solvers.reference.dispersion import predict, stable_cfl
+from solvers.reference.dispersion import predict, predicted_stable_cfl
 
 from .conftest import run_fields
 from .test_gpu import _max_rel, _simulate
@@ -336,7 +336,7 @@ def test_a_registered_kernel_joins_the_front_the_prediction_and_the_solvers(quin
     # the dispersion prediction, its stable CFL, the front preset and the prediction's method search
     p = predict(scene.replace(t_end=10.0, steps=None, dx=0.2, x_min=None, x_max=None))
     assert math.isfinite(p.predicted_error) and 0 < p.predicted_error < 1 and p.stable_cfl > 0
-    assert stable_cfl(scene) == p.stable_cfl
+    assert predicted_stable_cfl(scene) == p.stable_cfl
     assert front_axes()["kernel"] == (*BUILTIN, quintic)
     assert front_axes("quick", "acoustic-pulse")["kernel"] == (*BUILTIN, quintic)
     assert quintic in {m["kernel"] for m in fastest(0.05, 10.0)}

@@ -14,7 +14,7 @@ from pcabench.spec import RunSpec, identity, scene_from_row
 from solvers import DEFAULT_SCENE, Scene, SceneError, kernel_names, make_solver, scene_names
 from solvers.linkedlist_cpu import LinkedListCPU
 from solvers.physics.integrators import evolve as run_primitives
-from solvers.reference.dispersion import predict, predicted_fields_2d, stable_cfl
+from solvers.reference.dispersion import predict, predicted_fields_2d, predicted_stable_cfl
 
 from .conftest import cli_main, in_simulator
 
@@ -129,7 +129,7 @@ def test_the_2d_prediction_is_the_linear_run(kw):
     for name, value in p.measures.items():
         assert value == pytest.approx(record.errors[name], rel=1e-8), name
     _x, _y, drho, _u, _v, _t = predicted_fields_2d(scene)
-    assert p.stable_cfl == pytest.approx(stable_cfl(scene.replace(name=DEFAULT_SCENE)), rel=1e-12)
+    assert p.stable_cfl == pytest.approx(predicted_stable_cfl(scene.replace(name=DEFAULT_SCENE)), rel=1e-12)
 
 
 def test_the_2d_pulse_converges_to_the_exact_reference():
@@ -203,7 +203,10 @@ def test_the_fast_methods_come_from_the_prediction():
 
     paper = predict(Scene(dx=0.05, t_end=10.0, model="linear")).predicted_error
     found = fastest(paper, 10.0, "linear")
-    assert len({m["kernel"] for m in found}) == len(found) == len(kernel_names())
+    # one per kernel, but the sixth-order Laguerre-Gauss kernel: uncorrected and cut at the default 3 h it floors at
+    # 7 % and more at every h searched (it is a 5 h, corrected kernel: tests/test_high_order.py)
+    assert len({m["kernel"] for m in found}) == len(found)
+    assert set(kernel_names()) - {m["kernel"] for m in found} == {"laguerre-gauss-6"}
     for m in found:
         assert m["predicted_error"] <= paper and m["cfl"] <= MARGIN["linear"] * m["stable_cfl"] + 0.01
         scene = Scene(

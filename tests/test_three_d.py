@@ -227,9 +227,9 @@ def test_the_3d_stable_cfl_is_the_cubic_lattices_and_a_step_past_it_blows_up():
     past it the same run blows up and is recorded as such (not a crash)."""
     from pcabench.execute.run import run as run_spec
     from pcabench.spec import RunSpec
-    from solvers.reference.dispersion import stable_cfl
+    from solvers.reference.dispersion import predicted_stable_cfl
 
-    limit = stable_cfl(small())
+    limit = predicted_stable_cfl(small())
     assert 1.5 < limit < 3.0  # Wendland C2 at h 1.3 dx: 2.28 on the cube (2.35 on the square)
     held = run_spec(RunSpec("linkedlist-cpu", small(model="linear", cfl=0.95 * limit, t_end=None, steps=150)))
     blown = run_spec(RunSpec("linkedlist-cpu", small(model="linear", cfl=1.1 * limit, t_end=None, steps=150)))

@@ -25,7 +25,7 @@ from pcabench.studies.walls import section as W  # noqa: E402
 from pcabench.studies.walls.plan import FREE_COUNTERPART, WALL_COST_DX, WALL_COST_ROUNDS, WALLS, cost_round
 from solvers import Scene, kernel_names, scenes  # noqa: E402
 from solvers.method import Method
-from solvers.reference.dispersion import predict, stable_cfl  # noqa: E402
+from solvers.reference.dispersion import predict, predicted_stable_cfl  # noqa: E402
 
 from .figure_check import record  # noqa: E402
 from .test_study import row  # noqa: E402
@@ -63,7 +63,7 @@ def test_the_stability_runs_bracket_each_methods_predicted_limit(plan):
         methods = {(s.model, s.kernel, s.h_factor) for s in mine}
         for model, kernel, h in methods:
             cfls = [s.cfl for s in mine if (s.model, s.kernel, s.h_factor) == (model, kernel, h)]
-            limit = stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear"))
+            limit = predicted_stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear"))
             assert min(cfls) < limit < max(cfls), (name, model, kernel, h, cfls, limit)
         # long enough for round-off to grow at 2 % past the limit; and the plane scene does not break before it
         assert all(s.t_final < s.kind.breaking_time(s) for s in mine if s.model != "linear")
@@ -117,7 +117,7 @@ def _store(path):
                 wall_rms=wall,
                 bulk_rms=bulk * (1 + gap),
             )
-    limit = stable_cfl(Scene(dx=1.0, h_factor=1.3, model="linear"))
+    limit = predicted_stable_cfl(Scene(dx=1.0, h_factor=1.3, model="linear"))
     for cfl, status, step in ((round(0.9 * limit, 2), "unstable", 31), (round(1.02 * limit, 2), "unstable", 20)):
         add(
             row(

@@ -1,7 +1,7 @@
 """A run's predicted stability: the largest stable CFL of its method, and how far past it the run went.
 
 The limit (:func:`stable_cfl`, the suite's one) comes from the dispersion relation
-(solvers/reference/dispersion.py ``stable_cfl``): exact for the `linear` model on a periodic lattice; for
+(solvers/reference/dispersion.py ``predicted_stable_cfl``): exact for the `linear` model on a periodic lattice; for
 `fixed` and `lagrangian` it is their linear part's (design section 4). Where
 long runs of a scene measured a lower one (free ends, or a moving model's
 nonlinear terms: :func:`measured_limits`), that one is used.
@@ -74,7 +74,7 @@ def _limits(
     from solvers.kernels import truncated
     from solvers.method import Method
     from solvers.reference.dispersion import largest_symbol, unit_scene
-    from solvers.reference.dispersion import stable_cfl as lattice_limit
+    from solvers.reference.dispersion import predicted_stable_cfl as lattice_limit
 
     method = Method(kernel, h_factor, cutoff_factor if truncated(kernel) else None, 1.0, integrator, correction)
     scene = unit_scene(**method.scene_fields())
@@ -136,7 +136,7 @@ def stable_cfl(r) -> float:
     long runs of its scene and model measured where that is lower (:func:`measured_limits`). Every stable CFL the
     suite states or steps by is this one (advise, the fronts, the reports, the cylinder's advised CFL), but for
     a plan that brackets the periodic lattice's own limit on purpose (the walls study's long runs:
-    solvers.reference.dispersion.stable_cfl). Open edges keep
+    solvers.reference.dispersion.predicted_stable_cfl). Open edges keep
     it: their damping is a term of each update (solvers/absorbers/base.py; measured with `pcabench study --open`
     and the cylinder's long runs, docs/accuracy.md "Open edges")."""
     from solvers import Scene

@@ -20,7 +20,7 @@ For `fixed` and `lagrangian` it is their linear part only.
 
 The largest |D(k)| over the Brillouin zone bounds the step: a mode is stable
 while the integrator's amplification over one step has spectral radius <= 1,
-which depends only on z = c0 |D| dt; :func:`stable_cfl` turns the largest
+which depends only on z = c0 |D| dt; :func:`predicted_stable_cfl` turns the largest
 stable z into the largest stable CFL = dt c0 / dx.
 """
 
@@ -217,14 +217,15 @@ def largest_stable_z(integrator: str) -> float:
     return float(Z_SCAN[np.argmax(unstable)]) if unstable.any() else float(Z_SCAN[-1])
 
 
-def stable_cfl(scene) -> float:
+def predicted_stable_cfl(scene) -> float:
     """The largest stable CFL (dt c0 / dx) on the periodic lattice for the scene's (or a
     :class:`~solvers.method.Method`'s) kernel, h/dx, cutoff, integrator and correction (it does not depend on dx: D
     scales as 1/dx at fixed h/dx). The harness's stable CFL of a run (pcabench/predict/stability.py ``stable_cfl``)
     is this, or the lower limit long runs of its scene measured."""
     from solvers.scene import Scene
 
-    own = scene.kind.stable_cfl(scene) if hasattr(scene, "kind") else None  # a 3D scene's: the cubic lattice's
+    # a 3D scene's: the cubic lattice's
+    own = scene.kind.predicted_stable_cfl(scene) if hasattr(scene, "kind") else None
     if own is not None:
         return own
     cut = getattr(scene, "cutoff_factor", None)
@@ -247,7 +248,7 @@ def unit_scene(**method):
 def lattice_stable_cfl(
     kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str = "none"
 ) -> float:
-    """:func:`stable_cfl` of one method, by its fields (cached: the same at every dx)."""
+    """:func:`predicted_stable_cfl` of one method, by its fields (cached: the same at every dx)."""
     unit = unit_scene(
         kernel=kernel, h_factor=h_factor, cutoff_factor=cutoff_factor, integrator=integrator, correction=correction
     )
@@ -293,7 +294,7 @@ def predict_plane(scene) -> Prediction:
     return Prediction(
         predicted_error=measures.pop("mse"),
         predicted_me=measures.pop("me"),
-        stable_cfl=stable_cfl(scene),
+        stable_cfl=predicted_stable_cfl(scene),
         t_end=t,
         lattice_phase_error=d / k - 1.0,
         step_phase_error=step_phase_angle(scene.integrator, scene.c0 * d * scene.dt) / (scene.c0 * k * scene.dt) - 1.0,
@@ -356,7 +357,9 @@ def predict_2d(scene, kind) -> Prediction:
     x, y, drho, u, v, t = predicted_fields_2d(scene.replace(model="linear"))
     fields = Fields(x=x.ravel(), y=y.ravel(), u=u.ravel(), v=v.ravel(), drho=drho.ravel(), t=t)
     measures = kind.errors(scene.replace(model="linear"), fields)
-    return scored_prediction(measures, stable_cfl(scene), t, phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4))
+    return scored_prediction(
+        measures, predicted_stable_cfl(scene), t, phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4)
+    )
 
 
 def scored_prediction(measures: dict, stable: float, t: float, axis: tuple, diagonal: tuple) -> Prediction:

@@ -94,7 +94,7 @@ def lattice_stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integ
     return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
 
 
-def stable_cfl(scene) -> float:
+def predicted_stable_cfl(scene) -> float:
     """:func:`lattice_stable_cfl` of a 3D scene's method."""
     cut = scene.cutoff_factor
     return lattice_stable_cfl(scene.kernel, float(scene.h_factor), float(cut), scene.integrator, scene.correction)
@@ -118,7 +118,7 @@ def predicted_fields(scene) -> tuple:
     keep = np.abs(drho_hat) > SPECTRUM_FLOOR * size
     for h in hats:
         keep |= np.abs(h) > SPECTRUM_FLOOR * size
-    if scene.cfl > stable_cfl(scene):  # the round-off's modes grow past the stable step: every one evolved
+    if scene.cfl > predicted_stable_cfl(scene):  # the round-off's modes grow past the stable step: every one evolved
         keep[...] = True
     kz, ky, kx = (
         2.0 * math.pi * np.fft.fftfreq(n, d=scene.dx)[index]
@@ -148,7 +148,7 @@ def predict(scene, kind) -> Prediction:
     fields = Fields(x=exact.x, y=exact.y, z=exact.z, u=u.ravel(), v=v.ravel(), w=w.ravel(), drho=drho.ravel(), t=t)
     measures = kind.errors(linear, fields)
     axis, diagonal = phase_errors(scene, (1.0, 0.0, 0.0)), phase_errors(scene, (1.0, 1.0, 1.0))
-    return scored_prediction(measures, stable_cfl(scene), t, axis, diagonal)
+    return scored_prediction(measures, predicted_stable_cfl(scene), t, axis, diagonal)
 
 
 def phase_errors(scene, direction: tuple) -> tuple[float, float]:

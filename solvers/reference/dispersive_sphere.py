@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from solvers.reference.dispersion import Prediction, scored_prediction
-from solvers.reference.dispersion3d import phase_errors, stable_cfl, symbol
+from solvers.reference.dispersion3d import phase_errors, predicted_stable_cfl, symbol
 from solvers.reference.dispersive_cylinder import method_factor
 from solvers.reference.pulse2d import gauss_legendre
 
@@ -65,4 +65,4 @@ def predict_sphere(scene) -> Prediction:
     measures = scene.kind.probe_errors(scene, predicted_probes(scene))
     measures.update(mse=measures.pop("probe_rms"), me=measures.pop("probe_max"))
     axis, diagonal = phase_errors(scene, (1.0, 0.0, 0.0)), phase_errors(scene, (1.0, 1.0, 1.0))
-    return scored_prediction(measures, stable_cfl(scene), scene.t_final, axis, diagonal)
+    return scored_prediction(measures, predicted_stable_cfl(scene), scene.t_final, axis, diagonal)

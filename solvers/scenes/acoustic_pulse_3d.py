@@ -202,11 +202,11 @@ class AcousticPulse3D(SceneKind):
 
         return predict(scene, self)
 
-    def stable_cfl(self, scene) -> float:
+    def predicted_stable_cfl(self, scene) -> float:
         """The cubic lattice's stable CFL of the scene's method (solvers/reference/dispersion3d.py)."""
-        from solvers.reference.dispersion3d import stable_cfl
+        from solvers.reference.dispersion3d import predicted_stable_cfl
 
-        return stable_cfl(scene)
+        return predicted_stable_cfl(scene)
 
     def sized_domain(self, size: float) -> dict:
         """A cube of side ``size`` m centred on the origin."""

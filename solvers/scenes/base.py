@@ -333,9 +333,9 @@ class SceneKind:
         NoPrediction where the kind has none."""
         raise NoPrediction(f"the {self.name} scene has no prediction from the dispersion relation")
 
-    def stable_cfl(self, scene) -> float | None:
+    def predicted_stable_cfl(self, scene) -> float | None:
         """The largest stable CFL of ``scene``'s method where this kind's lattice is not the square one (a 3D
-        kind's cube); None: the square lattice's (solvers/reference/dispersion.py ``stable_cfl``)."""
+        kind's cube); None: the square lattice's (solvers/reference/dispersion.py ``predicted_stable_cfl``)."""
         return None
 
     def predict_headline(self, scene):

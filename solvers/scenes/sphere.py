@@ -137,11 +137,11 @@ class Sphere(SceneKind):
             out["mse"], out["me"] = float("nan"), float(np.max(np.abs(drho), initial=0.0))
         return out
 
-    def stable_cfl(self, scene) -> float:
+    def predicted_stable_cfl(self, scene) -> float:
         """The cubic lattice's stable CFL of the scene's method (solvers/reference/dispersion3d.py)."""
-        from solvers.reference.dispersion3d import stable_cfl
+        from solvers.reference.dispersion3d import predicted_stable_cfl
 
-        return stable_cfl(scene)
+        return predicted_stable_cfl(scene)
 
     def predict(self, scene):
         """The probes' errors the bulk's dispersion alone would give, the wall exact

@@ -269,7 +269,8 @@ def text(data, ctx) -> list[str]:
                 f"CFL {r['cfl']:g} " + ("bounded" if r["status"] == "ok" else f"{r['status']} at step {_step(r)}")
                 for r in mine
             )
-            + f"; the periodic lattice's predicted limit is {dispersion.stable_cfl(mine[0]['scene_value']):.3g}."
+            + "; the periodic lattice's predicted limit is "
+            + f"{dispersion.predicted_stable_cfl(mine[0]['scene_value']):.3g}."
         )
     return lines + [""]
 

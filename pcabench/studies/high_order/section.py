@@ -48,7 +48,7 @@ def rows(df) -> dict | None:
                 "seconds": float(r.t_solution) if r.status == "ok" else None,
                 "N": int(r.n_particles),
                 "limit": stable_cfl(scene),
-                "predicted": dispersion.stable_cfl(scene),
+                "predicted": dispersion.predicted_stable_cfl(scene),
             }
         )
     return {"runs": runs}

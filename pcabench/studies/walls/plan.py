@@ -25,6 +25,7 @@ WALL_STABILITY_MACH = {"plane-wall": 0.01, "pulse-wall": None}
 WALL_LINEAR_METHODS = (
     ("gaussian", 1.3),
     ("laguerre-gauss", 1.5),
+    ("laguerre-gauss-6", 1.5),
     ("wendland-c2", 2.13),
     ("wendland-c4", 2.13),
 )  # (kernel, h/dx)
@@ -51,7 +52,7 @@ def cost_round(preset_name: str) -> int | None:
 def walls() -> list[RunSpec]:
     """Accuracy, stability and cost at a rigid wall (WALL_*): 68 runs, 34 min on one busy core of the reference
     machine (about 30 s of each run is its JIT compilation)."""
-    from solvers.reference.dispersion import stable_cfl
+    from solvers.reference.dispersion import predicted_stable_cfl
 
     runs = [
         spec_of(name=name, dx=dx, t_end=FRONT_T_END, model=model, strip=WALL_STRIP[name])
@@ -64,7 +65,7 @@ def walls() -> list[RunSpec]:
         if mach is not None:
             base["mach"] = mach
         for kernel, h in WALL_LINEAR_METHODS:
-            limit = stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear"))
+            limit = predicted_stable_cfl(Scene(dx=1.0, kernel=kernel, h_factor=h, model="linear"))
             runs += [
                 spec_of(kernel=kernel, h_factor=h, model="linear", cfl=round(f * limit, 2), **base)
                 for f in WALL_BRACKET
