@@ -343,3 +343,26 @@ def test_the_weak_wall_keeps_the_energy_where_ghosts_do_not():
     assert rates["lattice"] > 1e-4
     with pytest.raises(SceneError, match="--boundary-method weak makes a wall only with a kernel correction"):
         Scene(**{**SCENES["cylinder"], "boundary_method": "weak"})
+
+
+def test_what_a_correction_needs_is_asked_of_it_not_read_from_its_name():
+    """The pair list keeps moment sums for moving particles where the correction sums moments (asked:
+    ``Correction.moments``), whatever it is called: a plug-in correction that sums none keeps none, one named
+    otherwise that does keeps them."""
+    from solvers.corrections import CORRECTIONS, Correction
+    from solvers.search.pairlist import MOMENT_SUMS, list_bytes
+
+    class Plain(Correction):
+        name = "plain-test"
+
+    class Summing(Correction):
+        name = "summing-test"
+        moments = True
+
+    base = Scene(0.1, model="lagrangian")
+    item = np.dtype(base.precision).itemsize
+    with CORRECTIONS.registered(Plain), CORRECTIONS.registered(Summing):
+        assert list_bytes(base.replace(correction="plain-test")) == list_bytes(base)
+        extra = list_bytes(base.replace(correction="summing-test")) - list_bytes(base)
+    assert extra == base.n_particles * MOMENT_SUMS * item
+    assert list_bytes(base.replace(correction="gradient")) - list_bytes(base) == extra

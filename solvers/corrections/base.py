@@ -29,6 +29,8 @@ class Correction:
     name: str = ""  # what --correction and the stored scene's ``correction`` call it
     summary: str = ""  # one line for --help
     arrays: int = 0  # arrays per particle it keeps beyond a standard solver's
+    moments: bool = False  # whether it sums each particle's moments (a pair list keeps their sums for moving ones)
+    allocates: bool = False  # whether its passes allocate arrays inside a step (a CUDA graph cannot replay it)
 
     def coefficients(self, continuity: bool, momentum: bool) -> tuple:
         """(vol, pr): which coefficients a PI of ``continuity``/``momentum`` needs first."""

@@ -48,6 +48,8 @@ class GradientCorrection(Correction):
     name = "gradient"
     summary = "kernel gradient correction (Bonet & Lok): exact for linear fields, energy-keeping form"
     arrays = 14  # M's inverse (3), Gamma (2), w (2), and the moments sweep's and inversion's temporaries
+    moments = True  # M and Gamma, at every search where particles move
+    allocates = True  # its per-particle passes make their arrays inside the step
     arrays_3d = 24  # in 3D: M's inverse (6), Gamma (3), w (3), and the temporaries
 
     def coefficients(self, continuity: bool, momentum: bool) -> tuple:

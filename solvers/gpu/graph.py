@@ -37,7 +37,7 @@ class CapturedSteps:
                 "--open: the graph path replays closed scenes only (an open edge's layer keeps damping factors "
                 "that capture would record but never compute)"
             )
-        if getattr(getattr(solver, "correction", None), "name", "none") != "none":
+        if getattr(getattr(solver, "correction", None), "allocates", False):
             raise ValueError(
                 "--correction: the graph path replays uncorrected steps only (a correction's per-particle passes "
                 "allocate their arrays inside the step)"

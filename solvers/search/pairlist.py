@@ -44,6 +44,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from solvers.corrections import correction_named
 from solvers.physics.backend import COMPILED, cpu_loops
 from solvers.search.compress import PAD
 
@@ -74,7 +75,8 @@ def list_bytes(scene, budget: int | None = None) -> int:
     item = np.dtype(scene.precision).itemsize
     per_particle = capacity(scene) if budget is None else budget
     # a correction's moments summed from the list at every search where particles move: their accumulators
-    moments = MOMENT_SUMS * item if scene.correction != "none" and scene.model == "lagrangian" else 0
+    summed = correction_named(scene.correction).moments and scene.model == "lagrangian"
+    moments = MOMENT_SUMS * item if summed else 0
     return scene.n_particles * (per_particle * (INDEX_BYTES + 2 * item) + ROW_BYTES + moments)
 
 
