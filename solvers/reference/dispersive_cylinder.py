@@ -23,8 +23,8 @@ from solvers.fields import Fields
 from solvers.reference.dispersion import (
     Prediction,
     phase_errors,
+    predicted_stable_cfl,
     scored_prediction,
-    stable_cfl,
     step_matrices,
     symbol,
 )
@@ -131,4 +131,4 @@ def predict_cylinder(scene, field: bool = True) -> Prediction:
         measures = kind.probe_errors(scene, predicted_probes(scene, method))
         measures.update(mse=measures["probe_rms"], me=measures.pop("probe_max"))
     axis, diagonal = phase_errors(scene, 0.0), phase_errors(scene, math.pi / 4)
-    return scored_prediction(measures, stable_cfl(scene), scene.t_final, axis, diagonal)
+    return scored_prediction(measures, predicted_stable_cfl(scene), scene.t_final, axis, diagonal)
