@@ -28,7 +28,8 @@ from solvers.reference import dispersion
 
 TARGET = 0.02  # the issue's: 2 % relative RMS at the probes
 TARGET_DX = 0.02  # at no more than 10 particles a pulse width
-WALL_STYLE = {"lattice": "-", "rings": "--", "weak": "-.", "cut": ":"}  # a boundary method's line and marker
+# a boundary method's line and marker (the predictions are dotted)
+WALL_STYLE = {"lattice": "-", "rings": "--", "weak": "-.", "cut": (0, (6, 2, 1, 2, 1, 2))}
 WALL_MARKER = {"lattice": "o", "rings": "s", "weak": "^", "cut": "D"}
 WALL_COLOUR = {"lattice": "tab:blue", "rings": "tab:orange", "weak": "tab:green", "cut": "tab:red"}
 # the prediction's dx (the wall exact, the bulk's dispersion alone: solvers/reference/dispersive_cylinder.py), to
@@ -297,7 +298,7 @@ def _exact(scene, series) -> tuple:
 
 def probes_figure(data, ctx):
     """p(t) at A, B and C over the workshop's window: the exact solution (black) beside each boundary method's
-    run at the finest dx of the most accurate kernel (linear)."""
+    run of the most accurate method and dx run with more than one wall (else the most accurate run), linear."""
     if not data:
         return None
     ok = [r for r in data["runs"] if r["status"] == "ok" and r["probes"] is not None and r["series"].get("t")]
@@ -306,9 +307,13 @@ def probes_figure(data, ctx):
         return None
     held = [r for r in ok if r["cfl"] < stable_cfl(r["scene_value"].replace(model="linear"))]
     ok = held or ok  # a run past the limit long runs measured is bounded only because it is short: not shown first
-    best = min(ok, key=lambda r: (-1 if r["dx"] == min(x["dx"] for x in ok) else 0, r["probes"]))
     same = ("dx", "label", "cfl")
-    shown = [r for r in ok if all(r[k] == best[k] for k in same)]
+    groups: dict = {}
+    for r in ok:
+        groups.setdefault(tuple(r[k] for k in same), []).append(r)
+    walls = [g for g in groups.values() if len({r["method"] for r in g}) > 1]  # where the walls differ, side by side
+    shown = min(walls or groups.values(), key=lambda g: min(r["probes"] for r in g))
+    best = min(shown, key=lambda r: r["probes"])
     path = ctx.out / "cylinder_probes.png"
     t, exact = _exact(best["scene_value"], best["series"])
     window = (t >= 6.0 - 1e-9) & (t <= 10.0 + 1e-9)
@@ -362,8 +367,8 @@ def error_figure(data, ctx):
     with F.figure(
         path,
         f"Sound around a cylinder: error against dx, linear ({ctx.name}); colour: method; solid, circles: lattice "
-        "ghosts; dashed, squares: rings; dash-dot, triangles: the weak wall; dotted, crosses: predicted (the wall "
-        "exact); grey: the 2 % target",
+        "ghosts; dashed, squares: rings; dash-dot, triangles: the weak wall's staircase; dash-dot-dot, diamonds: its "
+        "cut cells; dotted, crosses: predicted (the wall exact); grey: the 2 % target",
         "dx (m)",
         "relative RMS",
         ncols=2,
@@ -380,7 +385,7 @@ def error_figure(data, ctx):
         ):
             ax = axes[i]
             for (label, cfl), colour in zip(kernels, colours):
-                for method in ("lattice", "rings", "weak"):
+                for method in WALL_STYLE:
                     pts = sorted(
                         (r["dx"], r[what])
                         for r in ok

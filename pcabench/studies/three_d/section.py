@@ -52,13 +52,14 @@ def rows(df) -> dict | None:
             sphere.append(
                 {**row, **{k: float(v) if ok and v == v else None for k, v in probes.items()}, "series": series,
                  "scene_value": scene, "predicted": bulk_share(scene),
-                 "wall": scene.boundary_method_used}
+                 "wall": scene.boundary_method_used, "faces": scene.absorber_used}
             )  # fmt: skip
         elif scene.dims == 3:
             predicted = scene.kind.predict(scene).predicted_error
             plane = json.loads(r.plane) if ok and isinstance(r.get("plane"), str) else {}
             accuracy.append({**row, "predicted": predicted, "plane": plane, "scene_value": scene})
-    return {"accuracy": accuracy, "cost": cost, "sphere": sorted(sphere, key=lambda r: (r["wall"] != "weak", -r["dx"]))}
+    sphere.sort(key=lambda r: (r["faces"] != "sponge", r["wall"] != "weak", -r["dx"]))
+    return {"accuracy": accuracy, "cost": cost, "sphere": sphere}
 
 
 def bulk_share(scene) -> float | None:
@@ -82,6 +83,12 @@ def order(a, b, key: str = "error") -> float | None:
     if not (a.get(key) and b.get(key)):
         return None
     return math.log(a[key] / b[key]) / math.log(a["dx"] / b["dx"])
+
+
+def same_method(a, b) -> bool:
+    """Whether two sphere runs differ only in dx (their order is then the method's): the same wall, faces and
+    method, another dx."""
+    return all(a[k] == b[k] for k in ("wall", "faces", "label", "cfl")) and a["dx"] != b["dx"]
 
 
 def pair_ns(r) -> float | None:
@@ -172,11 +179,12 @@ def sphere_text(runs) -> list[str]:
             f"{r['dx']:g}",
             f"{r['N']:,}",
             r["wall"],
+            r["faces"],
             r["label"],
             *(fmt(r[k], ".3g") for k in ("A", "B", "C")),
             fmt(r["error"], ".3g") if r["error"] is not None else r["status"],
             fmt(r["predicted"], ".3g"),
-            fmt(order(a, r), ".2f") if a is not None and a["wall"] == r["wall"] else "-",
+            fmt(order(a, r), ".2f") if a is not None and same_method(a, r) else "-",
             fmt(r["seconds"], ".3g"),
         ]
         for a, r in zip([None, *runs[:-1]], runs)
@@ -193,14 +201,17 @@ def sphere_text(runs) -> list[str]:
     return [
         "",
         "The rigid sphere (`--scene sphere`: b = 0.4 m at (1.5, 0, 0) about a sphere of radius 0.5 m; the weak wall's "
-        "staircase and its cut cells, `--boundary-method cut`), linear, t = 4 s: relative RMS of p at the probes "
+        "staircase and its cut cells, `--boundary-method cut`; faces: what damps the open faces, the PML (the "
+        "issue's scene, the default since 2026-12-07) or the sponge), linear, t = 4 s: relative RMS of p at the probes "
         "over 1.5 <= t <= 4 s against the exact series (solvers/reference/sphere.py); beside it the bulk's share, "
         "predicted: the series with the method's own dispersion and an exact wall "
         "(solvers/reference/dispersive_sphere.py, `pcabench accuracy --scene sphere`), so that what the run has "
         "beyond it is the wall's. The issue's target (2 % at dx 0.05, order 2.5 from dx 0.1) needs dx 0.05: 1.5 "
         f"million particles with the layer{cost} (`pcabench study --three-d fine`).",
         "",
-        md_table(["dx", "N", "wall", "method", "A", "B", "C", "probes", "bulk (predicted)", "order", "s"], table),
+        md_table(
+            ["dx", "N", "wall", "faces", "method", "A", "B", "C", "probes", "bulk (predicted)", "order", "s"], table
+        ),
     ]
 
 
