@@ -10,10 +10,10 @@ import pytest
 
 from pcabench import store
 from pcabench.reports import frame
+from pcabench.reports.long_runs import long_run_limits
 from pcabench.spec import RunSpec, scene_from_row
 from pcabench.store.record import RunRecord
 from pcabench.store.rows import default_numerics, is_paper_method, numerics_label
-from pcabench.studies.stability.rows import long_run_limits
 from solvers import Scene, SceneError
 from solvers.method import Method
 

@@ -7,6 +7,7 @@ import itertools
 
 from pcabench.spec import RunSpec
 from pcabench.studies.preset import Preset, spec_of
+from pcabench.studies.protocols import FRONT_T_END
 from solvers import Scene, kernel_names, scene_kind
 from solvers.scenes import DEFAULT_SCENE
 
@@ -29,7 +30,6 @@ FRONT = {
         model=("linear", "lagrangian"),
     ),
 }
-FRONT_T_END = 10.0
 
 
 # The paper's own scene (dx = 0.05, full domain, t = 10 s): its method, and the methods the prediction names as

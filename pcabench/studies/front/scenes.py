@@ -19,11 +19,11 @@ from pcabench.reports.section import Section
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import is_paper_method, latest, linear_floor, numerics_label
 from pcabench.studies.front.figures import phase_direction, scene_fronts
+from pcabench.studies.protocols import FRONT_T_END as T_FINAL  # s
 from solvers import DEFAULT_SCENE, Scene, scene_kind
 from solvers.method import Method
 
 TARGETS = (0.10, 0.05, 0.02)  # relative RMS errors of the primary field
-T_FINAL = 10.0  # s
 MODEL_TARGET = 0.02  # "which model this scene needs": the error against the isothermal physics asked for
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 
 from pcabench.studies.preset import Preset, spec_of
-from pcabench.studies.stability.plan import LONG_SCENES, LONG_T_END, STABILITY_DX
+from pcabench.studies.protocols import LONG_SCENES, LONG_T_END, STABILITY_DX
 from solvers import Scene
 
 # The open-edges preset (issue 41, ``pcabench study --open``), in four parts.

@@ -19,13 +19,13 @@ import json
 import numpy as np
 
 from pcabench.reports import figures as F
+from pcabench.reports.long_runs import long_run_limits
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, stored_measure
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import latest
 from pcabench.studies.open_edges.plan import OPEN, OPEN_DX, OPEN_SCENES, open_cost_round
-from pcabench.studies.stability.plan import LONG_T_END
-from pcabench.studies.stability.rows import long_run_limits
+from pcabench.studies.protocols import LONG_T_END
 from solvers.absorbers import absorber_named
 from solvers.fields import Fields
 

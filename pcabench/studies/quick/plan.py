@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pcabench.spec import RunSpec
 from pcabench.studies.preset import Preset, spec_of
-from pcabench.studies.stability.plan import STABILITY_DX
+from pcabench.studies.protocols import STABILITY_DX
 from solvers import Scene
 
 QUICK_CFL = (0.2, 2.0, 5.0, 7.0)  # the quick map: stable, stable, just past the predicted 4.97, far past it

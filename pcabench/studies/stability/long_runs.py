@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
+from pcabench.reports.long_runs import long_run_limits
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, limit_words, outcome_cells
-from pcabench.studies.stability.rows import long_run_limits
 
 
 def text(rows, ctx) -> list[str]:

@@ -4,28 +4,16 @@ from __future__ import annotations
 
 from pcabench.spec import ALL_CORES, RunSpec
 from pcabench.studies.preset import Preset, spec_of
+from pcabench.studies.protocols import LONG_MODELS, LONG_SCENES, LONG_T_END, STABILITY_DX
 
-# The stability preset's scene: the design's dx = 0.25 on a strip, the linear model
-# (exactly the linear wave equation, so growth is the integrator's, not the physics').
-STABILITY_DX = 0.25
 STABILITY_CFL = (0.1, 0.2, 0.5, 1.0, 2.0, 2.5, 3.0, 4.0, 4.5, 5.0, 5.5, 6.0, 7.0)
 STABILITY_H = (1.0, 1.3)  # h/dx beside Scene's default
 # Above this relative RMS error a run that stayed bounded is classed inaccurate: twice the
 # error of Verlet at CFL 0.2 on the stability scene (10 % at dx = 0.25, t = 10 s).
 INACCURATE_ABOVE = 0.20
-# The long-run stability preset: the moving models' own limit, where their nonlinear terms (and, with free ends,
-# the particles at the edges) can grow what the linear part keeps bounded, measured over runs long enough for
-# round-off to grow. Two scenes: the paper's pulse on the stability strip, free ends in x (at Mach 0.01, so that it
-# does not break before t = 300 s: 350 s; the pulse leaves by the free end long before, so that the run then tests
-# the edges); and the 2D acoustic pulse in a 20 m periodic square, where the sound never leaves and never breaks.
-# The linear model runs beside the moving ones on each: the control whose limit the prediction knows exactly.
-LONG_SCENES = {
-    "plane-pulse": dict(strip=True, mach=0.01),
-    "acoustic-pulse": dict(x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0),
-}
-LONG_T_END = 300.0  # s: about 250 steps at CFL 4.7, dx 0.25
+# The long-run stability preset (LONG_SCENES, LONG_T_END, LONG_MODELS: pcabench/studies/protocols.py) at these
+# CFLs:
 LONG_CFL = (4.4, 4.5, 4.6, 4.7, 4.75, 4.8, 4.9, 5.0)
-LONG_MODELS = ("linear", "fixed", "lagrangian")
 
 
 def stability() -> list[RunSpec]:

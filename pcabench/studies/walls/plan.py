@@ -5,9 +5,8 @@ from __future__ import annotations
 import dataclasses
 
 from pcabench.spec import RunSpec
-from pcabench.studies.front.plan import FRONT_T_END
 from pcabench.studies.preset import Preset, spec_of
-from pcabench.studies.stability.plan import LONG_MODELS, LONG_T_END, STABILITY_DX
+from pcabench.studies.protocols import FRONT_T_END, LONG_MODELS, LONG_T_END, STABILITY_DX
 from solvers import Scene
 
 # The walls preset (issue 34, ``pcabench study --walls``): sound at a rigid wall, in three parts.

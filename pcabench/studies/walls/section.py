@@ -12,13 +12,13 @@ from pathlib import Path
 
 import numpy as np
 
+from pcabench.reports.long_runs import long_run_limits
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, outcome_cells, stored_measure
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import is_paper_method, latest
-from pcabench.studies.front.scenes import T_FINAL
-from pcabench.studies.stability.plan import LONG_T_END
-from pcabench.studies.stability.rows import long_run_limits
+from pcabench.studies.protocols import FRONT_T_END as T_FINAL
+from pcabench.studies.protocols import LONG_T_END
 from pcabench.studies.walls.figures import wall_errors
 from pcabench.studies.walls.plan import FREE_COUNTERPART, WALLS, cost_round
 from solvers import Scene, scenes
