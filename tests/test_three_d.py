@@ -565,3 +565,21 @@ def test_a_3d_scenes_open_faces_take_the_pml_and_a_row_stored_before_reads_as_th
     keys = {identity("linkedlist-cpu", 1, s, "", "m", "c", "h") for s in (scene, old)}
     assert len(keys) == 2 and stored_parameters(old)["absorber"] == "sponge"
     assert Scene(0.5, "acoustic-pulse-3d").as_dict()["absorber_used"] == ""  # closed: none
+
+
+def test_a_plug_in_kind_that_states_its_stable_cfl_by_the_earlier_name_is_still_asked():
+    """A scene kind written before ``predicted_stable_cfl`` (its ``stable_cfl``) still gives the prediction its
+    lattice's limit."""
+    from solvers.reference.dispersion import predicted_stable_cfl
+    from solvers.scenes.acoustic_pulse_3d import AcousticPulse3D
+
+    class Legacy(AcousticPulse3D):
+        def predicted_stable_cfl(self, scene):  # the base's, as a kind written before the name has it
+            return super(AcousticPulse3D, self).predicted_stable_cfl(scene)
+
+        def stable_cfl(self, scene):
+            return 0.123
+
+    scene = small()
+    assert Legacy().predicted_stable_cfl(scene) == 0.123
+    assert predicted_stable_cfl(scene) == AcousticPulse3D().predicted_stable_cfl(scene) > 1.0

@@ -335,8 +335,10 @@ class SceneKind:
 
     def predicted_stable_cfl(self, scene) -> float | None:
         """The largest stable CFL of ``scene``'s method where this kind's lattice is not the square one (a 3D
-        kind's cube); None: the square lattice's (solvers/reference/dispersion.py ``predicted_stable_cfl``)."""
-        return None
+        kind's cube); None: the square lattice's (solvers/reference/dispersion.py ``predicted_stable_cfl``). A
+        plug-in kind written before the name (its ``stable_cfl``) is asked by that."""
+        legacy = getattr(self, "stable_cfl", None)
+        return legacy(scene) if callable(legacy) else None
 
     def predict_headline(self, scene):
         """:meth:`predict` where only its headline error is wanted (advise's search): a kind may skip the rest."""
