@@ -92,6 +92,7 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
         ("stability-long", {paper}),
         ("walls", {paper}),
         ("cylinder", {CYLINDER_ADVISED}),
+        ("cylinder-wall", {("laguerre-gauss-6", 1.5)}),  # the sixth-order kernel's step with the body
         ("high-order", high_order),
     )
     for preset, methods in presets:

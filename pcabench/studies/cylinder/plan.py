@@ -59,7 +59,9 @@ CYLINDER_SIXTH_CFL = 1.0
 CYLINDER_SIXTH_SHORT_CFL = 0.5
 CYLINDER_WALL_DX = (0.04, 0.03, 0.025, 0.02)
 # the stable step with the body (cut cells) and the open edges: long runs (t = 100 s, dx 0.04) up to the periodic
-# lattice's predicted limit for RK4 (2.14) and the margin's 0.9 of it (1.93), whether advise's step holds there
+# lattice's predicted limit for RK4 (2.14) and the margin's 0.9 of it (1.93), whether advise's step holds there.
+# Measured 2026-12-07 (amd-epyc): 1.0 and 1.5 bounded, 1.9 and 2.1 blew up (steps 105 and 60): the body's limit is
+# below the lattice's, in pcabench/predict/measured_limits.csv
 CYLINDER_SIXTH_LONG_CFLS = (1.0, 1.5, 1.9, 2.1)
 
 
