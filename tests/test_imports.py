@@ -87,7 +87,7 @@ def _imports(module: str):
 
 
 def _faces(module: str, target: str) -> list[str]:
-    """The package faces importing ``target`` runs (``pcabench.reports`` for ``pcabench.reports.paper``), but for
+    """The package faces importing ``target`` runs (``pcabench.store`` for ``pcabench.store.rows``), but for
     ``module``'s own packages, which ran before it: an import of a submodule is an import of its packages too."""
     parts = target.split(".")
     above = [".".join(parts[:i]) for i in range(1, len(parts))]
@@ -132,8 +132,8 @@ def test_the_graph_is_read():
     """The walk sees the imports it must: inside functions, relative, and through a package's face."""
     assert "solvers.scene" in GRAPH["pcabench.studies.preset"]  # `from solvers import Scene`, through the face
     assert "pcabench.studies.preset" in GRAPH["pcabench.cli.study"]  # imported inside a function
-    # `from pcabench.reports import paper` runs the face pcabench.reports first: an edge to it too
-    assert {"pcabench.reports.paper", "pcabench.reports"} <= set(GRAPH["pcabench.studies.paper.rows"])
+    # `from pcabench.store.rows import latest` runs the face pcabench.store first: an edge to it too
+    assert {"pcabench.store.rows", "pcabench.store"} <= set(GRAPH["pcabench.studies.paper.rows"])
     assert len(GRAPH) > 50 and sum(map(len, GRAPH.values())) > 150
 
 

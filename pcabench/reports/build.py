@@ -15,11 +15,11 @@ from pcabench import store
 from pcabench.errors import NoResults
 from pcabench.machine import profiles
 from pcabench.reports import frame
-from pcabench.reports import paper as P
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Context, in_order
 from pcabench.store import runs
 from pcabench.store.safeio import own_folder, write_file
+from pcabench.studies.paper import published as P
 from pcabench.studies.paper.figures import cards_figure, fig14
 from pcabench.studies.paper.rows import card_ceilings, card_ratios, cards, table4, table6
 from pcabench.studies.paper.table6 import table6_md

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from pcabench.reports import paper as P
 from pcabench.reports.section import Section
+from pcabench.studies.paper import published as P
 from pcabench.studies.paper.figures import fig10
 from pcabench.studies.paper.rows import runtime_series
 

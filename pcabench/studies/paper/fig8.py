@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcabench.reports import paper as P
 from pcabench.reports.md import fmt, md_table, pct
 from pcabench.reports.section import Section
 from pcabench.store.rows import linear_floor
+from pcabench.studies.paper import published as P
 from pcabench.studies.paper.figures import fig8
 from pcabench.studies.paper.rows import accuracy_bars, error_series, trend
 from solvers import Scene

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pcabench.reports import paper as P
 from pcabench.reports.md import first_words, fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper import published as P
 from pcabench.studies.paper.figures import fig9
 from pcabench.studies.paper.rows import FIG9_LOOP_NAMES, fig9_rows, fig9_steps
 

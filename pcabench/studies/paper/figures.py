@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 from matplotlib.ticker import NullLocator
 
-from pcabench.reports import paper as P
 from pcabench.reports import tables as T
 from pcabench.reports.figdata import save_figure_data
 from pcabench.reports.figures import (
@@ -27,6 +26,7 @@ from pcabench.reports.figures import (
 )
 from pcabench.store.record import STEP_STAGES
 from pcabench.store.safeio import save_figure
+from pcabench.studies.paper import published as P
 from pcabench.studies.paper.rows import FIG9_LOOP_NAMES, cards_published, fig9_steps, trend
 from solvers import STAGES
 
@@ -47,7 +47,7 @@ PAPER_MARKERS = {"paper-system-1": "^", "paper-system-2": "v", "paper-system-3":
 
 
 def _published(ax, rows, marker, label, **style):
-    """The paper's rows (from :mod:`pcabench.reports.paper`) as one published series: grey, dashed, hollow."""
+    """The paper's rows (from :mod:`pcabench.studies.paper.published`) as one published series: grey, dashed, hollow."""
     pts = sorted((r["N"], r["ms"]) for r in rows)
     ax.plot(*zip(*pts), marker=marker, **{**PUBLISHED, **style}, label=label)
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from pcabench.machine import profiles
-from pcabench.reports import paper as P
 from pcabench.reports.tables import PROTOCOL, label, paper_scene, per_step_ms, protocol, where
 from pcabench.store.record import STEP_STAGES
 from pcabench.store.rows import default_numerics, latest, newest_per
+from pcabench.studies.paper import published as P
 from solvers import STAGES
 
 FIG9_LOOP_NAMES = {"gather": "the paper's gather loop", "list": "the pair list"}  # by ``linkedlist_loop``
@@ -532,7 +532,7 @@ def _ratio(x, y):
 
 def cards_published() -> list[dict]:
     """The paper's cards, one step (ms) by N, one source per card: the K20c's Table 4 (measured per step),
-    the other two cards' Table 6 (:mod:`pcabench.reports.paper` states the conversion)."""
+    the other two cards' Table 6 (:mod:`pcabench.studies.paper.published` states the conversion)."""
     return [
         r
         for r in P.step_times()

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pcabench.reports import paper as P
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper import published as P
 from pcabench.studies.paper.figures import fig13
 from pcabench.studies.paper.rows import one_step_shares, table4_of
 
@@ -40,7 +40,7 @@ def text(rows, ctx) -> list[str]:
         "stand apart, never averaged or replaced. The paper's column holds its published numbers of the same "
         "kind only: same N, same device, same search, serial and float64 (the paper's codes are "
         "single-thread and double precision), each with the conversion it took "
-        f"(pcabench/reports/paper.py). The paper has them for {paper_sizes(rows)}.",
+        f"(pcabench/studies/paper/published.py). The paper has them for {paper_sizes(rows)}.",
         "",
         md_table(
             [

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pcabench.reports import paper as P
 from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
+from pcabench.studies.paper import published as P
 from pcabench.studies.paper.figures import fig11
 from pcabench.studies.paper.rows import table4_of, table5
 
