@@ -6,12 +6,13 @@ import pytest
 
 from pcabench import store
 from pcabench.reports.build import write_reports
+from pcabench.reports.long_runs import long_run_limits
 from pcabench.reports.section import SECTIONS, Section
 from pcabench.studies.paper.rows import fig9_rows
 from pcabench.studies.stability import long_runs as long_runs_section
 from pcabench.studies.stability import section as stability_section
 from pcabench.studies.stability.figures import stability_map
-from pcabench.studies.stability.rows import long_run_limits, stability
+from pcabench.studies.stability.rows import stability
 
 from .test_study import fixture_rows
 
