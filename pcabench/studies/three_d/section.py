@@ -303,7 +303,7 @@ def sphere_figure(data, ctx):
     runs = [r for r in (data or {}).get("sphere", []) if r["error"] is not None and r["series"].get("t")]
     if not runs:
         return None
-    best = min(runs, key=lambda r: (r["dx"], r["wall"] != "cut"))  # the finest, cut cells first
+    best = min(runs, key=lambda r: (r["dx"], r["wall"] != "cut", r["faces"] == "sponge"))  # finest, cut cells, the PML
     scene, series = best["scene_value"], best["series"]
     t = np.asarray(series["t"], dtype=np.float64)
     start, end = scene.kind.window
