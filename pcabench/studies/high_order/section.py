@@ -160,15 +160,19 @@ def kernel_colours(runs) -> dict:
 
 
 def _style(label: str, cfl: float) -> dict:
-    """Solid and filled: corrected, dashed and hollow: standard; triangles: RK4, circles: Verlet at the paper's CFL
-    0.2, squares: Verlet at another CFL."""
-    marker = "^" if "rk4" in label else "o" if math.isclose(cfl, 0.2) else "s"
+    """Solid and filled: corrected, dashed and hollow: standard; triangles up: RK4 at CFL 1 or more, triangles down: RK4
+    below CFL 1, circles: Verlet at the paper's CFL 0.2, squares: Verlet at another CFL."""
+    if "rk4" in label:
+        marker = "^" if cfl >= 1 else "v"
+    else:
+        marker = "o" if math.isclose(cfl, 0.2) else "s"
     corrected = "gradient" in label
     return {"ls": "-" if corrected else "--", "marker": marker, **({} if corrected else {"mfc": "none"})}
 
 
 STYLE_KEY = (
-    "solid, filled: gradient-corrected; dashed, hollow: standard; triangles: RK4, circles: Verlet at CFL 0.2, "
+    "solid, filled: gradient-corrected; dashed, hollow: standard; triangles up / down: RK4 at CFL 1 / below, "
+    "circles: Verlet at CFL 0.2, "
     "squares: Verlet at "
 )
 STYLE_KEY += "another CFL"
