@@ -305,3 +305,21 @@ def test_what_the_cylinder_cannot_do_is_one_line(words, says, tmp_path):
     proc = subprocess.run([sys.executable, "-m", "pcabench.cli", *words], capture_output=True, text=True, env=env)
     lines = proc.stderr.strip().splitlines()
     assert proc.returncode != 0 and len(lines) == 1 and says in lines[0], proc.stderr
+
+
+def test_the_near_bands_grid_scale_part_parts_noise_from_sound():
+    """``grid_scale_part`` keeps a checkerboard (the lattice's own scale) but exp(-pi^2) of it and leaves of a wave
+    of 40 dx a part of 1 - exp(-(k dx)^2 / 2): the near band's `near_grid_rms` counts noise, not sound."""
+    from solvers.scenes.cylinder import grid_scale_part
+
+    dx = 0.05
+    iy, ix = np.mgrid[0:120, 0:100]
+    x, y = (ix * dx).ravel() - 2.5, (iy * dx).ravel() - 3.0
+    checker = ((-1.0) ** (ix + iy)).ravel()
+    assert np.allclose(grid_scale_part(x, y, checker, dx), (1 - math.exp(-(math.pi**2))) * checker, atol=1e-9)
+    k = 2 * np.pi / (40 * dx)
+    wave = np.cos(k * (x + 0.3 * y))
+    inner = (np.abs(x) < 1.5) & (np.abs(y) < 2.0)  # away from the FFT's wrap at the box's edges
+    part = grid_scale_part(x, y, wave, dx)[inner]
+    kk = (k * dx) ** 2 * (1 + 0.09)
+    assert np.sqrt(np.mean(part**2)) == pytest.approx((1 - np.exp(-kk / 2)) / np.sqrt(2), rel=0.05)
