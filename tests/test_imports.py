@@ -271,3 +271,12 @@ def test_every_study_folder_is_a_package():
     """The registries find a study's files through its package: a folder without ``__init__.py`` is skipped."""
     folders = {p.parent for p in (ROOT / "pcabench" / "studies").rglob("*.py")}
     assert [f for f in folders if not (f / "__init__.py").is_file()] == []
+
+
+def test_the_report_imports_no_study():
+    """pcabench/reports/ is the frame and the toolkits: it finds the studies' sections and pages through their
+    registries and imports none of their modules (issue 68: everything of a study, the paper's cards page and
+    summary included, in its folder)."""
+    arrows = [f"{m} -> {t}" for m, ts in GRAPH.items() if m.startswith("pcabench.reports") for t in ts]
+    assert [a for a in arrows if a.split(" -> ")[1].startswith("pcabench.studies")] == []
+    assert "pcabench.studies.paper.page" in MODULES and "pcabench.studies.paper.cards" in MODULES

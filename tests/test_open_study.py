@@ -195,12 +195,12 @@ def test_open_alone_is_the_preset_and_with_values_the_matrix(tmp_path, capsys):
 def test_the_open_studys_runs_are_its_sections_only(tmp_path):
     """Open runs, the preset's closed contrasts and its cost baselines stay out of the other sections (a closed
     run scored after its pulse has gone has a meaningless relative error): only "Open edges" reads them."""
-    from pcabench.reports.build import open_study, write_reports
+    from pcabench.reports.build import apart, write_reports
 
     path = _store(tmp_path / "store" / "m.jsonl")
     store.append(row(dx=0.5, t_end=10.0, model="linear", preset="front", stamp=9), path)  # a closed study's run
     df = frame.load(path.parent)
-    flagged = open_study(df)
+    flagged = apart(df)
     assert flagged.sum() == len(df) - 1 and not flagged[df.preset == "front"].any()
     (report,) = [p for p in write_reports(path.parent, tmp_path / "reports") if p.name == "report.md"]
     text = report.read_text()

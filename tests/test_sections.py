@@ -226,3 +226,17 @@ def test_the_long_run_table_measures_each_models_limit_below_its_first_blow_up(t
     text = "\n".join(long_runs_section.text(list(rows.values()), None))
     assert "**fixed** on acoustic-pulse blew up below the predicted 4.97, from CFL 4.7" in text
     assert "**linear** blew up below" not in text
+
+
+def test_a_page_across_machines_is_a_studys_registered_page(tmp_path):
+    """The cards page is the paper study's Page (pcabench/studies/paper/page.py), found by the page registry;
+    the index links what each page wrote with the page's own line, and a page's files are the build's."""
+    from pcabench.reports import page as pages
+    from pcabench.reports.page import Page
+
+    found = {p.name: p for p in pages.in_order()}
+    assert isinstance(found["cards"], Page) and found["cards"].write.__module__ == "pcabench.studies.paper.page"
+    paths = write_reports(_results(tmp_path), tmp_path / "reports")
+    assert tmp_path / "reports" / "cards.md" in paths
+    index = (tmp_path / "reports" / "README.md").read_text()
+    assert f"- [cards.md](cards.md): {found['cards'].index}" in index

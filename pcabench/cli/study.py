@@ -57,8 +57,9 @@ def run_study(
     ``sweep_budget`` in all, then write the reports into ``reports`` (None: no reports) and print the
     summary table; 0 (a failed run is a stored row, not an error)."""
     from pcabench.execute.sweep import sweep
-    from pcabench.reports.build import summary, write_reports
+    from pcabench.reports.build import write_reports
     from pcabench.store import check_writable, store_name
+    from pcabench.studies.paper.summary import summary
 
     if cluster:
         from pcabench.execute.cluster import check_address, cluster_sweep, dask_distributed

@@ -70,12 +70,16 @@ class Section:
     text: Callable[[Any, Context], list[str]]
     figures: tuple[Callable[[Any, Context], Path | None], ...] = ()
     all_scenes: bool = False  # reads ``ctx.df_scenes``; the others read the paper's scene only
+    # the rows only this section reads (a mask of the report's frame), kept out of every other section's frames
+    apart: Callable[[pd.DataFrame], Any] | None = None
     order: float = 1000.0  # its place in the report (the built-ins' are 10, 20, ...; the default: last)
 
 
 def _problem(section: Section) -> str | None:
     if not (callable(section.rows) and callable(section.text) and all(map(callable, section.figures))):
         return "a section needs callable rows, text and figures"
+    if section.apart is not None and not callable(section.apart):
+        return "a section's apart must be callable"
     return None
 
 

@@ -498,6 +498,13 @@ def figure(data, ctx):
     return path
 
 
+def own_rows(df):
+    """Which rows are this study's: open edges, or the preset's own closed runs (``open``, ``open-cost-<round>``:
+    contrasts scored once the pulse has gone, and cost baselines); only this section reads them."""
+    edges = df["open"].fillna("") != "" if "open" in df else False
+    return edges | (df.preset == OPEN) | df.preset.map(lambda p: open_cost_round(p) is not None)
+
+
 SECTION = Section(
     "open_edges",
     lambda ctx: rows(ctx.every_run()),
@@ -505,4 +512,5 @@ SECTION = Section(
     (figure,),
     all_scenes=True,
     order=155,
+    apart=own_rows,
 )
