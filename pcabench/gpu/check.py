@@ -5,7 +5,8 @@
 
 A GPU machine is lent rarely and briefly, so the first real run has to work
 and bring everything back from one call. The check runs these stages
-(:func:`stages`: its own, :data:`OWN`, and each study's from its folder,
+(:func:`stages`: its own, :data:`OWN`, the paper's among them from its folder
+(``pcabench/studies/paper/gpu.py``), and each other study's from its folder,
 ``pcabench/studies/<study>/gpu.py``, found by the registry
 :data:`pcabench.gpu.stage.STAGES`; a stage is one function of the shared
 :class:`~pcabench.gpu.stage.Check`) in order of value, each given what is
@@ -23,7 +24,7 @@ it has:
    (ghost particles); ``high-order`` with the gradient correction;
 3. ``sweep``: linkedlist-gpu, lagrangian Verlet, both precisions, 100K to 62.5M
    particles on the paper's domain, steps sized to the budget; runs go to the
-   results store (preset ``gpu``) through the ordinary sweep, in this process
+   results store (preset ``gpu``, the paper's plan) through the ordinary sweep, in this process
    so that kernels compile once;
 4. ``graph``: the step captured as a CUDA graph against plain launches, in the
    same process, alternating, best of several rounds, and their fields compared;
@@ -58,18 +59,15 @@ import tarfile
 import time
 from pathlib import Path
 
-from pcabench.gpu.agreement import agrees, compare_with_cpu
 from pcabench.gpu.ceilings import measure_ceilings
-from pcabench.gpu.graph_timing import graph_vs_plain
 from pcabench.gpu.plan import FULL, REHEARSAL, Budget, Plan
 from pcabench.gpu.stage import STAGES, Check, Stage
-from pcabench.gpu.sweeps import cpu_peer_specs, gpu_specs, run_and_release
 from pcabench.gpu.tables import markdown
 from pcabench.gpu.tools import ncu_command, run_logged
 from pcabench.spec import OptionError
 from pcabench.store import store_name
 from pcabench.store.safeio import fresh, own_folder, write_file
-from solvers import PRECISIONS
+from pcabench.studies.paper.gpu import PAPER_STAGES
 from solvers.gpu.device import device_backend, simulated
 
 H100_COMMIT = "bf587a5"  # the commit the H100 was measured at: asv compares the cards there
@@ -85,54 +83,6 @@ def measure(c: Check):
 
     profiles.save(c.profile)
     write_file(c.out / "profile.json", json.dumps(c.profile, indent=2) + "\n")
-
-
-def compare(c: Check) -> bool:
-    c.state["compare"] = compare_with_cpu(c.plan, c.out)
-    return agrees(c.state["compare"])
-
-
-def stored_sweep(c: Check, specs, spare_s: float) -> list[dict]:
-    """``specs`` through the ordinary sweep into the check's store, within what is left of the budget less
-    ``spare_s`` seconds kept for the stages after; the rows."""
-    from pcabench.execute.sweep import sweep
-
-    left = c.budget.left()
-    return sweep(specs, c.store_path, run_budget=left, sweep_budget=left - spare_s, runner=run_and_release)
-
-
-def gpu_sweep(c: Check) -> bool:
-    c.state["gpu_rows"] = stored_sweep(c, gpu_specs(c.plan), spare_s=60)
-    return all(r["status"] == "ok" for r in c.state["gpu_rows"])
-
-
-def graph(c: Check) -> bool:
-    plan = c.plan
-    if c.cupy is None:
-        c.state["graph"] = [
-            {"dx": dx, "precision": p, "error": "needs a real GPU (no streams in the simulator)"}
-            for dx in plan.graph_dx
-            for p in PRECISIONS
-        ]
-        return True
-    c.state["graph"] = []
-    for dx in plan.graph_dx:
-        for precision in PRECISIONS:
-            if c.budget.left() < 30:
-                break
-            try:
-                row = graph_vs_plain(dx, precision, plan.graph_steps, plan.graph_rounds, plan.scene)
-            except Exception as exc:  # noqa: BLE001
-                row = {"dx": dx, "precision": precision, "error": f"{type(exc).__name__}: {str(exc)[:300]}"}
-            c.state["graph"].append(row)
-            c.budget.say(f"graph dx {dx} {precision}: {row}")
-            c.cupy.get_default_memory_pool().free_all_blocks()
-    return all("error" not in r for r in c.state["graph"])
-
-
-def cpu_peers(c: Check) -> bool:
-    c.state["cpu_rows"] = stored_sweep(c, cpu_peer_specs(c.plan), spare_s=30)
-    return all(r["status"] == "ok" for r in c.state["cpu_rows"])
 
 
 def asv(c: Check) -> bool:
@@ -191,10 +141,7 @@ def ncu(c: Check) -> bool:
 # open 40, body 50, high-order 60; STAGES, each study's gpu.py) run between them, in order of value.
 OWN = (
     Stage("profile", 0, measure, order=0),
-    Stage("compare", 40, compare, order=10),
-    Stage("sweep", 60, gpu_sweep, order=30),
-    Stage("graph", 40, graph, order=70),
-    Stage("cpu", 40, cpu_peers, order=80),
+    *PAPER_STAGES,  # the paper's scene against the CPU, its sweep, the CUDA graph, the CPU peers
     Stage("asv", 60, asv, order=90),
     Stage("bench", 60, bench, order=100),
     Stage("pytest-gpu", 40, pytest_gpu, order=110),

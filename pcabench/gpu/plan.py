@@ -8,11 +8,9 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from solvers import Scene
+from pcabench.studies.paper import plan as paper
 
-GPU_SOLVER = "linkedlist-gpu"  # the solver this check measures (its CUDA graph path, its kernels under ncu)
-GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
-CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
+GPU_SOLVER = paper.GPU_SOLVER  # the solver this check measures: the paper's GPU sweep's
 
 RESERVE_S = 25.0  # kept back from every stage for the reports and the tarball
 
@@ -33,25 +31,20 @@ def card_cases(which, open_edges: bool = False) -> tuple:
 class Plan:
     """What the check runs and at what size."""
 
-    gpu_dx: tuple = GPU_DX
-    models: tuple = ("lagrangian",)
-    min_steps: int = 10  # steps of the biggest runs; smaller ones take up to max_steps (see gpu_steps)
-    max_steps: int = 100
+    gpu_dx: tuple = paper.GPU_DX
+    models: tuple = paper.GPU_MODELS
+    min_steps: int = paper.GPU_STEPS[0]  # steps of the biggest runs; smaller ones take up to max_steps (see gpu_steps)
+    max_steps: int = paper.GPU_STEPS[1]
     compare_dx: float = 0.5
     compare_steps: int = 20
     graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
     graph_steps: int = 50
     graph_rounds: int = 5
-    cpu_dx: tuple = CPU_DX
-    cpu_steps: int = 5
+    cpu_dx: tuple = paper.CPU_DX
+    cpu_steps: int = paper.CPU_STEPS
     scene: dict = field(default_factory=dict)  # Scene overrides (the rehearsal's small domain)
     asv_bench: str = "TimeGPUStep"
     ncu_dx: float = 0.01
-
-    def gpu_steps(self, dx: float) -> int:
-        """100 steps up to 2M particles, then 2e8 particle-steps per run, but at least ``min_steps``."""
-        n = Scene(dx=dx, **self.scene).n_particles
-        return max(self.min_steps, min(self.max_steps, int(2e8 // max(n, 1))))
 
 
 FULL = Plan()

@@ -1,9 +1,20 @@
-"""The paper's CPU matrix (Tables 4-6, Figs. 8-14), as far as the budgets allow."""
+"""The paper's runs: its CPU matrix (Tables 4-6, Figs. 8-14), as far as the budgets allow, and its GPU sweep with
+the GPU host's CPU peers (Table 6's same-machine columns, Fig. 14, the cards page), which ``pcabench gpu-check``
+runs on a lent card (its stages: gpu.py) and ``pcabench study --paper gpu`` lists or runs anywhere."""
 
 from __future__ import annotations
 
-from pcabench.spec import ALL_CORES, RunSpec
+from pcabench.spec import ALL_CORES, SERIAL, RunSpec
 from pcabench.studies.preset import Preset, spec_of
+from solvers import DEFAULT_SOLVER, PRECISIONS, Scene
+
+GPU_PRESET = "gpu"  # the GPU sweep's and its CPU peers' rows carry it
+GPU_SOLVER = "linkedlist-gpu"  # the solver the GPU runs measure (its CUDA graph path, its kernels under ncu)
+GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
+GPU_MODELS = ("lagrangian",)
+GPU_STEPS = (10, 100)  # (fewest, most) steps of a GPU run: gpu_steps
+CPU_DX = (0.1, 0.05, 0.025)  # 100K .. 1.6M: Table 6's CPU column on the GPU's host
+CPU_STEPS = 5
 
 
 def paper() -> list[RunSpec]:
@@ -28,6 +39,60 @@ def paper() -> list[RunSpec]:
     return runs
 
 
+def gpu_steps(dx: float, scene: dict | None = None, steps: tuple = GPU_STEPS) -> int:
+    """A GPU run's steps at ``dx`` (``scene``: Scene overrides): the most up to 2M particles, then 2e8
+    particle-steps per run, but at least the fewest (``steps``)."""
+    n = Scene(dx=dx, **(scene or {})).n_particles
+    return max(steps[0], min(steps[1], int(2e8 // max(n, 1))))
+
+
+def gpu_sweep(gpu_dx=GPU_DX, models=GPU_MODELS, scene: dict | None = None, steps: tuple = GPU_STEPS) -> list:
+    """The GPU timing sweep: linkedlist-gpu on the paper's full domain, every size, precision and model (the card
+    checks its own memory)."""
+    scene = scene or {}
+    return [
+        RunSpec(
+            GPU_SOLVER,
+            Scene(
+                dx=dx,
+                steps=gpu_steps(dx, scene, steps),
+                model=model,
+                precision=precision,
+                memory_limit_bytes=2**40,
+                **scene,
+            ),
+            preset=GPU_PRESET,
+        )
+        for dx in gpu_dx
+        for precision in PRECISIONS
+        for model in models
+    ]
+
+
+def cpu_peers(cpu_dx=CPU_DX, steps: int = CPU_STEPS, scene: dict | None = None) -> list:
+    """linkedlist-cpu, lagrangian float64, one thread and every core, on the GPU's host: Table 6's CPU column."""
+    return [
+        RunSpec(DEFAULT_SOLVER, Scene(dx=dx, steps=steps, **(scene or {})), threads, preset=GPU_PRESET)
+        for dx in cpu_dx
+        for threads in (SERIAL, ALL_CORES)
+    ]
+
+
 PAPER = Preset(
-    "paper", paper, 900.0, flag="paper", help="the paper's CPU matrix, within the budgets ({size})", order=20
+    "paper",
+    paper,
+    900.0,
+    flag="paper",
+    choice="cpu",
+    help="the paper's CPU matrix, within the budgets ({size})",
+    order=20,
+)
+PAPER_GPU = Preset(
+    GPU_PRESET,
+    lambda: gpu_sweep() + cpu_peers(),
+    900.0,
+    flag="paper",
+    choice="gpu",
+    help="the paper's GPU sweep and its host's CPU peers, on a GPU machine (`pcabench gpu-check` runs them) ({size})",
+    order=21,
 )
