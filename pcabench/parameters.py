@@ -17,8 +17,8 @@ from dataclasses import dataclass
 from typing import Callable
 
 from solvers import INTEGRATORS, MODELS, PRECISIONS, Scene, kernel_named, kernel_names, scene_names, scenes
-from solvers.absorbers import absorber_named, absorber_names
-from solvers.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD, boundary_method_names
+from solvers.boundaries.absorbers import absorber_named, absorber_names
+from solvers.boundaries.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD, boundary_method_names
 from solvers.corrections import correction_named, correction_names
 from solvers.edges import OPEN_EDGES
 
@@ -146,7 +146,8 @@ BOUNDARY = (
     Parameter(
         "absorber",
         "--absorber",
-        "what damps an open edge's layer (solvers/absorbers/; default: pml, the sponge on a plane pulse's strip)",
+        "what damps an open edge's layer (solvers/boundaries/absorbers/; default: pml, the sponge on a plane "
+        "pulse's strip)",
         absorber_names,
         per_scene=True,
     ),
@@ -162,7 +163,8 @@ BODY = (
     Parameter(
         "boundary_method",
         "--boundary-method",
-        "how a body's curved wall is modelled (solvers/bodies/: ghost particles on rings fitted to its surface, "
+        "how a body's curved wall is modelled (solvers/boundaries/bodies/: ghost particles on rings fitted to "
+        "its surface, "
         "on the lattice inside it, or none, the corrected operators making the wall; default "
         f"{DEFAULT_BOUNDARY_METHOD}, with --correction {CORRECTED_BOUNDARY_METHOD})",
         boundary_method_names,

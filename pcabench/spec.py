@@ -17,7 +17,7 @@ import os
 from dataclasses import dataclass
 
 from solvers import Scene, SceneError, check_pair_loop, resolve_pair_loop, solver_class
-from solvers.bodies import CORRECTED_BOUNDARY_METHOD
+from solvers.boundaries.bodies import CORRECTED_BOUNDARY_METHOD
 from solvers.corrections import DEFAULT_CORRECTION
 from solvers.edges import default_absorber
 from solvers.scene import PAPER_PULSE, PER_KIND

@@ -2,8 +2,8 @@
 
 An :class:`Edges` is what a Scene's edge options are (``Scene.edges``): the edges an absorbing layer lies beyond
 (``open``: "", "x", "y" or "xy"), the layer's width, what damps it and how strongly; each left unset ("" or None)
-takes the absorber's default for the scene (solvers/absorbers/). The layer's geometry follows from these given
-the scene (its dx, pulse width and kind): :meth:`n_layer` columns of dx beyond each open edge, its
+takes the absorber's default for the scene (solvers/boundaries/absorbers/). The layer's geometry follows from these
+given the scene (its dx, pulse width and kind): :meth:`n_layer` columns of dx beyond each open edge, its
 :meth:`strength`, and the :meth:`problems` of a value that cannot be built. Its defaults (closed, nothing set)
 are the fields' own, which Scene reads (``Scene.default``).
 """
@@ -30,8 +30,8 @@ def default_absorber(kind) -> str:
 @dataclass(frozen=True)
 class Edges:
     """The open edges and their layer: ``open`` ("" closed; a Scene resolves "" to its kind's), ``layer_width``
-    (m, whole columns of dx; None: the absorber's default), ``absorber`` (solvers/absorbers/; "": the scene's,
-    :meth:`absorber_used`) and ``absorber_strength`` (1/s; None: the absorber's default for the scene)."""
+    (m, whole columns of dx; None: the absorber's default), ``absorber`` (solvers/boundaries/absorbers/; "": the
+    scene's, :meth:`absorber_used`) and ``absorber_strength`` (1/s; None: the absorber's default for the scene)."""
 
     open: str = ""
     layer_width: float | None = None
@@ -71,9 +71,9 @@ class Edges:
         return default_absorber(scene.kind)
 
     def absorber_model(self, scene):
-        """The absorber of :meth:`absorber_used` (solvers/absorbers/); ValueError naming --absorber and the
+        """The absorber of :meth:`absorber_used` (solvers/boundaries/absorbers/); ValueError naming --absorber and the
         choices if it is unknown."""
-        from solvers.absorbers import absorber_named
+        from solvers.boundaries.absorbers import absorber_named
 
         return absorber_named(self.absorber_used(scene))
 

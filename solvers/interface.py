@@ -344,9 +344,9 @@ class Solver(abc.ABC):
             self.moves += 1
 
     def absorb(self, f: float, fields: str) -> None:
-        """The open edges' absorbing layers (solvers/absorbers/): ``fields`` ("velocity" or "density") damped by
-        half of an update of f dt, called before and after that update, so that the damping is a term of the
-        update (stable at the closed scene's CFL: solvers/absorbers/base.py); nothing on a closed scene."""
+        """The open edges' absorbing layers (solvers/boundaries/absorbers/): ``fields`` ("velocity" or "density")
+        damped by half of an update of f dt, called before and after that update, so that the damping is a term of the
+        update (stable at the closed scene's CFL: solvers/boundaries/absorbers/base.py); nothing on a closed scene."""
         for model in self.boundary_models:
             model.damp(self, f, fields)
 

@@ -1,7 +1,7 @@
 """Fields sampled at points off the particles: first-order moving least squares over the particles in reach.
 
 Used where a value is wanted between particles: a body's ghosts take the fluid's values at their mirror points
-(solvers/bodies/), and a run records drho at probe points (:meth:`solvers.interface.Solver.sample`).
+(solvers/boundaries/bodies/), and a run records drho at probe points (:meth:`solvers.interface.Solver.sample`).
 """
 
 from __future__ import annotations

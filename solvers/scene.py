@@ -106,7 +106,7 @@ class Scene:
     pulse_center: float | None = None  # pulse position at t = 0, m; None: the kind's (the paper's 0)
     cylinder_radius: float | None = None  # a rigid cylinder's radius, m (a scene kind with a body); None: the kind's
     sphere_radius: float | None = None  # a rigid sphere's radius, m (a 3D scene kind with a body); None: the kind's
-    boundary_method: str = ""  # how a body's curved wall is modelled (solvers/bodies/); "": the default
+    boundary_method: str = ""  # how a body's curved wall is modelled (solvers/boundaries/bodies/); "": the default
     probes: tuple = ()  # points ((x, y) or (x, y, z), ...) m where a run records drho every few steps, beside its own
     edges: Edges = Edges()  # the open edges and their layer (solvers/edges.py); open "": the kind's
     method: Method = DEFAULT_METHOD  # kernel, h/dx, truncation, CFL, integrator, correction (solvers/method.py)
@@ -202,7 +202,7 @@ class Scene:
 
     @property
     def absorber(self) -> str:
-        """What damps the layer (solvers/absorbers/); "": the scene's (:attr:`absorber_used`)."""
+        """What damps the layer (solvers/boundaries/absorbers/); "": the scene's (:attr:`absorber_used`)."""
         return self.edges.absorber
 
     @property
@@ -436,7 +436,7 @@ class Scene:
             )
             return
         try:
-            from solvers.bodies import boundary_method_named, boundary_method_names
+            from solvers.boundaries.bodies import boundary_method_named, boundary_method_names
 
             method = boundary_method_named(self.boundary_method_used)
         except ValueError as exc:
@@ -465,9 +465,9 @@ class Scene:
 
     @property
     def boundary_method_used(self) -> str:
-        """How the body's wall is modelled: ``boundary_method``, or the default (solvers/bodies/): standard SPH's
-        (rings), or with a kernel correction the one whose wall holds with it (the weak wall's cut cells)."""
-        from solvers.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD
+        """How the body's wall is modelled: ``boundary_method``, or the default (solvers/boundaries/bodies/): standard
+        SPH's (rings), or with a kernel correction the one whose wall holds with it (the weak wall's cut cells)."""
+        from solvers.boundaries.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD
 
         if self.boundary_method:
             return self.boundary_method
@@ -504,7 +504,7 @@ class Scene:
         correction), naming what holds; "" otherwise."""
         if self.body is None or self.correction == DEFAULT_CORRECTION:
             return ""
-        from solvers.bodies import CORRECTED_BOUNDARY_METHOD, boundary_method_named
+        from solvers.boundaries.bodies import CORRECTED_BOUNDARY_METHOD, boundary_method_named
 
         try:
             why = getattr(boundary_method_named(self.boundary_method_used), "fails_with_correction", "")

@@ -62,7 +62,10 @@ def _classes(cls: type) -> list[type]:
     for c in cls.__mro__:
         if c.__module__ in ("builtins", "abc", "typing"):
             continue
-        file = Path(inspect.getsourcefile(c))
+        try:
+            file = Path(inspect.getsourcefile(c))
+        except (TypeError, OSError):  # a class made at run time (no file): as class_sources says it
+            raise ValueError(f"jitcache: no source file for class {c.__qualname__} (of {cls.__qualname__})") from None
         if file not in seen:
             seen.add(file)
             out.append(c)

@@ -189,7 +189,7 @@ def test_a_study_folder_is_not_found_without_its_files(study_folder):
 
 
 def test_the_boundary_method_recipe_registers_a_method_the_cylinder_runs(run_recipe):
-    from solvers.bodies import boundary_method_names
+    from solvers.boundaries.bodies import boundary_method_names
 
     ns = run_recipe("Add a boundary method")
     assert "about-itself" not in boundary_method_names()  # unregistered once its block ended
@@ -197,7 +197,7 @@ def test_the_boundary_method_recipe_registers_a_method_the_cylinder_runs(run_rec
 
 
 def test_the_absorber_recipe_registers_an_absorber_that_every_solver_applies(run_recipe):
-    from solvers.absorbers import absorber_names
+    from solvers.boundaries.absorbers import absorber_names
 
     ns = run_recipe("Add an absorber")
     assert "ramp" not in absorber_names()  # unregistered once its block ended

@@ -1,5 +1,5 @@
-"""The weak wall with cut cells (``--boundary-method cut``, solvers/bodies/cut.py): each lattice site the body's
-surface cuts carries its cell's fluid volume. Its volumes hold the fluid's domain to second order, every solver
+"""The weak wall with cut cells (``--boundary-method cut``, solvers/boundaries/bodies/cut.py): each lattice site the
+body's surface cuts carries its cell's fluid volume. Its volumes hold the fluid's domain to second order, every solver
 reads them alike, and on the cylinder its error is the bulk's alone where the staircase's is the wall's."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from solvers import Scene
-from solvers.bodies.base import cell_fractions
+from solvers.boundaries.bodies.base import cell_fractions
 from solvers.physics.integrators import evolve
 from solvers.registry import make_solver
 

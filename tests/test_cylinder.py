@@ -11,7 +11,7 @@ import pytest
 from pcabench.execute.run import run
 from pcabench.spec import RunSpec
 from solvers import Scene, SceneError, make_solver
-from solvers.bodies import GHOST, INERT, BodyEntered, boundary_method_names
+from solvers.boundaries.bodies import GHOST, INERT, BodyEntered, boundary_method_names
 from solvers.physics.integrators import step_program
 from solvers.scenes.cylinder import probe_points
 

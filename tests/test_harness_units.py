@@ -270,11 +270,11 @@ def test_the_gpu_checks_body_stage_compares_the_cylinder_with_each_boundary_meth
     from pcabench.studies.cylinder import gpu as cylinder_gpu
     from pcabench.studies.high_order import gpu as high_order_gpu
     from solvers import Scene
-    from solvers.bodies import boundary_method_names
+    from solvers.boundaries.bodies import boundary_method_names
 
     assert cylinder_gpu.cases(True).scenes == (SCENES["cylinder"],)
     assert all(Scene(**s).body is not None for s in cylinder_gpu.cases(False).scenes + cylinder_gpu.cases(True).scenes)
-    from solvers.bodies import boundary_method_named
+    from solvers.boundaries.bodies import boundary_method_named
 
     # every boundary method has a stage: the ghosts' in the body stage, a corrected method's wall (weak) in the
     # high-order stage

@@ -183,9 +183,9 @@ LAYERS = (
     (
         "solvers.plugins",
         "solvers.kernels",
-        "solvers.absorbers",
+        "solvers.boundaries.absorbers",
         "solvers.corrections",
-        "solvers.bodies",
+        "solvers.boundaries.bodies",
         "solvers.boundaries",
         "solvers.sampling",
         "solvers.jitcache",

@@ -16,7 +16,7 @@ from pcabench.paths import reference_results
 from pcabench.spec import RunSpec, scene_from_row, stored_parameters
 from pcabench.store import read_rows
 from solvers import Scene, SceneError, make_solver
-from solvers.absorbers.sponge import Sponge
+from solvers.boundaries.absorbers.sponge import Sponge
 from solvers.physics.integrators import evolve
 from solvers.reference.dispersion import predicted_velocity
 

@@ -387,3 +387,18 @@ def test_run_json_is_one_object_on_stdout_whatever_a_plugin_prints_at_import_or_
     assert out.returncode == 0, out.stderr[-2000:]
     assert json.loads(out.stdout)["status"] == "ok", out.stdout  # the whole of stdout is one object
     assert "loud plug-in: imported" in out.stderr and "loud plug-in: bye" in out.stderr
+
+
+def test_a_class_made_at_run_time_has_no_source_and_says_so():
+    """A class exec'd in a namespace that is no module (a notebook's cell, CONTRIBUTING's recipes as the tests
+    run them) has no source file: ValueError, which run_sources turns into an unknown code, never a TypeError out
+    of the first run's provenance."""
+    import pytest
+
+    from solvers.interface import Solver
+    from solvers.sources import code_sources
+
+    namespace = {"__name__": "__made_at_run_time__", "Solver": Solver}
+    exec("class Made(Solver):\n    name = 'made'\n", namespace)  # noqa: S102
+    with pytest.raises(ValueError, match="no source file for class Made"):
+        code_sources(namespace["Made"])

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from solvers import Scene, SceneError
-from solvers.bodies.base import INERT
+from solvers.boundaries.bodies.base import INERT
 from solvers.physics.integrators import evolve
 from solvers.registry import make_solver
 

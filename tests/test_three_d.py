@@ -531,8 +531,8 @@ def test_the_3d_prediction_evolves_only_the_pulses_modes_and_loses_nothing():
 def test_an_absorber_of_the_earlier_damp_signature_still_damps_and_in_3d_takes_y_and_z_together():
     """A plug-in absorber written for ``damp(arrays, fx, fy, fields)`` (before the 3D faces): the layer calls it so,
     with fy fz as its fy in 3D; its run equals the sponge's, whose damp is the product of the three."""
-    from solvers.absorbers import ABSORBERS
-    from solvers.absorbers.sponge import Sponge
+    from solvers.boundaries.absorbers import ABSORBERS
+    from solvers.boundaries.absorbers.sponge import Sponge
 
     class Legacy(Sponge):
         name = "legacy-sponge"

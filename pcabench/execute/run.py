@@ -20,7 +20,7 @@ from pcabench.machine.memory import is_out_of_memory
 from pcabench.spec import RunSpec
 from pcabench.store.record import RunRecord
 from solvers import SceneError, jitcache, make_solver
-from solvers.bodies import BodyEntered
+from solvers.boundaries.bodies import BodyEntered
 from solvers.corrections import SingularMoments
 from solvers.fields import Fields
 from solvers.physics.integrators import step_program

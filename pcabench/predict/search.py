@@ -43,10 +43,10 @@ HIGH_ORDER_DX_BODY = (0.04, 0.03, 0.025, 0.0225, 0.02, 0.01)
 # times the prediction at dx 0.04, 0.03, 0.0225, 0.02 (the lattice's staircase about the circle: first order). A
 # body's suggestion asks the prediction for this share of the target.
 BODY_MARGIN = 0.5
-# A corrected method's suggestion near a body has cut cells (solvers/bodies/cut.py: the sites the surface cuts carry
-# their cells' fluid volume), whose wall is second order. Measured (2026-12-07, `pcabench study --cylinder wall`):
-# the probes 1.00 to 1.02 times the prediction with the fourth-order kernel (Verlet CFL 0.5, dx 0.04 to 0.02), 1.04
-# and 1.43 with the sixth-order one (RK4 CFL 1, dx 0.04 and 0.02: where the bulk's is 0.1 %, the wall's shows).
+# A corrected method's suggestion near a body has cut cells (solvers/boundaries/bodies/cut.py: the sites the surface
+# cuts carry their cells' fluid volume), whose wall is second order. Measured (2026-12-07, `pcabench study --cylinder
+# wall`): the probes 1.00 to 1.02 times the prediction with the fourth-order kernel (Verlet CFL 0.5, dx 0.04 to 0.02),
+# 1.04 and 1.43 with the sixth-order one (RK4 CFL 1, dx 0.04 and 0.02: where the bulk's is 0.1 %, the wall's shows).
 CUT_WALL = {"boundary_method": "cut"}
 CUT_MARGIN = 0.7
 
@@ -93,7 +93,7 @@ def suggest(
     x neighbours x the step's sweeps: on the thinnest strip where a strip serves the scene, else on its own
     domain), the one predicted closest to it, and the paper configuration's dx. A scene with a body is predicted
     with its wall exact (the bulk's dispersion alone: a lower bound of a run's error), a corrected method with
-    cut cells (solvers/bodies/cut.py: the ghosts' walls grow with a corrected negative-lobe kernel); the
+    cut cells (solvers/boundaries/bodies/cut.py: the ghosts' walls grow with a corrected negative-lobe kernel); the
     search says how far it is on stderr, every 2 s. The study command it names makes runs that advise, asked
     again, reads: ``problem`` (the study options of the problem asked about: ``--open x``, ``--mach 0.1``) goes into
     it, and a strip only where ``domain`` is not ``full``."""

@@ -137,8 +137,8 @@ def stable_cfl(r) -> float:
     suite states or steps by is this one (advise, the fronts, the reports, the cylinder's advised CFL), but for
     a plan that brackets the periodic lattice's own limit on purpose (the walls study's long runs:
     solvers.reference.dispersion.predicted_stable_cfl). Open edges keep
-    it: their damping is a term of each update (solvers/absorbers/base.py; measured with `pcabench study --open`
-    and the cylinder's long runs, docs/accuracy.md "Open edges")."""
+    it: their damping is a term of each update (solvers/boundaries/absorbers/base.py; measured with `pcabench study
+    --open` and the cylinder's long runs, docs/accuracy.md "Open edges")."""
     from solvers import Scene
     from solvers.method import Method
 

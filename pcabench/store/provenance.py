@@ -70,8 +70,8 @@ def run_registries() -> tuple:
     """The registries whose entries make a run's numbers (solvers, kernels, scenes, absorbers, boundary methods,
     corrections): a plug-in of any of them is part of :func:`code_key`. Presets only name runs and report
     sections only read them."""
-    from solvers.absorbers.registry import ABSORBERS
-    from solvers.bodies.registry import BOUNDARY_METHODS
+    from solvers.boundaries.absorbers.registry import ABSORBERS
+    from solvers.boundaries.bodies.registry import BOUNDARY_METHODS
     from solvers.corrections.registry import CORRECTIONS
     from solvers.kernels.registry import KERNELS
     from solvers.registry import SOLVERS

@@ -1,7 +1,7 @@
 """A scene's boundaries as one family of models, one file each (see base.py): rigid walls at x edges (walls.py),
 the absorbing layer beyond open edges (layer.py) and a rigid body inside the domain (body.py; a 3D scene's:
 body3d.py). How each is made is a plug-in of its own where there are choices: the layer's absorber
-(solvers/absorbers/), the body's boundary method (solvers/bodies/)."""
+(solvers/boundaries/absorbers/), the body's boundary method (solvers/boundaries/bodies/)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""A rigid body inside the scene: its curved wall made by particles inside it (the boundary method: solvers/bodies/).
+"""A rigid body inside the scene: its curved wall made by particles inside it (the boundary method:
+solvers/boundaries/bodies/).
 
 A body (``Scene.body``: a cylinder of radius a, its axis at x0, y0) holds the lattice sites inside it. The scene's
 boundary method says which of them are the wall's particles (ghosts) and where they sit; the others inside are
@@ -19,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from solvers.bodies.base import FLUID, GHOST, INERT, BodyEntered
 from solvers.boundaries.base import Boundary
+from solvers.boundaries.bodies.base import FLUID, GHOST, INERT, BodyEntered
 from solvers.sampling import mls_weights
 
 
@@ -32,7 +33,7 @@ class RigidBody(Boundary):
     kind = "body"
 
     def __init__(self, scene):
-        from solvers.bodies import boundary_method_named
+        from solvers.boundaries.bodies import boundary_method_named
 
         super().__init__(scene)
         self.method = boundary_method_named(scene.boundary_method_used)

@@ -1,8 +1,8 @@
 """A rigid body in a 3D scene (a sphere): its wall the weak one, the only one a 3D body has.
 
 The sphere (``Scene.body``: radius a, its centre at x0, y0 and z = 0) holds the lattice sites inside it; every one
-is inert (solvers/bodies/weak.py): zero fields and no mass, so no sum counts it and the fluid near the wall has
-truncated neighbourhoods, where the gradient-corrected operators make the wall (u . n = 0 weakly, the
+is inert (solvers/boundaries/bodies/weak.py): zero fields and no mass, so no sum counts it and the fluid near the wall
+has truncated neighbourhoods, where the gradient-corrected operators make the wall (u . n = 0 weakly, the
 summation-by-parts boundary). The inert particles never move (put back after every advance of moving particles)
 and a fluid particle half a spacing inside the sphere stops the run (BodyEntered). The ghost bodies of 2D
 (solvers/boundaries/body.py) are refused on a 3D scene (Scene's body check).
@@ -10,8 +10,8 @@ and a fluid particle half a spacing inside the sphere stops the run (BodyEntered
 
 from __future__ import annotations
 
-from solvers.bodies.base import FLUID, INERT, BodyEntered
 from solvers.boundaries.base import Boundary
+from solvers.boundaries.bodies.base import FLUID, INERT, BodyEntered
 
 FIELDS = ("u", "v", "w", "drho", "drho_x", "drho_y")  # with a PML's parts of drho where the layer carries them
 
@@ -24,7 +24,7 @@ class RigidBody3D(Boundary):
     kind = "body"
 
     def __init__(self, scene):
-        from solvers.bodies import boundary_method_named
+        from solvers.boundaries.bodies import boundary_method_named
 
         super().__init__(scene)
         self.method = boundary_method_named(scene.boundary_method_used)

@@ -1,19 +1,20 @@
-"""Open edges: an absorbing layer beyond each, damping what leaves the domain (the absorber: solvers/absorbers/).
+"""Open edges: an absorbing layer beyond each, damping what leaves the domain (the absorber:
+solvers/boundaries/absorbers/).
 
 ``Scene.edges`` (solvers/edges.py) says which edges are open and the layer's width and strength; the lattice
 holds the layer's columns (rows) beyond the domain (``Scene.n_layer``), whose particles are not scored. Around
 each kick and advance the layer damps its fields by half of the update's decay, before and after it (stable at
-the closed scene's CFL: solvers/absorbers/base.py), with a rate sigma rising with each particle's depth beyond the
-domain's edges (:meth:`OpenLayer.factors`). A split absorber (the PML) carries drho's x part ``drho_x`` and its
-rate ``ddx`` (the continuity sweep with v = 0: ``Solver.continuity_parts``) as arrays of the state; in 3D the y
-part too (``drho_y``, ``ddy``: the sweep with u = w = 0), the z part being what is left.
+the closed scene's CFL: solvers/boundaries/absorbers/base.py), with a rate sigma rising with each particle's depth
+beyond the domain's edges (:meth:`OpenLayer.factors`). A split absorber (the PML) carries drho's x part
+``drho_x`` and its rate ``ddx`` (the continuity sweep with v = 0: ``Solver.continuity_parts``) as arrays of the
+state; in 3D the y part too (``drho_y``, ``ddy``: the sweep with u = w = 0), the z part being what is left.
 """
 
 from __future__ import annotations
 
 import inspect
 
-from solvers.absorbers.base import product
+from solvers.boundaries.absorbers.base import product
 from solvers.boundaries.base import Boundary
 
 
@@ -23,7 +24,7 @@ class OpenLayer(Boundary):
     name = "open layer"
 
     def __init__(self, scene):
-        from solvers.absorbers import absorber_named
+        from solvers.boundaries.absorbers import absorber_named
 
         super().__init__(scene)
         self.absorber = absorber_named(scene.absorber_used)

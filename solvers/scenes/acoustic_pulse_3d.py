@@ -13,8 +13,8 @@ Error measures (the primary field is drho): relative RMS and max error of drho a
 cube, and the relative RMS of drho along the lattice's axes through the centre and along its body diagonals,
 apart (the lattice's phase error depends on the direction of travel).
 
-With ``--open xyz`` its six faces open onto a sponge layer (solvers/absorbers/sponge.py; ``--absorber pml`` the
-split-field PML, which sends back a quarter of the sponge's energy at the same width): the pulse is alone in open
+With ``--open xyz`` its six faces open onto a sponge layer (solvers/boundaries/absorbers/sponge.py; ``--absorber pml``
+the split-field PML, which sends back a quarter of the sponge's energy at the same width): the pulse is alone in open
 space (no images), scored against the closed form at the scored sites while it is inside the cube (``rms_drho``),
 then by what the faces left behind (``left_energy``, the error's acoustic energy over the initial pulse's, and
 ``left_amplitude``).

@@ -17,7 +17,7 @@ the entry-point group ``pcabench.scenes``) with a ``name``. It states
   differ (the pulse's width and centre, a body's radius; ``open``: the edges
   an open problem always opens);
 * ``body``: whether it holds a rigid body (:meth:`body_of`: a cylinder's axis
-  and radius), whose curved wall a boundary method models (solvers/bodies/;
+  and radius), whose curved wall a boundary method models (solvers/boundaries/bodies/;
   the boundary kind ``body``);
 * ``fields``: the fields its error measures name; ``primary`` the one the
   headline error (a record's ``mse`` and ``me``) measures;

@@ -4,7 +4,7 @@ A cylinder of radius a = ``cylinder_radius`` (0.5 m) with its axis at the origin
 drho = rho0 Ma exp(-ln2 ((x - xp)^2 + y^2) / b^2) at rest at (xp, 0) = (``pulse_center``, 0) = (4, 0) m with
 b = ``pulse_width`` = 0.2 m, c0 = 1 m/s, in the open plane: the square [-6, 6]^2 m with its four edges open
 (an absorbing layer beyond each: the scene is an open problem, its edges are always open). The cylinder's wall
-is modelled by a boundary method (``boundary_method``, solvers/bodies/). The exact linear reference is the
+is modelled by a boundary method (``boundary_method``, solvers/boundaries/bodies/). The exact linear reference is the
 series solution (solvers/reference/cylinder.py: the free pulse plus the scattered field).
 
 The workshop observes p = c0^2 drho at A (r = 5 m, 90 deg), B (5 m, 135 deg) and C (5 m, 180 deg) over
@@ -73,8 +73,8 @@ class Cylinder(SceneKind):
     primary = "drho"
     body = True
     window = WINDOW  # s: where the probes are scored
-    # a rigid cylinder with its ghost particles (solvers/bodies/: the default boundary method), the pulse's flank
-    # at its wall from the first step (a solver that skips the ghosts' values, Solver.prepare_boundaries, fails
+    # a rigid cylinder with its ghost particles (solvers/boundaries/bodies/: the default boundary method), the pulse's
+    # flank at its wall from the first step (a solver that skips the ghosts' values, Solver.prepare_boundaries, fails
     # agreement):
     # the body and the pulse with 3 widths about it (1,376 particles with the layer)
     smallest = {

@@ -3,12 +3,12 @@
 A sphere of radius a = ``sphere_radius`` (0.5 m) at the origin, the Gaussian pulse
 drho = rho0 Ma exp(-ln2 ((x - xp)^2 + y^2 + z^2) / b^2) at rest at (xp, 0, 0) = (``pulse_center``, 0, 0) =
 (1.5, 0, 0) m with b = ``pulse_width`` = 0.4 m, c0 = 1 m/s, in open space: the cube [-2.25, 2.25]^3 m with its six
-faces open (the split-field PML beyond each, solvers/absorbers/pml.py, by default, as every 3D scene's since
+faces open (the split-field PML beyond each, solvers/boundaries/absorbers/pml.py, by default, as every 3D scene's since
 2026-12-07: its parts of the continuity rate summed in the rate's own pass; ``--absorber sponge`` sends back from
 the +x and +y faces into A's window, docs/accuracy.md). The sphere's
-wall is the weak one (solvers/bodies/weak.py: the body's sites carry no volume, the gradient-corrected operators
-make the wall), which needs ``--correction gradient``. The pulse's flank reaches the sphere at t = 0 (1.3 % of its
-peak at the surface): the fluid's data is the Gaussian cut at the wall, as the exact reference's
+wall is the weak one (solvers/boundaries/bodies/weak.py: the body's sites carry no volume, the gradient-corrected
+operators make the wall), which needs ``--correction gradient``. The pulse's flank reaches the sphere at t = 0 (1.3 %
+of its peak at the surface): the fluid's data is the Gaussian cut at the wall, as the exact reference's
 (solvers/reference/sphere.py: the exterior Neumann series in spherical Bessel functions and Legendre polynomials
 for the scattered part and the part cut away, the closed form for the free pulse).
 

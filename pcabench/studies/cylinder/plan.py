@@ -33,7 +33,7 @@ CYLINDER_ADVISED_SHARE = 0.8  # of the stable CFL on this scene
 CYLINDER_LONG_T_END = 200.0
 CYLINDER_LONG_CFLS = (3.52, 4.0, 4.2, 4.4)
 # 7. High-order SPH (issue 56; solvers/corrections/gradient.py): the Laguerre-Gauss kernel at h = 1.5 dx cut at
-# 4 h with the kernel gradient correction and the weak wall (solvers/bodies/weak.py: ghosts with a corrected
+# 4 h with the kernel gradient correction and the weak wall (solvers/boundaries/bodies/weak.py: ghosts with a corrected
 # negative-lobe kernel grow at the body), Verlet at a quarter of its stable CFL (2.04: the fourth-order operator
 # leaves Verlet's phase error the largest; the shortest step is the most accurate): against dx about the
 # workshop's 10 particles a pulse width, its long run with the body (t = 100 s) and the lagrangian model.
@@ -47,11 +47,11 @@ CYLINDER_HIGH_ORDER = {
 CYLINDER_HIGH_ORDER_CFL = 0.5
 CYLINDER_HIGH_ORDER_DX = (0.04, 0.03, 0.0225, 0.02)
 CYLINDER_HIGH_ORDER_LONG_T_END = 100.0
-# 8. The wall and the bulk (issue 67; `--cylinder wall`): part 7's method with cut cells (solvers/bodies/cut.py: the
-# sites the surface cuts carry their cells' fluid volume) against dx, and the sixth-order Laguerre-Gauss kernel
-# (cut at 5 h, where it keeps its order) with RK4 at CFL 1 with cut cells and with the staircase (`weak`), at CFL
-# 0.5 at the workshop's dx, and its long runs (t = 100 s) at dx 0.04: which error, the bulk's or the wall's,
-# limits each method (the report's cylinder table), and the stable step with the body.
+# 8. The wall and the bulk (issue 67; `--cylinder wall`): part 7's method with cut cells
+# (solvers/boundaries/bodies/cut.py: the sites the surface cuts carry their cells' fluid volume) against dx, and the
+# sixth-order Laguerre-Gauss kernel (cut at 5 h, where it keeps its order) with RK4 at CFL 1 with cut cells and with
+# the staircase (`weak`), at CFL 0.5 at the workshop's dx, and its long runs (t = 100 s) at dx 0.04: which error, the
+# bulk's or the wall's, limits each method (the report's cylinder table), and the stable step with the body.
 CYLINDER_WALL = "cylinder-wall"
 CYLINDER_CUT = {**CYLINDER_HIGH_ORDER, "boundary_method": "cut"}
 CYLINDER_SIXTH = {**CYLINDER_CUT, "kernel": "laguerre-gauss-6", "cutoff_factor": 5.0, "integrator": "rk4"}
@@ -63,6 +63,9 @@ CYLINDER_WALL_DX = (0.04, 0.03, 0.025, 0.02)
 # Measured 2026-12-07 (amd-epyc): 1.0 and 1.5 bounded, 1.9 and 2.1 blew up (steps 105 and 60): the body's limit is
 # below the lattice's, in pcabench/predict/measured_limits.csv
 CYLINDER_SIXTH_LONG_CFLS = (1.0, 1.5, 1.9, 2.1)
+# the fourth-order method with cut cells, its long runs with the body (t = 100 s, dx 0.04): at its study's CFL and
+# at the largest its free ends keep bounded (measured_limits.csv: Verlet 1.4, RK4 1.8), whether the body lowers them
+CYLINDER_CUT_LONG = ({"cfl": CYLINDER_HIGH_ORDER_CFL}, {"cfl": 1.4}, {"cfl": 1.8, "integrator": "rk4"})
 
 
 def advised_cfl() -> float:
@@ -101,13 +104,15 @@ def sixth_order(dx, **more):
 
 def cylinder_wall() -> list:
     """Part 8 (CYLINDER_WALL_DX ...): the fourth- and sixth-order methods with cut cells against dx, the sixth's
-    staircase and short step beside them, its long run; smallest first within each part."""
+    staircase and short step beside them, the long runs of both; smallest first within each part."""
     runs = [high_order(dx, boundary_method="cut") for dx in CYLINDER_WALL_DX]
     runs += [sixth_order(dx) for dx in CYLINDER_WALL_DX]
     coarse, fine = CYLINDER_WALL_DX[0], CYLINDER_WALL_DX[-1]
     runs += [sixth_order(dx, boundary_method="weak") for dx in (coarse, fine)]
     runs += [sixth_order(fine, cfl=CYLINDER_SIXTH_SHORT_CFL)]
     runs += [sixth_order(coarse, cfl=cfl, t_end=CYLINDER_HIGH_ORDER_LONG_T_END) for cfl in CYLINDER_SIXTH_LONG_CFLS]
+    long = {"boundary_method": "cut", "t_end": CYLINDER_HIGH_ORDER_LONG_T_END}
+    runs += [high_order(coarse, **long, **step) for step in CYLINDER_CUT_LONG]
     return runs
 
 

@@ -36,8 +36,8 @@ OPEN_COST_STEPS = 40
 OPEN_COST_TAG = OPEN + "-cost-"
 # 4. Stability: the long runs of ``--stability long`` (LONG_SCENES, t = 300 s, dx 0.25) with the edges open, the
 # paper's method in the linear and lagrangian models from CFL 3 past the closed scenes' limit (4.75-4.9) to the
-# prediction's (4.97): the layer's damping, a term of each update (solvers/absorbers/base.py), keeps the closed
-# scene's limit (the damping after the step, before 2026-12-05, blew up from 4).
+# prediction's (4.97): the layer's damping, a term of each update (solvers/boundaries/absorbers/base.py), keeps the
+# closed scene's limit (the damping after the step, before 2026-12-05, blew up from 4).
 OPEN_LONG_CFL = (3.0, 3.25, 3.5, 3.75, 4.0, 4.4, 4.6, 4.75, 4.8, 4.9, 5.0)
 OPEN_LONG_MODELS = ("linear", "lagrangian")
 OPEN_LONG_EDGES = {"plane-pulse": "x", "acoustic-pulse": "xy"}

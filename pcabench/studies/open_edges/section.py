@@ -26,7 +26,7 @@ from pcabench.spec import scene_from_row
 from pcabench.store.rows import latest
 from pcabench.studies.open_edges.plan import OPEN, OPEN_DX, OPEN_SCENES, open_cost_round
 from pcabench.studies.protocols import LONG_T_END
-from solvers.absorbers import absorber_named
+from solvers.boundaries.absorbers import absorber_named
 from solvers.fields import Fields
 
 TARGET_AMPLITUDE = 1e-2  # the issue's: at most 1 % of the amplitude left behind
@@ -366,7 +366,8 @@ def _stability_text(rows_) -> list[str]:
         "The long runs of `--stability long` with the edges open (the plane pulse's x edges with the sponge, the "
         "2D pulse's four with the PML, each at its default layer), beside the closed scenes' own long runs where "
         "this store has them. The layer's damping is a term of each update, half before and half after every "
-        "kick and advance of the fields it damps (solvers/absorbers/base.py), so that the leapfrog's discrete "
+        "kick and advance of the fields it damps (solvers/boundaries/absorbers/base.py), so that the leapfrog's "
+        "discrete "
         "energy still only falls: it should hold wherever the closed scene holds. (Damping every field once "
         "after the step, as runs before 2026-12-05 did, blew up from CFL 4.)",
         "",
@@ -415,7 +416,7 @@ def text(data, ctx) -> list[str]:
         "",
         "An open edge (`--open x`, `y` or `xy`) grows the lattice by an absorbing layer of particles beyond the "
         "domain, which stays the scored one; the sponge damps u, v and drho at once, the split-field PML each "
-        "field at its own axis's rate (solvers/absorbers/). `pcabench study --open` makes every run below; "
+        "field at its own axis's rate (solvers/boundaries/absorbers/). `pcabench study --open` makes every run below; "
         "`open_edges.png` draws what is left against the layer's width.",
         "",
         *body,

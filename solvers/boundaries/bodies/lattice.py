@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from solvers.bodies.base import GHOSTS_BREAK_CORRECTION, BoundaryMethod, sites_inside
+from solvers.boundaries.bodies.base import GHOSTS_BREAK_CORRECTION, BoundaryMethod, sites_inside
 
 
 class Lattice(BoundaryMethod):

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from solvers.bodies.base import GHOST, INERT, BodyEntered, BoundaryMethod
-from solvers.bodies.registry import (
+from solvers.boundaries.bodies.base import GHOST, INERT, BodyEntered, BoundaryMethod
+from solvers.boundaries.bodies.registry import (
     BOUNDARY_METHODS,
     CORRECTED_BOUNDARY_METHOD,
     DEFAULT_BOUNDARY_METHOD,

@@ -1,9 +1,9 @@
 """The weak wall with cut cells: a lattice site whose cell the body's surface cuts carries the fluid's share of it.
 
-The weak wall (solvers/bodies/weak.py) makes the wall from the corrected operators' adjoint pairing: the fluid's
-volume ends where the sites carrying it end, a staircase about the surface, first order in dx. Here each site
+The weak wall (solvers/boundaries/bodies/weak.py) makes the wall from the corrected operators' adjoint pairing: the
+fluid's volume ends where the sites carrying it end, a staircase about the surface, first order in dx. Here each site
 carries the volume of its cell (a square, a cube in 3D, of side dx about it) that lies outside the body, m = f
-rho dx^d with f the cell's fluid fraction (:func:`~solvers.bodies.base.cell_fractions`): the volume sums (the
+rho dx^d with f the cell's fluid fraction (:func:`~solvers.boundaries.bodies.base.cell_fractions`): the volume sums (the
 corrected operators' quadrature) then hold the fluid's true domain to second order, and a site whose centre is
 inside the surface but whose cell is not (at most half a cell's diagonal deep) carries its cell's fluid part as a
 fluid particle (a fluid particle has entered the body past that depth, :meth:`Cut.entry_depth`). Nothing else
@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from solvers.bodies.base import cell_fractions
-from solvers.bodies.weak import Weak
+from solvers.boundaries.bodies.base import cell_fractions
+from solvers.boundaries.bodies.weak import Weak
 
 ENTRY_MARGIN = 0.05  # spacings: round-off never reads a cut site's own place as an entry
 

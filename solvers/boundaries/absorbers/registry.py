@@ -1,9 +1,9 @@
-"""The absorber registry: every absorbing layer pcabench offers (solvers/absorbers/, one file each; plug-ins
+"""The absorber registry: every absorbing layer pcabench offers (solvers/boundaries/absorbers/, one file each; plug-ins
 through the entry-point group ``pcabench.absorbers``), by the one :class:`~solvers.plugins.Registry` mechanism."""
 
 from __future__ import annotations
 
-from solvers.absorbers.base import Absorber
+from solvers.boundaries.absorbers.base import Absorber
 from solvers.plugins import Registry
 
 ENTRY_POINT_GROUP = "pcabench.absorbers"
@@ -11,7 +11,7 @@ DEFAULT_ABSORBER = "sponge"
 
 ABSORBERS = Registry(
     "absorber",
-    "solvers.absorbers",
+    "solvers.boundaries.absorbers",
     Absorber,
     group=ENTRY_POINT_GROUP,
     default=DEFAULT_ABSORBER,

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from solvers.bodies.base import BoundaryMethod, sites_inside
+from solvers.boundaries.bodies.base import BoundaryMethod, sites_inside
 
 
 class Weak(BoundaryMethod):

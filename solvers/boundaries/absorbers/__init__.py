@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-from solvers.absorbers.base import Absorber
-from solvers.absorbers.registry import ABSORBERS, DEFAULT_ABSORBER, ENTRY_POINT_GROUP, absorber_named, absorber_names
+from solvers.boundaries.absorbers.base import Absorber
+from solvers.boundaries.absorbers.registry import (
+    ABSORBERS,
+    DEFAULT_ABSORBER,
+    ENTRY_POINT_GROUP,
+    absorber_named,
+    absorber_names,
+)
 
 __all__ = ["Absorber", "ABSORBERS", "DEFAULT_ABSORBER", "ENTRY_POINT_GROUP", "absorber_named", "absorber_names"]

@@ -3,8 +3,8 @@ at its own axis's rate, drho split into its parts along each axis (x and y; x, y
 
 from __future__ import annotations
 
-from solvers.absorbers.base import Absorber
-from solvers.absorbers.sponge import Sponge
+from solvers.boundaries.absorbers.base import Absorber
+from solvers.boundaries.absorbers.sponge import Sponge
 
 VELOCITY = ("u", "v", "w")  # each axis's velocity component
 PARTS = ("drho_x", "drho_y")  # the parts of drho carried (the last axis's is what is left)
@@ -23,8 +23,8 @@ class PML(Absorber):
     theta)); the sponge damps every field at sigma_x + sigma_y, which reflects at the onset and at low frequency
     (the 2D pulse's wake). The x part of the SPH continuity sum is the same sweep with v = 0 (the rate is linear in
     the velocities), computed by the solver (``split``) and carried in ``drho_x`` through the integrator's updates;
-    each field is damped around its own updates (solvers/absorbers/base.py). The profile is the sponge's, sigma =
-    strength (depth / width)^2."""
+    each field is damped around its own updates (solvers/boundaries/absorbers/base.py). The profile is the sponge's,
+    sigma = strength (depth / width)^2."""
 
     name = "pml"
     summary = "split-field perfectly matched layer: u, drho_x damped by sigma_x, v, drho_y by sigma_y"

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from solvers.absorbers.base import Absorber
+from solvers.boundaries.absorbers.base import Absorber
 
 DEFAULT_STRENGTH = 12.0  # c0 / L: the scan's best (docs/accuracy.md)
 DEFAULT_WIDTHS = 1.5  # pulse widths: the thinnest layer of the scan inside the targets with room

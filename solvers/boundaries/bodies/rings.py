@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from solvers.bodies.base import GHOSTS_BREAK_CORRECTION, BoundaryMethod, ring_count, sites_inside
+from solvers.boundaries.bodies.base import GHOSTS_BREAK_CORRECTION, BoundaryMethod, ring_count, sites_inside
 
 
 class Rings(BoundaryMethod):
