@@ -240,3 +240,23 @@ def test_a_page_across_machines_is_a_studys_registered_page(tmp_path):
     assert tmp_path / "reports" / "cards.md" in paths
     index = (tmp_path / "reports" / "README.md").read_text()
     assert f"- [cards.md](cards.md): {found['cards'].index}" in index
+
+
+def test_a_section_reads_the_presets_it_declares(tmp_path):
+    """``Section.reads`` names presets; the report hands the section their runs as ``ctx.runs`` (a name ending in
+    ``*`` is a study's rounds) and nothing of another preset's."""
+    import dataclasses
+
+    import pandas as pd
+
+    from pcabench.reports.section import Context
+
+    df = pd.DataFrame({"preset": ["walls", "walls-cost-1", "walls-cost-2", "front", "three-d"], "x": range(5)})
+    ctx = Context(df.iloc[:0], df.iloc[:0], "m", tmp_path, df_scenes=df)
+    assert list(ctx.runs_of(("walls-cost-*", "three-d")).x) == [1, 2, 4]
+    assert list(ctx.runs_of(("front",)).x) == [3] and ctx.runs_of(("nope",)).empty
+    seen = {}
+    probe = Section("probe", lambda c: seen.setdefault("runs", c.runs), lambda rows, c: [], reads=("front",))
+    own = dataclasses.replace(ctx, runs=ctx.runs_of(probe.reads))
+    probe.rows(own)
+    assert list(seen["runs"].preset) == ["front"] and own.cache is ctx.cache  # the caches shared

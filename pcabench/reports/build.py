@@ -7,6 +7,7 @@ reports/README.md             the index
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from pathlib import Path
 from typing import Callable
@@ -70,9 +71,10 @@ def report_for(ctx: Context, progress: Callable[[str], None] | None = None) -> P
     for i, section in enumerate(chosen, 1):  # read at each report: a section registered since is in it
         if progress:
             progress(f"report {ctx.name}: section {i} of {len(chosen)}, {section.name}")
-        rows = section.rows(ctx)
-        drawn = [p for p in (draw(rows, ctx) for draw in section.figures) if p is not None]
-        body += section.text(rows, ctx) + figure_lines(drawn)
+        own = dataclasses.replace(ctx, runs=ctx.runs_of(section.reads)) if section.reads else ctx  # shares caches
+        rows = section.rows(own)
+        drawn = [p for p in (draw(rows, own) for draw in section.figures) if p is not None]
+        body += section.text(rows, own) + figure_lines(drawn)
         figs += drawn
     kept = set(figs) | {p.with_suffix(".csv") for p in figs}
     for stale in (set(out.glob("*.png")) | set(out.glob("*.csv"))) - kept:  # a figure whose data is gone: gone

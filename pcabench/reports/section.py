@@ -38,6 +38,19 @@ class Context:
     # the open-edges study's runs too (``pcabench study --open``: open edges, their closed contrasts and cost
     # baselines), which only the "Open edges" section reads: the other sections' scenes are the closed ones
     df_open: pd.DataFrame | None = None
+    # the runs of the presets the section being written declares (``Section.reads``), handed to it by the report
+    runs: pd.DataFrame | None = None
+
+    def runs_of(self, presets: tuple) -> pd.DataFrame | None:
+        """This machine's runs (:meth:`every_run`) of ``presets`` (names; one ending in ``*`` names every preset
+        it begins: ``walls-cost-*``, a study's rounds), None where there are no runs."""
+        df = self.every_run()
+        if df is None or df.empty or "preset" not in df:
+            return None
+        names = {p for p in presets if not p.endswith("*")}
+        stems = tuple(p[:-1] for p in presets if p.endswith("*"))
+        tags = df.preset.astype(str)
+        return df[tags.isin(names) | (tags.str.startswith(stems) if stems else False)]
 
     def every_run(self):
         """This machine's runs with the open-edges study's (open edges, the cylinder's), for the sections that read
@@ -73,6 +86,9 @@ class Section:
     # the rows only this section reads (a mask of the report's frame), kept out of every other section's frames
     apart: Callable[[pd.DataFrame], Any] | None = None
     order: float = 1000.0  # its place in the report (the built-ins' are 10, 20, ...; the default: last)
+    # the presets whose runs it reads (``ctx.runs``, handed to it by the report: no section slices the store by
+    # preset itself); () reads the frames of the context as they are
+    reads: tuple = ()
 
 
 def _problem(section: Section) -> str | None:

@@ -24,11 +24,12 @@ SCENES = {"plane-pulse": "the plane pulse (5 m strip)", "acoustic-pulse": "the 2
 
 
 def rows(df) -> dict | None:
-    """The high-order study's runs of ``df`` (newest of each), one row each; None where there are none."""
-    if df is None or df.empty or "preset" not in df or not (df.preset == HIGH_ORDER).any():
+    """The high-order study's runs ``df`` (the report's ``ctx.runs``; newest of each), one row each; None where there
+    are none."""
+    if df is None or df.empty:
         return None
     runs = []
-    for _, r in latest(df[df.preset == HIGH_ORDER]).iterrows():
+    for _, r in latest(df).iterrows():
         scene = scene_from_row(r)
         method = Method.of(scene)
         runs.append(
@@ -249,9 +250,10 @@ def _seconds(r):
 
 SECTION = Section(
     "high-order",
-    lambda ctx: rows(ctx.every_run()),
+    lambda ctx: rows(ctx.runs),
     text,
     (orders_figure, work_precision_figure),
     all_scenes=True,
     order=158,
+    reads=(HIGH_ORDER,),
 )

@@ -23,11 +23,12 @@ TARGET = (1e-3, 0.25, 3.5)  # the issue's: the high-order method at most 1e-3 at
 
 
 def rows(df) -> dict | None:
-    """The 3D study's runs of ``df`` (newest of each): the accuracy runs with their prediction, the cost runs."""
-    if df is None or df.empty or "preset" not in df or not df.preset.isin((THREE_D, THREE_D_FINE)).any():
+    """The 3D study's runs ``df`` (its presets', the report's ``ctx.runs``; newest of each): the accuracy runs with
+    their prediction, the cost runs."""
+    if df is None or df.empty:
         return None
     accuracy, cost, sphere = [], [], []
-    for _, r in latest(df[df.preset.isin((THREE_D, THREE_D_FINE))]).iterrows():
+    for _, r in latest(df).iterrows():
         scene = scene_from_row(r)
         ok = r.status == "ok" and np.isfinite(r.mse)
         row = {
@@ -334,9 +335,10 @@ def sphere_figure(data, ctx):
 
 SECTION = Section(
     "three-d",
-    lambda ctx: rows(ctx.every_run()),
+    lambda ctx: rows(ctx.runs),
     text,
     (error_figure, slice_figure, sphere_figure),
     all_scenes=True,
     order=159,
+    reads=(THREE_D, THREE_D_FINE),
 )
