@@ -24,7 +24,7 @@ from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section, stored_measure
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import latest
-from pcabench.studies.open_edges.plan import OPEN, OPEN_DX, OPEN_SCENES, open_cost_round
+from pcabench.studies.open_edges.plan import OPEN, OPEN_COST_TAG, OPEN_DX, OPEN_SCENES, open_cost_round
 from pcabench.studies.protocols import LONG_T_END
 from solvers.boundaries.absorbers import absorber_named
 from solvers.fields import Fields
@@ -189,7 +189,9 @@ def lowers_limit(r) -> bool | None:
 
 
 def rows(df) -> dict | None:
-    if df.empty or "preset" not in df or not (df.preset == OPEN).any():
+    """The section's tables from its presets' runs ``df`` (the report's ``ctx.runs``: the study's, its cost
+    rounds', and ``--stability long``'s closed runs beside its own long ones); None without the study's runs."""
+    if df is None or df.empty or not (df.preset == OPEN).any():
         return None
     left = left_rows(df)
     return {
@@ -508,10 +510,11 @@ def own_rows(df):
 
 SECTION = Section(
     "open_edges",
-    lambda ctx: rows(ctx.every_run()),
+    lambda ctx: rows(ctx.runs),
     text,
     (figure,),
     all_scenes=True,
     order=155,
     apart=own_rows,
+    reads=(OPEN, OPEN_COST_TAG + "*", "stability-long"),
 )
