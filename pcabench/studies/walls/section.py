@@ -20,7 +20,7 @@ from pcabench.store.rows import is_paper_method, latest
 from pcabench.studies.protocols import FRONT_T_END as T_FINAL
 from pcabench.studies.protocols import LONG_T_END
 from pcabench.studies.walls.figures import wall_errors
-from pcabench.studies.walls.plan import FREE_COUNTERPART, WALLS, cost_round
+from pcabench.studies.walls.plan import FREE_COUNTERPART, WALL_COST_TAG, WALLS, cost_round
 from solvers import Scene, scenes
 from solvers.method import Method
 
@@ -133,11 +133,14 @@ def cost(df) -> list[dict]:
     return sorted(rows, key=lambda r: (r["scene"], -r["dx"]))
 
 
-def rows(df) -> dict | None:
-    """The section's three tables from one machine's runs of every scene, None where it has no wall run."""
+def rows(df, runs=None) -> dict | None:
+    """The section's three tables: the accuracy from one machine's runs of every scene ``df``, the long runs and
+    the cost from its presets' runs ``runs`` (the report's ``ctx.runs``; None: ``df``'s); None where it has no
+    wall run."""
     if df.empty or not df.scene.isin(wall_scenes()).any():
         return None
-    return {"accuracy": accuracy(df), "stability": stability(df), "cost": cost(df)}
+    own = df if runs is None else runs
+    return {"accuracy": accuracy(df), "stability": stability(own), "cost": cost(own)}
 
 
 # ---------------------------------------------------------------- the section's Markdown
@@ -525,9 +528,10 @@ def text(data, ctx) -> list[str]:
 
 SECTION = Section(
     "walls",
-    lambda ctx: rows(ctx.df_scenes if ctx.df_scenes is not None else ctx.df),
+    lambda ctx: rows(ctx.df_scenes if ctx.df_scenes is not None else ctx.df, ctx.runs),
     text,
     (lambda d, ctx: wall_errors(d["accuracy"], ctx.out, ctx.name) if d else None,),
     all_scenes=True,
     order=150,
+    reads=(WALLS, WALL_COST_TAG + "*", "stability-long"),
 )
