@@ -71,7 +71,7 @@ def report_for(ctx: Context, progress: Callable[[str], None] | None = None) -> P
     for i, section in enumerate(chosen, 1):  # read at each report: a section registered since is in it
         if progress:
             progress(f"report {ctx.name}: section {i} of {len(chosen)}, {section.name}")
-        own = dataclasses.replace(ctx, runs=ctx.runs_of(section.reads)) if section.reads else ctx  # shares caches
+        own = dataclasses.replace(ctx, runs=ctx.runs_of(section.reads, section.all_scenes)) if section.reads else ctx
         rows = section.rows(own)
         drawn = [p for p in (draw(rows, own) for draw in section.figures) if p is not None]
         body += section.text(rows, own) + figure_lines(drawn)

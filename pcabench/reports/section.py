@@ -41,10 +41,11 @@ class Context:
     # the runs of the presets the section being written declares (``Section.reads``), handed to it by the report
     runs: pd.DataFrame | None = None
 
-    def runs_of(self, presets: tuple) -> pd.DataFrame | None:
-        """This machine's runs (:meth:`every_run`) of ``presets`` (names; one ending in ``*`` names every preset
-        it begins: ``walls-cost-*``, a study's rounds), None where there are no runs."""
-        df = self.every_run()
+    def runs_of(self, presets: tuple, all_scenes: bool = True) -> pd.DataFrame | None:
+        """This machine's runs of ``presets`` (names; one ending in ``*`` names every preset it begins:
+        ``walls-cost-*``, a study's rounds): of every scene (:meth:`every_run`), or with ``all_scenes`` False of
+        the paper's scene (``df``), as the section reads; None where there are no runs."""
+        df = self.every_run() if all_scenes else self.df
         if df is None or df.empty or "preset" not in df:
             return None
         names = {p for p in presets if not p.endswith("*")}

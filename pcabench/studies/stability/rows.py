@@ -51,20 +51,15 @@ def stability(df, inaccurate_above: float) -> tuple[list[dict], list[dict]]:
     Built from the prediction (pcabench/predict/stability.py): a run at or past its
     method's predicted stable CFL is unstable, by its blow-up or, where it
     ended bounded, by prediction (``e_foldings``: how far its most unstable
-    mode grew in its steps, too little for round-off to show). The runs of the
-    stability preset, and a quick study's CFL sweep (three CFLs or more of one
-    method).
+    mode grew in its steps, too little for round-off to show). ``df``: the runs of the
+    stability preset and of the quick study (the section's ``reads``), of which a quick study's CFL sweep
+    (three CFLs or more of one method) counts.
     """
     from pcabench.predict.stability import UNSTABLE_BY_PREDICTION, assess, e_foldings
 
-    runs = latest(
-        df[
-            df.preset.isin(["stability", "quick"])
-            & df.protocol.str.startswith("t =")
-            & (df.model == "linear")
-            & (df.domain == "strip")
-        ]
-    )
+    if df is None or df.empty:
+        return [], []
+    runs = latest(df[df.protocol.str.startswith("t =") & (df.model == "linear") & (df.domain == "strip")])
     keys = ["integrator", "kernel", "h_factor", "cutoff_factor", "precision", "protocol", "dx"]
     if not runs.empty:
         sweeps = runs.groupby(keys + ["preset"]).cfl.transform("nunique")

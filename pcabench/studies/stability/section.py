@@ -117,6 +117,13 @@ def draw_stability_map(rows, ctx):
     return stability_map(*rows, ctx.out, ctx.name, INACCURATE_ABOVE)
 
 
-SECTION = Section("stability", lambda ctx: stability(ctx.df, INACCURATE_ABOVE), text, (draw_stability_map,), order=100)
+SECTION = Section(
+    "stability",
+    lambda ctx: stability(ctx.runs, INACCURATE_ABOVE),
+    text,
+    (draw_stability_map,),
+    order=100,
+    reads=("stability", "quick"),  # the stability map's runs, and a quick study's CFL sweep
+)
 
 __all__ = ["SECTION", "LONG_RUNS"]  # the registry finds both here
