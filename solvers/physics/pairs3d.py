@@ -30,10 +30,10 @@ def separation_rule(jit):
     the sum is) and its own displacements, j at its own; the lattice part whole numbers, exact."""
 
     @jit
-    def separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k):
-        rx = (lxi - lx[j]) * k[SPACING] + (sx[i] - sx[j])
-        ry = (lyi - ly[j]) * k[SPACING] + (sy[i] - sy[j])
-        rz = (lzi - lz[j]) * k[SPACING] + (sz[i] - sz[j])
+    def separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k):
+        rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
+        ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+        rz = (lzi - lz[j]) * k[SPACING] + (szi - sz[j])
         return rx, ry, rz
 
     return separation
@@ -46,11 +46,12 @@ def continuity_sum(jit, separation, gradient):
     @jit
     def continuity_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
         u, v, w, vol = fields
+        sxi, syi, szi, ui, vi, wi = sx[i], sy[i], sz[i], u[i], v[i], w[i]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
             if r2 < k[RC2]:
-                acc += vol[j] * gradient(r2, k) * ((u[i] - u[j]) * rx + (v[i] - v[j]) * ry + (w[i] - w[j]) * rz)
+                acc += vol[j] * gradient(r2, k) * ((ui - u[j]) * rx + (vi - v[j]) * ry + (wi - w[j]) * rz)
         return acc
 
     return continuity_range
@@ -65,13 +66,14 @@ def continuity_split_sum(jit, separation, gradient):
     def continuity_split_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
         u, v, w, vol = fields
         whole, xpart, ypart = acc
+        sxi, syi, szi, ui, vi, wi = sx[i], sy[i], sz[i], u[i], v[i], w[i]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
             if r2 < k[RC2]:
                 weight = vol[j] * gradient(r2, k)
-                ux, vy = (u[i] - u[j]) * rx, (v[i] - v[j]) * ry
-                whole += weight * (ux + vy + (w[i] - w[j]) * rz)
+                ux, vy = (ui - u[j]) * rx, (vi - v[j]) * ry
+                whole += weight * (ux + vy + (wi - w[j]) * rz)
                 xpart += weight * ux
                 ypart += weight * vy
         return whole, xpart, ypart
@@ -86,11 +88,12 @@ def momentum_sum(jit, separation, gradient):
     def momentum_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
         mass, pr = fields
         ax, ay, az = acc
+        sxi, syi, szi, pri = sx[i], sy[i], sz[i], pr[i]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
             if r2 < k[RC2]:
-                c = mass[j] * (pr[i] + pr[j]) * gradient(r2, k)
+                c = mass[j] * (pri + pr[j]) * gradient(r2, k)
                 ax += c * rx
                 ay += c * ry
                 az += c * rz
@@ -104,8 +107,9 @@ def neighbour_count(jit, separation):
 
     @jit
     def neighbours_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
+        sxi, syi, szi = sx[i], sy[i], sz[i]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
             if rx * rx + ry * ry + rz * rz < k[RC2]:
                 acc += 1
         return acc
@@ -122,8 +126,9 @@ def moment_sums(jit, separation, gradient):
     def moments_range(j0, j1, lxi, lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields):
         (vol,) = fields
         mxx, mxy, mxz, myy, myz, mzz, gx, gy, gz = acc
+        sxi, syi, szi = sx[i], sy[i], sz[i]
         for j in range(j0, j1):
-            rx, ry, rz = separation(lxi, lyi, lzi, i, j, lx, ly, lz, sx, sy, sz, k)
+            rx, ry, rz = separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k)
             r2 = rx * rx + ry * ry + rz * rz
             if r2 < k[RC2]:
                 c = vol[j] * gradient(r2, k)
