@@ -45,11 +45,28 @@ class TrackPairCost3D:
             raise NotImplementedError(str(exc)) from None
         self.pairs = {d: p.n_particles * p.solver.mean_neighbours() for d, p in self.prepared.items()}
 
-    def track_pair_cost(self, kernel):
+    def best_pi(self) -> dict:
+        """The best PI of ``REPEATS``, s, in 3D and in 2D, the two timed in turn."""
         best = {d: float("inf") for d in self.prepared}
         for _ in range(REPEATS):
             for d, p in self.prepared.items():
                 t0 = time.perf_counter()
                 p.stage("pi")
                 best[d] = min(best[d], time.perf_counter() - t0)
+        return best
+
+    def track_pair_cost(self, kernel):
+        best = self.best_pi()
         return (best[3] / self.pairs[3]) / (best[2] / self.pairs[2])
+
+
+if __name__ == "__main__":  # python -m benchmarks.bench_three_d: each kernel's PI in 3D and 2D and the ratio
+    for name in TrackPairCost3D.params[0]:
+        bench = TrackPairCost3D()
+        bench.setup(name)
+        best = bench.best_pi()
+        ns = {d: 1e9 * best[d] / bench.pairs[d] for d in best}
+        print(
+            f"{name}: PI 3D {1e3 * best[3]:.1f} ms, 2D {1e3 * best[2]:.1f} ms; "
+            f"{ns[3]:.2f} / {ns[2]:.2f} ns a particle-neighbour: 3D pair / 2D pair {ns[3] / ns[2]:.2f}"
+        )

@@ -17,14 +17,15 @@ from solvers.search.allpairs import AllPairs
 
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str, kernel: str, across: bool = True, dims: int = 2) -> dict:
+def sweeps(precision: str, kernel: str, across: bool = True, dims: int = 2, displaced: bool = True) -> dict:
     """The all-pair interaction loops for ``precision`` and ``kernel``, with or without the mirrors across a
-    wall (``across``; serial, as in the paper; solvers/loops/allpair.py, compiled once per machine), and
+    wall (``across``; serial, as in the paper; solvers/loops/allpair.py, compiled once per machine) and the
+    displacements in the separations (``displaced``), and
     the per-particle updates; in 3D solvers/loops/allpair3d.py's."""
     if dims == 3:
-        loops = cpu_loops("allpair3d", precision, kernel, False, across)
+        loops = cpu_loops("allpair3d", precision, kernel, False, across, displaced)
         return {**cpu_updates(precision, False, dims), **{name: getattr(loops, name) for name in COMPILED["allpair3d"]}}
-    loops = cpu_loops("allpair", precision, kernel, False, across)
+    loops = cpu_loops("allpair", precision, kernel, False, across, displaced)
     return {**{name: getattr(loops, name) for name in COMPILED["allpair"]}, **cpu_updates(precision, False)}
 
 
@@ -54,7 +55,7 @@ class AllPairCPU(Solver):
 
     def launch(self, name: str, *args):
         s = self.scene
-        return sweeps(s.precision, s.kernel, across(s), s.dims)[name](*args)
+        return sweeps(s.precision, s.kernel, across(s), s.dims, self.displaced)[name](*args)
 
     def warmup(self) -> float:
         t0 = time.perf_counter()

@@ -157,6 +157,7 @@ class Solver(abc.ABC):
         self.dtype = np.dtype(scene.precision)
         self.k = kernel.constants(scene, self.dtype)
         self.moving = scene.model == "lagrangian"
+        self.displaced = True  # until the particles are placed (after_init)
         self.correction = scene.sph_correction
         # the scene's walls, open layer and body (solvers/boundaries/), each called at its points of a step
         self.boundary_models = boundary_models(scene)
@@ -236,8 +237,11 @@ class Solver(abc.ABC):
         return POSITIONS[self.scene.dims]
 
     def after_init(self) -> None:
-        """The neighbour search for the scene (``self.nnps``), once the arrays exist; a hook for device-specific
-        setup too."""
+        """Whether any particle is off its lattice site (``displaced``), the neighbour search for the scene
+        (``self.nnps``), once the arrays exist; a hook for device-specific setup too."""
+        self.displaced = self.moving or any(
+            bool(np.any(self.to_host(self.arrays[name]))) for name in ("sx", "sy", "sz") if name in self.arrays
+        )
         if self.neighbour_search is not None:
             self.nnps = self.neighbour_search(self.scene, self.launch, self.xp)
 

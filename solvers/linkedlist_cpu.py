@@ -36,18 +36,21 @@ from solvers.search.celllist import CellListSolver
 
 
 @lru_cache(maxsize=None)
-def sweeps(precision: str, kernel: str, parallel: bool, across: bool = True, dims: int = 2) -> dict:
+def sweeps(
+    precision: str, kernel: str, parallel: bool, across: bool = True, dims: int = 2, displaced: bool = True
+) -> dict:
     """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool, with or
     without the pairs across an x seam or wall (``across``; solvers/loops/cells.py, compiled once per
-    machine), and the per-particle updates; in 3D the trimmed stencil's loops and their updates
+    machine), with or without the displacements in the separations (``displaced``), and the per-particle
+    updates; in 3D the trimmed stencil's loops and their updates
     (solvers/loops/cells3d.py)."""
     if dims == 3:
-        loops = cpu_loops("cells3d", precision, kernel, parallel, across)
+        loops = cpu_loops("cells3d", precision, kernel, parallel, across, displaced)
         return {
             **cpu_updates(precision, parallel, dims),
             **{name: getattr(loops, name) for name in COMPILED["cells3d"]},
         }
-    loops = cpu_loops("cells", precision, kernel, parallel, across)
+    loops = cpu_loops("cells", precision, kernel, parallel, across, displaced)
     return {**{name: getattr(loops, name) for name in COMPILED["cells"]}, **cpu_updates(precision, parallel)}
 
 
@@ -129,7 +132,7 @@ class LinkedListCPU(CellListSolver):
         if self.threads > 1:
             use_threads(self.threads)  # a call into numba only if another solver set another count since
         s = self.scene
-        return sweeps(s.precision, s.kernel, self.threads > 1, across(s), s.dims)[name](*args)
+        return sweeps(s.precision, s.kernel, self.threads > 1, across(s), s.dims, self.displaced)[name](*args)
 
     def sort_cells(self) -> None:
         """SNP: the search bins the particles (``self.nnps.bin``: particleIndex, cellParticleOrder,

@@ -24,26 +24,29 @@ def use_threads(n: int, decided: bool = False) -> None:
 
 
 @lru_cache(maxsize=None)
-def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True):
+def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True, displaced: bool = True):
     """The pair functions for numba's CPU target in ``precision`` with ``kernel``'s G, inlined into the
-    sweeps that call them; ``across``: with the pairs across an x seam or wall (solvers/physics/pairs.py)."""
+    sweeps that call them; ``across``: with the pairs across an x seam or wall; ``displaced``: with the
+    particles' displacements in every separation (solvers/physics/pairs.py)."""
     import numba
 
     from solvers.kernels.constants import make_exp_neg_table
     from solvers.physics.pairs import make_pairs
 
-    return make_pairs(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision, across)
+    exp_neg = make_exp_neg_table(precision)
+    return make_pairs(numba.njit(inline="always"), exp_neg, kernel, precision, across, displaced)
 
 
 @lru_cache(maxsize=None)
-def cpu_pairs3d(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True):
+def cpu_pairs3d(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True, displaced: bool = True):
     """The 3D pair functions (solvers/physics/pairs3d.py) for numba's CPU target, as :func:`cpu_pairs`."""
     import numba
 
     from solvers.kernels.constants import make_exp_neg_table
     from solvers.physics.pairs3d import make_pairs3d
 
-    return make_pairs3d(numba.njit(inline="always"), make_exp_neg_table(precision), kernel, precision, across)
+    exp_neg = make_exp_neg_table(precision)
+    return make_pairs3d(numba.njit(inline="always"), exp_neg, kernel, precision, across, displaced)
 
 
 def pair_sources(kernel: str = DEFAULT_KERNEL, dims: int = 2) -> tuple:
@@ -60,12 +63,18 @@ def pair_sources(kernel: str = DEFAULT_KERNEL, dims: int = 2) -> tuple:
 
 
 def cpu_loops(
-    template: str, precision: str, kernel: str, parallel: bool | None, across: bool = True, **bind
+    template: str,
+    precision: str,
+    kernel: str,
+    parallel: bool | None,
+    across: bool = True,
+    displaced: bool = True,
+    **bind,
 ) -> ModuleType:
-    """The loops of ``template`` (solvers/loops/) over :func:`cpu_pairs` for ``precision``, ``kernel`` and
-    ``across``,
-    compiled with numba's CPU target (on its threads where ``parallel``; every function the template lists in
-    ``COMPILED``) and cached on disk once per machine (solvers/jitcache.py). ``bind``: more free names, as values."""
+    """The loops of ``template`` (solvers/loops/) over :func:`cpu_pairs` for ``precision``, ``kernel``,
+    ``across`` and ``displaced``, compiled with numba's CPU target (on its threads where ``parallel``; every
+    function the template lists in ``COMPILED``) and cached on disk once per machine (solvers/jitcache.py).
+    ``bind``: more free names, as values."""
     from solvers import jitcache
 
     module = f"solvers.loops.{template}"
@@ -75,7 +84,10 @@ def cpu_loops(
     pairs = "cpu_pairs3d" if template.endswith("3d") else "cpu_pairs"  # a 3D template's pair functions are 3D
     return jitcache.specialise(
         module,
-        bind={"P": f"{pairs}({precision!r}, {kernel!r}, {across!r})", **{k: repr(v) for k, v in bind.items()}},
+        bind={
+            "P": f"{pairs}({precision!r}, {kernel!r}, {across!r}, {displaced!r})",
+            **{k: repr(v) for k, v in bind.items()},
+        },
         functions={name: ("numba.njit", options) for name in names},
         imports=("import numba", f"from solvers.physics.backend import {pairs}"),
         depends=pair_sources(kernel, 3 if pairs == "cpu_pairs3d" else 2),

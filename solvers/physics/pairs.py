@@ -52,26 +52,46 @@ from solvers.kernels.constants import (
 )
 
 
-def range_sums(jit, gradient, mirror: bool) -> tuple:
+def separation_rule(jit, mirror: bool, displaced: bool = True):
+    """r_ij's two components, m: of particle j itself, r_ij = (lx_i - lx_j) dx + (sx_i - sx_j) per axis, or
+    (``mirror``) of its image across a rigid wall: ``lxi`` is i's column minus the wall's mirror sum M (the image
+    of column lx_j is column M - lx_j, its displacement -sx_j), so r_ij' = (lxi + lx_j) dx + (sx_i + sx_j). The
+    lattice part is exact. ``displaced`` False (every displacement zero for the whole run: fixed particles on
+    their sites, :attr:`solvers.interface.Solver.displaced`): the lattice part alone, the same bits without
+    the displacements' loads. Both flags compile-time constants."""
+
+    @jit
+    def separation(lxi, lyi, sxi, syi, j, lx, ly, sx, sy, k):
+        if mirror:
+            rx = (lxi + lx[j]) * k[SPACING]
+            if displaced:
+                rx += sxi + sx[j]
+        else:
+            rx = (lxi - lx[j]) * k[SPACING]
+            if displaced:
+                rx += sxi - sx[j]
+        ry = (lyi - ly[j]) * k[SPACING]
+        if displaced:
+            ry += syi - sy[j]
+        return rx, ry
+
+    return separation
+
+
+def range_sums(jit, gradient, mirror: bool, displaced: bool = True) -> tuple:
     """The four pair sums over the particles j0..j1-1: of the particles themselves, or (``mirror``) of their
     mirror images across a rigid wall, x_j' = 2 x_w - x_j with the normal velocity reversed (u_j' = -u_j) and
-    the same v, drho, mass and coefficients. For mirrors ``lxi`` is i's column minus the wall's mirror sum M
-    (the image of column lx_j is column M - lx_j, its displacement -sx_j), so that
-    r_ij' = (lxi + lx_j) dx + (sx_i + sx_j), exact like every separation. ``mirror`` is a compile-time
-    constant: each variant has its own loop."""
+    the same v, drho, mass and coefficients, each separation by :func:`separation_rule`. ``mirror`` and
+    ``displaced`` are compile-time constants: each variant has its own loop."""
+    separation = separation_rule(jit, mirror, displaced)
 
     @jit
     def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):
         """sum_j vol_j u_ij . r_ij G_ij over the particles j0..j1-1 (lyi already shifted)."""
         acc = k[ZERO]
         for j in range(j0, j1):
-            if mirror:
-                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-                uij = ui + u[j]
-            else:
-                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-                uij = ui - u[j]
-            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            rx, ry = separation(lxi, lyi, sxi, syi, j, lx, ly, sx, sy, k)
+            uij = ui + u[j] if mirror else ui - u[j]
             r2 = rx * rx + ry * ry
             if r2 < k[RC2]:
                 g = gradient(r2, k)
@@ -84,11 +104,7 @@ def range_sums(jit, gradient, mirror: bool) -> tuple:
         ax = k[ZERO]
         ay = k[ZERO]
         for j in range(j0, j1):
-            if mirror:
-                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-            else:
-                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            rx, ry = separation(lxi, lyi, sxi, syi, j, lx, ly, sx, sy, k)
             r2 = rx * rx + ry * ry
             if r2 < k[RC2]:
                 w = mass[j] * (pri + pr[j]) * gradient(r2, k)
@@ -101,11 +117,7 @@ def range_sums(jit, gradient, mirror: bool) -> tuple:
         """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
         count = 0
         for j in range(j0, j1):
-            if mirror:
-                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-            else:
-                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            rx, ry = separation(lxi, lyi, sxi, syi, j, lx, ly, sx, sy, k)
             if rx * rx + ry * ry < k[RC2]:
                 count += 1
         return count
@@ -120,11 +132,7 @@ def range_sums(jit, gradient, mirror: bool) -> tuple:
         gx = k[ZERO]
         gy = k[ZERO]
         for j in range(j0, j1):
-            if mirror:
-                rx = (lxi + lx[j]) * k[SPACING] + (sxi + sx[j])
-            else:
-                rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-            ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
+            rx, ry = separation(lxi, lyi, sxi, syi, j, lx, ly, sx, sy, k)
             r2 = rx * rx + ry * ry
             if r2 < k[RC2]:
                 w = vol[j] * gradient(r2, k)
@@ -623,19 +631,20 @@ def particle_passes(jit) -> dict:
     }
 
 
-def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True) -> ModuleType:
+def make_pairs(jit, exp_neg, kernel: str, precision: str, across: bool = True, displaced: bool = True) -> ModuleType:
     """The pair functions compiled with ``jit`` for ``kernel`` in ``precision``, using
     ``exp_neg(x) = exp(-x)`` (itself compiled here) where the kernel needs it. ``across``: whether an x
     edge of the scene has images (a periodic seam or a rigid wall); False compiles the stencil sums and the
     all-pair sums without the pairs across it (a compile-time constant: the paper's scene, free in x, pays
-    nothing for seams and walls it does not have; see :func:`stencil_range`).
+    nothing for seams and walls it does not have; see :func:`stencil_range`). ``displaced`` False: every
+    displacement is zero for the whole run (:func:`separation_rule`).
 
     They come back as attributes of a module object, which numba resolves inside the jitted sweeps
     that call them (it cannot type a plain namespace).
     """
     gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg)))
-    plain = range_sums(jit, gradient, mirror=False)
-    mirrored = range_sums(jit, gradient, mirror=True)
+    plain = range_sums(jit, gradient, mirror=False, displaced=displaced)
+    mirrored = range_sums(jit, gradient, mirror=True, displaced=displaced)
     stencil = stencil_rules(jit)
     beyond = across_sums(jit, stencil["stencil_row"], stencil["on_x_boundary"], plain, mirrored)
     pairs = ModuleType(f"{__name__}.compiled", "The pair functions for one backend (see make_pairs).")

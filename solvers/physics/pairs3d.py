@@ -25,15 +25,21 @@ from solvers.kernels.constants import C0SQ, NONLIN, NX, NY, NZ, ONE, RC2, RHO0, 
 TRIM_SLACK = 1e-5  # of the cutoff: the stencil's trim never drops a pair the sums' rounding puts within the cutoff
 
 
-def separation_rule(jit):
+def separation_rule(jit, displaced: bool = True):
     """r_ij's three components, m: particle i at lattice coordinates (lxi, lyi, lzi) (shifted across a seam where
-    the sum is) and its own displacements, j at its own; the lattice part whole numbers, exact."""
+    the sum is) and its own displacements, j at its own; the lattice part whole numbers, exact. ``displaced``
+    False (every displacement zero for the whole run, :attr:`solvers.interface.Solver.displaced`): the lattice
+    part alone, the same bits without the displacements' loads (a compile-time constant)."""
 
     @jit
     def separation(lxi, lyi, lzi, sxi, syi, szi, j, lx, ly, lz, sx, sy, sz, k):
-        rx = (lxi - lx[j]) * k[SPACING] + (sxi - sx[j])
-        ry = (lyi - ly[j]) * k[SPACING] + (syi - sy[j])
-        rz = (lzi - lz[j]) * k[SPACING] + (szi - sz[j])
+        rx = (lxi - lx[j]) * k[SPACING]
+        ry = (lyi - ly[j]) * k[SPACING]
+        rz = (lzi - lz[j]) * k[SPACING]
+        if displaced:
+            rx += sxi - sx[j]
+            ry += syi - sy[j]
+            rz += szi - sz[j]
         return rx, ry, rz
 
     return separation
@@ -290,12 +296,13 @@ def minimum_image_rule(jit):
     return over_all
 
 
-def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True) -> ModuleType:
+def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True, displaced: bool = True) -> ModuleType:
     """The 3D pair functions compiled with ``jit`` for ``kernel`` (normalised in 3D) in ``precision``: each sum
     over a range, over the stencil (``*_cells``) and over every particle (``*_allpair``), and the cell index of a
-    position. ``across``: whether x has a periodic seam (compile-time)."""
+    position. ``across``: whether x has a periodic seam; ``displaced``: whether particles can leave their lattice
+    sites (:func:`separation_rule`; both compile-time)."""
     gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg), dims=3))
-    separation = separation_rule(jit)
+    separation = separation_rule(jit, displaced)
     continuity_range = continuity_sum(jit, separation, gradient)
     continuity_split_range = continuity_split_sum(jit, separation, gradient)
     momentum_range = momentum_sum(jit, separation, gradient)
