@@ -57,7 +57,8 @@ def test_fixed_particles_give_the_same_bits_without_their_displacements(case):
 
 
 def test_moving_particles_and_a_bodys_shifted_sites_keep_the_displacements():
-    """The Lagrangian model moves particles; the 2D lattice body places its particles off their sites."""
+    """The Lagrangian model moves particles; the 2D ring body (the cylinder's default) places its particles off
+    their sites."""
     moving = make_solver("linkedlist-cpu")
     moving.input(Scene(dx=0.5, name="acoustic-pulse", model="lagrangian"))
     moving.init()
