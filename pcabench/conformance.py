@@ -480,7 +480,7 @@ def memory(subject: Subject) -> str:
         bound = cls.memory_bytes(scene, pair_loop)
         subject.evolve(scene, pair_loop=pair_loop)  # compiled and first launched outside the measurement
         used = measure(subject, scene, pair_loop)
-        what = f"{pair_loop}/{integrator}/{precision}" + ("" if correction == "none" else f"/{correction}")
+        what = f"{pair_loop}/{integrator}/{precision}" + ("" if correction == DEFAULT_CORRECTION else f"/{correction}")
         over = f" (+{used - bound:,} B: within the {PYTHON_OBJECTS:,} B of Python objects allowed)"
         notes.append(f"{what} {used / bound:.1%}" + (over if bound < used <= bound + PYTHON_OBJECTS else ""))
         if used > bound + PYTHON_OBJECTS:

@@ -188,11 +188,15 @@ class GradientCorrection(Correction):
         )
 
     def lattice_factor(self, scene) -> float:
-        """1 / M_xx of a particle inside the lattice: the symbol's long-wave slope divided out (D(k) / D'(0))."""
+        """1 / M_xx of a particle inside the lattice (square in 2D, cubic in 3D, by the scene's dimension): the
+        symbol's long-wave slope divided out (D(k) / D'(0)); M_xx = -dx^d sum_j G(r_j) x_j^2 over the lattice
+        neighbours within the cutoff."""
         reach = int(math.ceil(scene.cutoff / scene.dx))
         offsets = np.arange(-reach, reach + 1, dtype=np.float64) * scene.dx
-        x, y = np.meshgrid(offsets, offsets, indexing="ij")
-        r = np.hypot(x, y)
+        axes = np.meshgrid(*(offsets,) * scene.dims, indexing="ij")
+        r = np.hypot(*axes) if scene.dims == 2 else np.sqrt(sum(a * a for a in axes))
         keep = (r < scene.cutoff) & (r > 0)
-        moment = -(scene.dx**2) * float((scene.sph_kernel.gradient(r[keep], scene.h) * x[keep] ** 2).sum())
+        dims = {"dims": 3} if scene.dims == 3 else {}  # a 2D-only kernel takes no dims
+        g = scene.sph_kernel.gradient(r[keep], scene.h, **dims)
+        moment = -(scene.dx**scene.dims) * float((g * axes[0][keep] ** 2).sum())
         return 1.0 / moment if math.isfinite(moment) and moment > 0 else 1.0

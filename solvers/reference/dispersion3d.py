@@ -44,15 +44,6 @@ def lattice_offsets(scene) -> tuple:
     return a[keep].astype(float), b[keep].astype(float), c[keep].astype(float), g
 
 
-def lattice_factor(scene) -> float:
-    """1 / M_xx inside the cubic lattice for a corrected method (the correction's L is that scalar there), else 1."""
-    if scene.correction == "none":
-        return 1.0
-    a, _b, _c, g = lattice_offsets(scene)
-    moment = -(scene.dx**3) * float((g * (a * scene.dx) ** 2).sum())
-    return 1.0 / moment if math.isfinite(moment) and moment > 0 else 1.0
-
-
 def symbol(scene, kx, ky, kz) -> tuple:
     """(D_x, D_y, D_z) at wavenumbers (kx, ky, kz), 1/m (arrays broadcast together), in chunks."""
     a, b, c, g = lattice_offsets(scene)
@@ -67,7 +58,7 @@ def symbol(scene, kx, ky, kz) -> tuple:
         weight = -(scene.dx**3) * np.sin(phase) * g
         for i, o in enumerate((a, b, c)):
             out[i, part] = weight @ (o * scene.dx)
-    scale = lattice_factor(scene)
+    scale = scene.sph_correction.lattice_factor(scene)  # a correction's factor in the lattice's interior
     return tuple(scale * row.reshape(shape) for row in out)
 
 

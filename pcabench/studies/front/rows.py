@@ -8,6 +8,7 @@ import numpy as np
 from pcabench.reports.tables import label
 from pcabench.store.rows import comparable, error_column, is_paper_method, latest, numerics_label
 from solvers import DEFAULT_KERNEL, Scene
+from solvers.corrections import DEFAULT_CORRECTION
 from solvers.method import Method
 
 FRONT_MODELS = ("linear", "lagrangian")  # fixed solves neither equation: it is in the simplifications' table
@@ -46,7 +47,7 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
                 "h_factor": r.h_factor,
                 "cfl": r.cfl,
                 "integrator": r.integrator,
-                "correction": r.get("correction") or "none",
+                "correction": r.get("correction") or DEFAULT_CORRECTION,
                 "cutoff_factor": r.cutoff_factor,
                 "precision": r.precision,
                 "model": r.model,

@@ -9,6 +9,7 @@ from pcabench.reports import tables as T
 from pcabench.reports.md import first_words, fmt, md_table
 from pcabench.reports.section import Section
 from pcabench.store.rows import latest
+from solvers.corrections import DEFAULT_CORRECTION
 
 
 def rows(ctx):
@@ -39,7 +40,7 @@ def text(bad, ctx) -> list[str]:
             r.integrator,
             r.kernel,
             fmt(r.h_factor, ".3g"),
-            "-" if r.correction in (None, "none") else r.correction,
+            "-" if r.correction in (None, DEFAULT_CORRECTION) else r.correction,
             f"{r.dx:g}",
             f"{int(r.n_particles):,}",
             T.protocol(r),
