@@ -260,3 +260,24 @@ def test_a_section_reads_the_presets_it_declares(tmp_path):
     own = dataclasses.replace(ctx, runs=ctx.runs_of(probe.reads))
     probe.rows(own)
     assert list(seen["runs"].preset) == ["front"] and own.cache is ctx.cache  # the caches shared
+
+
+def test_the_front_leaves_out_the_runs_of_presets_that_measure_no_error(tmp_path):
+    """A preset that says its runs are not scored (the long stability runs, a plug-in's) gives no front point,
+    at whatever time it ends; the same run under a scored preset is one."""
+    from pcabench.reports import frame
+    from pcabench.studies.front.rows import speed_front
+    from pcabench.studies.preset import PRESETS, Preset
+
+    from .test_study import row
+
+    path = tmp_path / "front" / "m.jsonl"
+    scene = dict(dx=1.0, t_end=10.0, model="linear", x_min=-10.0, x_max=10.0, y_min=-10.0, y_max=10.0)
+    for preset, cfl in (("front", 1.0), ("stability-long", 1.5), ("my-long", 2.0)):
+        store.append(row(name="acoustic-pulse", preset=preset, cfl=cfl, **scene), path)
+    mine = Preset("my-long", lambda: [], 60.0, flag="my-long", scored=False)
+    with PRESETS.registered(mine):
+        points, _ = speed_front(frame.load(path.parent))
+    assert sorted(p["cfl"] for p in points) == [1.0]
+    points, _ = speed_front(frame.load(path.parent))  # the plug-in gone: its run is an ordinary one again
+    assert sorted(p["cfl"] for p in points) == [1.0, 2.0]

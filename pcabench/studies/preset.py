@@ -39,7 +39,8 @@ class Preset:
     (``--run-budget`` overrides). On the command line it is ``--<flag>``, or ``--<flag> <choice>`` where
     several presets share a flag (the first listed is the flag's value when none is given); ``help`` says
     what it measures, its run count ``{size}`` counted from the plan (or by ``count(scene)``, where a plan
-    predicts some of its runs); ``order`` places it in the help."""
+    predicts some of its runs); ``order`` places it in the help. ``scored`` False: its runs measure something
+    other than accuracy (a stable step over a long run), so no front or accuracy table takes their errors."""
 
     name: str
     plan: Callable[..., list]
@@ -50,6 +51,7 @@ class Preset:
     help: str = ""
     order: float = 100.0
     count: Callable[[str], str] | None = None
+    scored: bool = True
 
     def specs(self, scene: str = DEFAULT_SCENE) -> list:
         return self.plan(scene=scene) if self.scened else self.plan()
@@ -85,6 +87,11 @@ PRESETS = Registry(
 def size_text(name: str, scene: str = DEFAULT_SCENE) -> str:
     """How many runs preset ``name`` makes on ``scene``, as its help says it."""
     return PRESETS.get(name).size(scene)
+
+
+def unscored() -> tuple[str, ...]:
+    """The presets whose runs' errors are not accuracy results (:attr:`Preset.scored` False)."""
+    return tuple(p.name for p in PRESETS.all().values() if not p.scored)
 
 
 def budget(name: str) -> float:

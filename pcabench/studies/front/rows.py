@@ -7,6 +7,7 @@ import numpy as np
 
 from pcabench.reports.tables import label
 from pcabench.store.rows import comparable, error_column, is_paper_method, latest, numerics_label
+from pcabench.studies.preset import unscored
 from solvers import DEFAULT_KERNEL, Scene
 from solvers.corrections import DEFAULT_CORRECTION
 from solvers.method import Method
@@ -29,7 +30,7 @@ def speed_front(df) -> tuple[list[dict], list[dict]]:
     """
     from pcabench.predict.stability import assess
 
-    accuracy_runs = df.preset != "stability-long"  # runs to t = 300 s to measure a stable step, not an error
+    accuracy_runs = ~df.preset.isin(unscored())  # not the runs that measure a stable step (pcabench.studies.preset)
     pts = latest(
         df[(df.status == "ok") & df.protocol.str.startswith("t =") & df.model.isin(FRONT_MODELS) & accuracy_runs]
     )

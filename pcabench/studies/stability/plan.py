@@ -69,4 +69,5 @@ STABILITY_LONG = Preset(
     choice="long",
     help="each model at CFL 4.4-5 to t = 300 s, the moving models' own limit ({size})",
     order=31,
+    scored=False,  # runs to t = 300 s to measure a stable step, not an error
 )
