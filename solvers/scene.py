@@ -9,11 +9,12 @@ Gaussian pulse of Mach 0.05, a Gaussian kernel with h = 2.13 dx truncated at
 there instead.
 
 A scene holds its numerical method as a value (:class:`~solvers.method.Method`:
-kernel, h/dx, truncation, CFL, integrator, correction; the paper's its default)
-and its edges as another (:class:`~solvers.edges.Edges`: which are open, and the
-absorbing layer beyond them). Its parameters are one flat list
-(:data:`Scene.PARAMETERS`: its keywords, its record's columns, its options), the
-method's and the edges' read through from those values.
+kernel, h/dx, truncation, CFL, integrator, correction; the paper's its default),
+its edges as another (:class:`~solvers.edges.Edges`: which are open, and the
+absorbing layer beyond them) and a body's options as a third
+(:class:`~solvers.body.BodyOptions`: its radius, its wall's model). Its parameters
+are one flat list (:data:`Scene.PARAMETERS`: its keywords, its record's columns,
+its options), the method's, the edges' and the body's read through from those values.
 
 A scene states its particle count and memory before anything is allocated
 (:meth:`Scene.memory_bytes`) and rejects nonsense with a message that names
@@ -29,6 +30,7 @@ import math
 from dataclasses import dataclass, field, fields, replace
 from typing import ClassVar
 
+from solvers.body import BodyOptions
 from solvers.corrections import DEFAULT_CORRECTION, Correction, correction_named
 from solvers.edges import Edges
 from solvers.kernels import Kernel, kernel_named
@@ -71,6 +73,7 @@ PML_ARRAYS_3D = 9
 # a body's radius only where the kind has a body).
 PAPER_PULSE = {"pulse_width": 3.0, "pulse_center": 0.0}
 PER_KIND = ("pulse_width", "pulse_center", "cylinder_radius", "sphere_radius")
+BODY_PER_KIND = ("cylinder_radius", "sphere_radius")  # of PER_KIND: the body's options (solvers/body.py)
 LAYER_UNSET = Edges.layer_unset()  # a closed scene's layer options
 DEFAULT_METHOD = Method.paper()  # Scene's method unless given (solvers/method.py: the paper's)
 
@@ -104,11 +107,9 @@ class Scene:
     mach: float = 0.05
     pulse_width: float | None = None  # the 3 in exp(-((x - c0 t)/3)^2), m; None: the kind's (the paper's 3)
     pulse_center: float | None = None  # pulse position at t = 0, m; None: the kind's (the paper's 0)
-    cylinder_radius: float | None = None  # a rigid cylinder's radius, m (a scene kind with a body); None: the kind's
-    sphere_radius: float | None = None  # a rigid sphere's radius, m (a 3D scene kind with a body); None: the kind's
-    boundary_method: str = ""  # how a body's curved wall is modelled (solvers/boundaries/bodies/); "": the default
     probes: tuple = ()  # points ((x, y) or (x, y, z), ...) m where a run records drho every few steps, beside its own
     edges: Edges = Edges()  # the open edges and their layer (solvers/edges.py); open "": the kind's
+    body_options: BodyOptions = BodyOptions()  # a rigid body's radius and wall model (solvers/body.py)
     method: Method = DEFAULT_METHOD  # kernel, h/dx, truncation, CFL, integrator, correction (solvers/method.py)
     model: str = "lagrangian"
     precision: str = "float64"
@@ -126,16 +127,20 @@ class Scene:
         "model", "integrator", "precision", "steps", "t_end", "blowup_factor",
     )  # fmt: skip
 
-    def __init__(self, dx: float, name: str = DEFAULT_SCENE, *, method=None, edges=None, **given) -> None:
+    def __init__(
+        self, dx: float, name: str = DEFAULT_SCENE, *, method=None, edges=None, body_options=None, **given
+    ) -> None:
         """A scene of lattice spacing ``dx`` (m) of the scene kind ``name``: every other parameter a keyword of
-        :data:`PARAMETERS`. ``method`` and ``edges`` give those values whole; a flat keyword (``kernel=``,
-        ``open=``) refines the value it belongs to."""
+        :data:`PARAMETERS`. ``method``, ``edges`` and ``body_options`` give those values whole; a flat keyword
+        (``kernel=``, ``open=``, ``cylinder_radius=``) refines the value it belongs to."""
         unknown = sorted(set(given) - set(self.PARAMETERS) - {"memory_limit_bytes"})
         if unknown:
             raise TypeError(f"Scene() got an unexpected keyword argument {unknown[0]!r}")
         method = DEFAULT_METHOD if method is None else method
         edges = Edges() if edges is None else edges
-        for keyword, value, kind in (("method", method, Method), ("edges", edges, Edges)):
+        body_options = BodyOptions() if body_options is None else body_options
+        values = (("method", method, Method), ("edges", edges, Edges), ("body_options", body_options, BodyOptions))
+        for keyword, value, kind in values:
             if not isinstance(value, kind):
                 raise SceneError(f"{keyword} must be a {kind.__name__} value (got {type(value).__name__} {value!r})")
         numerics = {k: given.pop(k) if k in given else getattr(method, k) for k in METHOD_FIELDS}
@@ -151,10 +156,12 @@ class Scene:
         object.__setattr__(
             self, "edges", Edges(**{k: given.pop(k) if k in given else getattr(edges, k) for k in Edges.names()})
         )
+        body = {k: given.pop(k) if k in given else getattr(body_options, k) for k in BodyOptions.names()}
+        object.__setattr__(self, "body_options", BodyOptions(**body))
         object.__setattr__(self, "dx", dx)
         object.__setattr__(self, "name", name)
         for f in fields(self):
-            if f.name not in ("dx", "name", "method", "edges"):
+            if f.name not in ("dx", "name", "method", "edges", "body_options"):
                 object.__setattr__(self, f.name, given.pop(f.name, f.default))
         self.__post_init__()
 
@@ -210,6 +217,23 @@ class Scene:
         """The absorber's strength asked for, 1/s; None: the absorber's default for the scene."""
         return self.edges.absorber_strength
 
+    # ------------------------------------------------------------ the body's parameters
+    @property
+    def cylinder_radius(self) -> float | None:
+        """A rigid cylinder's radius, m (a scene kind with a body in 2D; else None)."""
+        return self.body_options.cylinder_radius
+
+    @property
+    def sphere_radius(self) -> float | None:
+        """A rigid sphere's radius, m (a 3D scene kind with a body; else None)."""
+        return self.body_options.sphere_radius
+
+    @property
+    def boundary_method(self) -> str:
+        """How a body's curved wall is modelled, as asked (solvers/boundaries/bodies/); "": the default
+        (:attr:`boundary_method_used`)."""
+        return self.body_options.boundary_method
+
     def __post_init__(self) -> None:
         if self.steps is None and self.t_end is None:
             object.__setattr__(self, "steps", 100)  # the paper's protocol
@@ -225,7 +249,11 @@ class Scene:
                 object.__setattr__(self, key, kind.domain.get(key, PAPER_DEPTH[key]))
         for key in PER_KIND:
             if getattr(self, key) is None:
-                object.__setattr__(self, key, kind.defaults.get(key, PAPER_PULSE.get(key)))
+                value = kind.defaults.get(key, PAPER_PULSE.get(key))
+                if key in BODY_PER_KIND:
+                    object.__setattr__(self, "body_options", replace(self.body_options, **{key: value}))
+                else:
+                    object.__setattr__(self, key, value)
         if not self.open:
             object.__setattr__(self, "edges", replace(self.edges, open=kind.defaults.get("open", "")))
         words = "x,y,z" if kind.dims == 3 else "x,y"
@@ -417,45 +445,9 @@ class Scene:
                 )
 
     def _validate_body(self, need, finite) -> None:
-        """A body's parameters only where the kind has a body (its own checks are the kind's), and a known
-        boundary method."""
-        if not (self.kind.body and self.dims == 2):
-            need(
-                self.cylinder_radius is None,
-                f"--cylinder-radius: the {self.name} scene has no body of that shape (use --scene cylinder)",
-            )
-        if not (self.kind.body and self.dims == 3):
-            need(
-                self.sphere_radius is None,
-                f"--sphere-radius: the {self.name} scene has no body of that shape (use --scene sphere)",
-            )
-        if not self.kind.body:
-            need(
-                not self.boundary_method,
-                f"--boundary-method: the {self.name} scene has no body (use --scene cylinder)",
-            )
-            return
-        try:
-            from solvers.boundaries.bodies import boundary_method_named, boundary_method_names
-
-            method = boundary_method_named(self.boundary_method_used)
-        except ValueError as exc:
-            raise SceneError(str(exc)) from None
-        if self.dims == 3:  # a body in 3D: the weak walls alone (the ghost bodies place particles in a plane)
-            walls = [name for name in boundary_method_names() if 3 in getattr(boundary_method_named(name), "dims", ())]
-            need(
-                3 in getattr(method, "dims", (2,)),
-                ("" if self.boundary_method else "standard SPH's body, ")
-                + f"--boundary-method {method.name}: the {self.name} scene's body is 3D, whose wall is "
-                f"--boundary-method {' or '.join(walls)} alone (the ghost bodies are 2D's); it needs a kernel "
-                "correction: add --correction gradient (the high-order method: --kernel laguerre-gauss --cutoff 4 "
-                "--h-factor 1.5 --correction gradient)",
-            )
-        need(
-            not getattr(method, "needs_correction", False) or self.correction != DEFAULT_CORRECTION,
-            f"--boundary-method {method.name} makes a wall only with a kernel correction: add --correction "
-            f"gradient (got --correction {self.correction})",
-        )
+        """The body's options (:meth:`solvers.body.BodyOptions.problems`): the first problem, in one line."""
+        for problem in self.body_options.problems(self):
+            need(False, problem)
 
     @property
     def body(self) -> tuple | None:
@@ -465,13 +457,8 @@ class Scene:
 
     @property
     def boundary_method_used(self) -> str:
-        """How the body's wall is modelled: ``boundary_method``, or the default (solvers/boundaries/bodies/): standard
-        SPH's (rings), or with a kernel correction the one whose wall holds with it (the weak wall's cut cells)."""
-        from solvers.boundaries.bodies import CORRECTED_BOUNDARY_METHOD, DEFAULT_BOUNDARY_METHOD
-
-        if self.boundary_method:
-            return self.boundary_method
-        return DEFAULT_BOUNDARY_METHOD if self.correction == DEFAULT_CORRECTION else CORRECTED_BOUNDARY_METHOD
+        """How the body's wall is modelled (:meth:`solvers.body.BodyOptions.boundary_method_used`)."""
+        return self.body_options.boundary_method_used(self.correction)
 
     @property
     def blowup_bounds(self) -> dict:
@@ -807,6 +794,8 @@ class Scene:
             return getattr(DEFAULT_METHOD, name)
         if name in Edges.names():
             return getattr(Edges(), name)
+        if name in BodyOptions.names():
+            return getattr(BodyOptions(), name)
         return cls.__dataclass_fields__[name].default
 
     def parameters(self) -> dict:

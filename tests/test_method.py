@@ -145,6 +145,27 @@ def test_a_scene_holds_its_method_and_edges_and_its_parameters_are_one_list():
     assert Scene(dx=0.5).method == Method.paper() and Scene.default("cutoff_factor") == 3.0
 
 
+def test_a_scenes_body_is_a_value_beside_its_edges():
+    """The body's radius and wall model are one value (solvers/body.py): resolved to the kind's radius, read
+    through by the flat keywords, given whole or refined by a keyword, and refused in one line on a scene
+    without that body."""
+    from solvers.body import BodyOptions
+
+    s = Scene(0.1, "cylinder", boundary_method="lattice")
+    assert s.body_options == BodyOptions(cylinder_radius=0.5, boundary_method="lattice") and s.body == (0.0, 0.0, 0.5)
+    assert (s.cylinder_radius, s.sphere_radius, s.boundary_method_used) == (0.5, None, "lattice")
+    assert Scene(**s.parameters()) == s == Scene(0.1, "cylinder", body_options=s.body_options)
+    wider = Scene(0.1, "cylinder", body_options=s.body_options, cylinder_radius=0.7)
+    assert wider.body == (0.0, 0.0, 0.7) and wider.boundary_method == "lattice"
+    assert Scene(0.125, "sphere", correction="gradient").body_options == BodyOptions(sphere_radius=0.5)
+    assert Scene(0.125, "sphere", correction="gradient").boundary_method_used == "cut"  # the corrected default
+    assert Scene(0.5).body_options == BodyOptions() and Scene(0.5).body is None
+    with pytest.raises(SceneError, match=r"^--sphere-radius: the cylinder scene has no body of that shape"):
+        Scene(0.1, "cylinder", sphere_radius=0.5)
+    with pytest.raises(SceneError, match=r"^body_options must be a BodyOptions value"):
+        Scene(0.1, "cylinder", body_options={"cylinder_radius": 0.5})
+
+
 def test_a_method_names_why_it_cannot_run_and_a_scene_refuses_it_with_that_line():
     ok = [Method.paper(), Method("wendland-c4", 1.3, None, 2.0, "rk4", "gradient")]
     assert all(list(m.problems()) == [] for m in ok)
