@@ -226,6 +226,8 @@ def rows(ctx):
     rows = time_to_accuracy(df)
     methods = {}
     for r in rows:
+        if scene_kind(r["scene"]).dims != 2:
+            continue  # the phase's direction is drawn on the square lattice: the 2D scenes' methods
         for p in (r["best"], r["paper"]):
             if p is not None:
                 methods.setdefault(
@@ -311,9 +313,11 @@ def text(data, ctx) -> list[str]:
             for (m, t), v in sorted(both.items())
             if len(set(v.values())) > 1
         ]
+        three_d = any(scene_kind(s).dims == 3 for v in both.values() for s in v)
         lines += [
-            f"Does the method fastest on the plane pulse stay fastest in 2D? In {len(both) - len(differ)} of "
-            f"{len(both)} (model, target) pairs both scenes name the same method"
+            f"Does the method fastest on the plane pulse stay fastest in 2D{' and 3D' if three_d else ''}? In "
+            f"{len(both) - len(differ)} of {len(both)} (model, target) pairs "
+            f"{'every scene names' if any(len(v) > 2 for v in both.values()) else 'both scenes name'} the same method"
             + (f"; they differ for {', '.join(differ)}." if differ else "."),
             "",
         ]
@@ -358,7 +362,7 @@ def text(data, ctx) -> list[str]:
         short = [abs(c["short"][0] - c["short"][-1]) for c in data["phase"]]
         lines += [
             "The lattice's phase error depends on the direction of travel. `phase_direction.png` draws, for "
-            "the methods of the table, the predicted phase speed error (lattice and step together) at the "
+            "the 2D scenes' methods of the table, the predicted phase speed error (lattice and step together) at the "
             "2D pulse's wavenumber 1/b from the lattice's axis (0 degrees) to its diagonal (45 degrees) at "
             f"dx = 0.25 m: axis and diagonal differ by at most {100 * max(spread):.3g} % of c0 there, far "
             "less than the lag itself; for a short wave of 8 particles per wavelength by up to "
