@@ -14,6 +14,7 @@ from solvers.method import INTEGRATORS
 from solvers.registry import (
     DEFAULT_SOLVER,
     ENTRY_POINT_GROUP,
+    GPU_SOLVER,
     check_pair_loop,
     make_solver,
     registry,
@@ -39,6 +40,7 @@ __all__ = [
     "kernel_named",
     "kernel_names",
     "DEFAULT_SOLVER",
+    "GPU_SOLVER",
     "ENTRY_POINT_GROUP",
     "registry",
     "solver_names",

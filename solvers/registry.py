@@ -26,6 +26,7 @@ from solvers.scene import SceneError
 ENTRY_POINT_GROUP = "pcabench.solvers"
 SOLVER_NAME = NAME  # the record's solver field (pcabench/store/schema.py): the one name rule
 DEFAULT_SOLVER = "linkedlist-cpu"  # what a study runs when no solver is named: the paper's cell list, on the CPU
+GPU_SOLVER = "linkedlist-gpu"  # the GPU runs' solver (the paper's GPU sweep, pcabench gpu-check): its cell list
 
 SOLVERS = Registry(
     "solver",

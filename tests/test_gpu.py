@@ -215,7 +215,7 @@ def test_gpu_walls_match_cpu(requires_gpu, tmp_path):
     """The GPU check's walls stage on the card: plane-wall and pulse-wall (mirror particles), linear and
     lagrangian, float64 and float32, against linkedlist-cpu."""
     from pcabench.gpu.agreement import agrees
-    from pcabench.gpu.plan import FULL
+    from pcabench.studies.paper.gpu import FULL
     from pcabench.studies.walls import gpu as walls_gpu
 
     cases = walls_gpu.cases(rehearse=False)

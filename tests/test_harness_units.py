@@ -184,6 +184,7 @@ def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
     from pcabench.gpu import check as G
     from pcabench.gpu import plan
     from pcabench.gpu import stage as S
+    from pcabench.studies.paper.gpu import PAPER_STAGES, REHEARSAL
 
     ran = []
 
@@ -195,13 +196,13 @@ def test_a_gpu_check_stage_that_fails_or_lacks_time_does_not_stop_the_next():
 
     budget = plan.Budget(100.0)
     budget.say = lambda *a, **k: None  # quiet
-    check = S.Check(plan.REHEARSAL, Path("."), budget, {"stages": []}, {"id": "m"}, None, Path("s.jsonl"), True, {})
+    check = S.Check(REHEARSAL, Path("."), budget, {"stages": []}, {"id": "m"}, None, Path("s.jsonl"), True, {})
     for stage in (S.Stage("broken", 0, broken), S.Stage("greedy", 1e9, fine), S.Stage("fine", 0, fine)):
         G.run_stage(stage, check)
     status = {s["stage"]: s["status"] for s in check.state["stages"]}
     assert status["broken"].startswith("failed: RuntimeError: no card")
     assert status["greedy"].startswith("not run:") and status["fine"] == "ok" and ran == ["fine"]
-    assert [s.name for s in G.stages()][:4] == ["profile", "compare", "walls", "sweep"]  # the order of value
+    assert [s.name for s in G.stages(PAPER_STAGES)][:4] == ["profile", "compare", "walls", "sweep"]  # by value
 
 
 def test_the_gpu_checks_walls_stage_passes_only_what_agrees_and_shows_its_rows():
@@ -322,10 +323,11 @@ def _study_folder(tmp_path, name: str, files: dict):
 def test_a_study_gpu_stage_that_does_not_load_or_takes_a_taken_name_is_one_failed_stage(tmp_path):
     """The GPU check still runs every other stage (a lent machine's minutes are not lost to one study's typo)."""
     from pcabench.gpu import check as G
+    from pcabench.studies.paper.gpu import PAPER_STAGES
 
     undo = _study_folder(tmp_path, "broken_gpu", {"gpu.py": "import a_module_that_is_not_there\n"})
     try:
-        names = [s.name for s in G.stages()]
+        names = [s.name for s in G.stages(PAPER_STAGES)]  # the paper's given stages run all the same
         assert "studies" in names and {"profile", "compare", "sweep", "ncu"} <= set(names)
         (failed,) = [s for s in G.stages() if s.name == "studies"]
         with pytest.raises(RuntimeError, match="a_module_that_is_not_there"):
@@ -335,10 +337,10 @@ def test_a_study_gpu_stage_that_does_not_load_or_takes_a_taken_name_is_one_faile
     clash = "from pcabench.gpu.stage import Stage\nSTAGE = Stage('sweep', 0, lambda c: True, order=5)\n"
     undo = _study_folder(tmp_path, "clashing_gpu", {"gpu.py": clash})
     try:
-        (failed,) = [s for s in G.stages() if s.name == "studies"]
+        (failed,) = [s for s in G.stages(PAPER_STAGES) if s.name == "studies"]
         with pytest.raises(RuntimeError, match="the check's own name sweep"):
             failed.work(None)
-        assert [s.name for s in G.stages()].count("sweep") == 1
+        assert [s.name for s in G.stages(PAPER_STAGES)].count("sweep") == 1
     finally:
         undo()
     assert "studies" not in [s.name for s in G.stages()]
@@ -364,7 +366,8 @@ def test_listing_the_gpu_stages_imports_no_gpu_library():
     import sys
 
     code = (
-        "import sys; from pcabench.gpu.check import stages; stages(); "
+        "import sys; from pcabench.gpu.check import stages; from pcabench.studies.paper.gpu import PAPER_STAGES; "
+        "stages(PAPER_STAGES); "
         "print([m for m in ('cupy', 'numba.cuda', 'numba_cuda') if m in sys.modules])"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout

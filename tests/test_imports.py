@@ -193,7 +193,15 @@ LAYERS = (
         "solvers.fields",
     ),  # registries, kernels, absorbers, corrections, boundary methods, sampling between particles, a run's fields
     ("solvers.physics",),  # the rates per pair and the integrators, for every backend
-    ("solvers.scene", "solvers.scenes", "solvers.interface", "solvers.reference", "solvers.method", "solvers.edges"),
+    (
+        "solvers.scene",
+        "solvers.scenes",
+        "solvers.interface",
+        "solvers.reference",
+        "solvers.method",
+        "solvers.edges",
+        "solvers.body",
+    ),
     ("solvers.search", "solvers.gpu", "solvers.loops"),  # the neighbour search, the GPU backend, compiled loops
     ("solvers.allpair_cpu", "solvers.linkedlist_cpu", "solvers.linkedlist_gpu", "solvers.registry"),  # solvers
     ("solvers",),  # the package's face

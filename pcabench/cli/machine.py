@@ -29,10 +29,11 @@ def cmd_profile(args) -> int:
 
 def cmd_gpu_check(args) -> int:
     from pcabench.gpu.check import gpu_check
+    from pcabench.studies.paper.gpu import FULL, PAPER_STAGES, REHEARSAL
 
-    return gpu_check(
-        Path(args.out), Path(args.results), Path(args.reports), budget_s=args.budget, rehearse=args.rehearse
-    )
+    plan = REHEARSAL if args.rehearse else FULL  # the paper's sizes; its stages with the check's own
+    out, results, reports = Path(args.out), Path(args.results), Path(args.reports)
+    return gpu_check(out, results, reports, plan, budget_s=args.budget, rehearse=args.rehearse, given=PAPER_STAGES)
 
 
 def cmd_check_solver(args) -> int:

@@ -11,12 +11,12 @@ from typing import Callable
 import numpy as np
 
 from pcabench.execute.run import run
-from pcabench.gpu.plan import GPU_SOLVER, Plan
+from pcabench.gpu.plan import Plan
 from pcabench.gpu.stage import Check, Stage
 from pcabench.gpu.tables import scene_agreement
 from pcabench.spec import RunSpec
 from pcabench.store.safeio import fresh
-from solvers import DEFAULT_SOLVER, MODELS, PRECISIONS, Scene
+from solvers import DEFAULT_SOLVER, GPU_SOLVER, MODELS, PRECISIONS, Scene
 
 # ---------------------------------------------------------------- 2. GPU against CPU
 AGREEMENT = {"float64": 1e-12, "float32": 1e-4}  # the largest relative difference of u GPU vs CPU that passes

@@ -60,14 +60,13 @@ import time
 from pathlib import Path
 
 from pcabench.gpu.ceilings import measure_ceilings
-from pcabench.gpu.plan import FULL, REHEARSAL, Budget, Plan
+from pcabench.gpu.plan import Budget, Plan
 from pcabench.gpu.stage import STAGES, Check, Stage
 from pcabench.gpu.tables import markdown
 from pcabench.gpu.tools import ncu_command, run_logged
 from pcabench.spec import OptionError
 from pcabench.store import store_name
 from pcabench.store.safeio import fresh, own_folder, write_file
-from pcabench.studies.paper.gpu import PAPER_STAGES
 from solvers.gpu.device import device_backend, simulated
 
 H100_COMMIT = "bf587a5"  # the commit the H100 was measured at: asv compares the cards there
@@ -141,7 +140,6 @@ def ncu(c: Check) -> bool:
 # open 40, body 50, high-order 60; STAGES, each study's gpu.py) run between them, in order of value.
 OWN = (
     Stage("profile", 0, measure, order=0),
-    *PAPER_STAGES,  # the paper's scene against the CPU, its sweep, the CUDA graph, the CPU peers
     Stage("asv", 60, asv, order=90),
     Stage("bench", 60, bench, order=100),
     Stage("pytest-gpu", 40, pytest_gpu, order=110),
@@ -149,11 +147,12 @@ OWN = (
 )
 
 
-def stages() -> list[Stage]:
-    """Every stage the check runs, in order: its own and each study's (read at each check). A study's gpu.py
-    that does not load, or a study's stage named like one of the check's own, is one failed stage: the check
-    still runs every other stage and brings back what it has."""
-    own = {s.name for s in OWN}
+def stages(given: tuple = ()) -> list[Stage]:
+    """Every stage the check runs, in order: its own, those its caller ``given`` (the paper study's: the command
+    line hands them in, pcabench/studies/paper/gpu.py) and each study's registered one (read at each check). A
+    study's gpu.py that does not load, or a study's stage named like one of the check's own, is one failed
+    stage: the check still runs every other stage (the given ones too) and brings back what it has."""
+    own = {s.name for s in (*OWN, *given)}
     try:
         studies = list(STAGES.all().values())
         clash = sorted(own & {s.name for s in studies})
@@ -166,7 +165,7 @@ def stages() -> list[Stage]:
             raise RuntimeError(why)
 
         studies = [Stage("studies", 0, failed, order=15)]
-    return sorted((*OWN, *studies), key=lambda s: (s.order, s.name))
+    return sorted((*OWN, *given, *studies), key=lambda s: (s.order, s.name))
 
 
 def run_stage(stage: Stage, c: Check) -> None:
@@ -202,9 +201,16 @@ def missing_tools() -> list[str]:
 
 
 def gpu_check(
-    out: Path, results: Path, reports: Path, budget_s: float = 480.0, rehearse: bool = False, plan: Plan | None = None
+    out: Path,
+    results: Path,
+    reports: Path,
+    plan: Plan,
+    budget_s: float = 480.0,
+    rehearse: bool = False,
+    given: tuple = (),
 ) -> int:
-    """Every stage of :func:`stages` within ``budget_s`` seconds; 0 when every stage that ran passed, else 1.
+    """Every stage of :func:`stages` (with the caller's ``given`` ones) within ``budget_s`` seconds, at the sizes
+    of ``plan``; 0 when every stage that ran passed, else 1.
 
     With ``rehearse`` (no GPU needed) the kernels run in numba's CUDA simulator at a few hundred particles.
     """
@@ -217,7 +223,6 @@ def gpu_check(
 
         os.environ["NUMBA_ENABLE_CUDASIM"] = "1"  # for the child processes (asv, pytest)
         config.reload_config()  # and this one: numba read its settings when the solver registry imported it
-    plan = plan or (REHEARSAL if rehearse else FULL)
     from pcabench.machine import profiles
     from pcabench.reports.build import write_reports
     from pcabench.store.provenance import git_commit
@@ -237,11 +242,12 @@ def gpu_check(
         rehearse,
         dict(os.environ, PCABENCH_COMMIT=state["commit"]),
     )
-    for stage in stages():
+    every = stages(given)
+    for stage in every:
         run_stage(stage, c)
 
     state["elapsed_s"] = budget.elapsed()
-    text = markdown(profile, state, stages())
+    text = markdown(profile, state, every)
     write_file(out / "gpu_check.md", text)
     write_file(out / "gpu_check.json", json.dumps(state, indent=1, default=str) + "\n")
     print(text, flush=True)

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from pcabench.gpu.plan import GPU_SOLVER
-from solvers import Scene, make_solver
+from solvers import GPU_SOLVER, Scene, make_solver
 from solvers.physics.integrators import step_program
 
 

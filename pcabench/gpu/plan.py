@@ -1,5 +1,6 @@
-"""What the GPU check's own stages run and within what time: the full plan (sized on the H100 run), the
-rehearsal's, and the budget each stage is given. A study's stage sizes its own cases in its folder
+"""What the GPU check's stages run and within what time: a :class:`Plan` (the paper study's full plan, sized on
+the H100 run, and its rehearsal's are in pcabench/studies/paper/gpu.py, which the command line hands the check),
+and the budget each stage is given. A study's stage sizes its own cases in its folder
 (``pcabench/studies/<study>/gpu.py``), from the scene kinds' card sizes (:func:`card_cases`)."""
 
 from __future__ import annotations
@@ -7,10 +8,6 @@ from __future__ import annotations
 import sys
 import time
 from dataclasses import dataclass, field
-
-from pcabench.studies.paper import plan as paper
-
-GPU_SOLVER = paper.GPU_SOLVER  # the solver this check measures: the paper's GPU sweep's
 
 RESERVE_S = 25.0  # kept back from every stage for the reports and the tarball
 
@@ -29,40 +26,23 @@ def card_cases(which, open_edges: bool = False) -> tuple:
 
 @dataclass(frozen=True)
 class Plan:
-    """What the check runs and at what size."""
+    """What the check runs and at what size: the GPU sweep's sizes, models and steps and its CPU peers' (the
+    paper study's, pcabench/studies/paper/gpu.py), the rest the check's own."""
 
-    gpu_dx: tuple = paper.GPU_DX
-    models: tuple = paper.GPU_MODELS
-    min_steps: int = paper.GPU_STEPS[0]  # steps of the biggest runs; smaller ones take up to max_steps (see gpu_steps)
-    max_steps: int = paper.GPU_STEPS[1]
+    gpu_dx: tuple
+    models: tuple
+    min_steps: int  # steps of the biggest runs; smaller ones take up to max_steps (see gpu_steps)
+    max_steps: int
+    cpu_dx: tuple
+    cpu_steps: int
     compare_dx: float = 0.5
     compare_steps: int = 20
     graph_dx: tuple = (0.1, 0.025, 0.01)  # 100K, 1.6M, 10M
     graph_steps: int = 50
     graph_rounds: int = 5
-    cpu_dx: tuple = paper.CPU_DX
-    cpu_steps: int = paper.CPU_STEPS
     scene: dict = field(default_factory=dict)  # Scene overrides (the rehearsal's small domain)
     asv_bench: str = "TimeGPUStep"
     ncu_dx: float = 0.01
-
-
-FULL = Plan()
-REHEARSAL = Plan(
-    gpu_dx=(1.0, 0.5),
-    min_steps=2,
-    max_steps=2,
-    compare_dx=1.0,
-    compare_steps=3,
-    graph_dx=(1.0,),
-    graph_steps=2,
-    graph_rounds=1,
-    cpu_dx=(1.0,),
-    cpu_steps=2,
-    scene={"x_min": -8.0, "x_max": 8.0},
-    asv_bench="TimeGPUStep",
-    ncu_dx=1.0,
-)
 
 
 class Budget:

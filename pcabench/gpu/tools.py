@@ -8,8 +8,9 @@ import sys
 import time
 from pathlib import Path
 
-from pcabench.gpu.plan import GPU_SOLVER, Plan
+from pcabench.gpu.plan import Plan
 from pcabench.store.safeio import fresh
+from solvers import GPU_SOLVER
 
 
 # ---------------------------------------------------------------- 6-8. subprocess stages

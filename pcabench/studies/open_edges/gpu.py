@@ -12,12 +12,12 @@ import numpy as np
 from pcabench.conformance import SCENES
 from pcabench.execute.run import run
 from pcabench.gpu.agreement import agrees, compare_cases
-from pcabench.gpu.plan import GPU_SOLVER, card_cases
+from pcabench.gpu.plan import card_cases
 from pcabench.gpu.stage import Check, Stage
 from pcabench.gpu.tables import scene_agreement
 from pcabench.spec import RunSpec
 from pcabench.store.record import STEP_STAGES
-from solvers import PRECISIONS, Scene
+from solvers import GPU_SOLVER, PRECISIONS, Scene
 
 TITLE = "Open edges (an absorbing layer)"
 

@@ -2,7 +2,8 @@
 the cards page), the step as a CUDA graph, and the GPU host's CPU peers (Table 6's same-machine column).
 
 These are the check's own stages (pcabench/gpu/check.py runs them beside the profile, asv, the benchmarks, the
-GPU tests and Nsight Compute), kept in the paper's folder: :data:`PAPER_STAGES` is a tuple, not a registered
+GPU tests and Nsight Compute; the command line hands them to it with the paper's plan, :data:`FULL` or
+:data:`REHEARSAL`), kept in the paper's folder: :data:`PAPER_STAGES` is a tuple, not a registered
 stage each, so that another study's gpu.py failing to load never costs the paper's measurement.
 """
 
@@ -12,7 +13,9 @@ import sys
 
 from pcabench.gpu.agreement import agrees, compare_with_cpu
 from pcabench.gpu.graph_timing import graph_vs_plain
+from pcabench.gpu.plan import Plan
 from pcabench.gpu.stage import Check, Stage
+from pcabench.studies.paper.plan import CPU_DX, CPU_STEPS, GPU_DX, GPU_MODELS, GPU_STEPS
 from pcabench.studies.paper.plan import cpu_peers as cpu_peers_specs
 from pcabench.studies.paper.plan import gpu_sweep as gpu_sweep_specs
 from solvers import PRECISIONS, solver_class
@@ -88,4 +91,24 @@ PAPER_STAGES = (
     Stage("sweep", 60, gpu_sweep, order=30),
     Stage("graph", 40, graph, order=70),
     Stage("cpu", 40, cpu_peers, order=80),
+)
+
+# What the check runs on a card (sized on the H100 run) and in its rehearsal (numba's simulator, a few hundred
+# particles); the command line hands them and PAPER_STAGES to pcabench/gpu/check.py.
+FULL = Plan(GPU_DX, GPU_MODELS, GPU_STEPS[0], GPU_STEPS[1], CPU_DX, CPU_STEPS)
+REHEARSAL = Plan(
+    gpu_dx=(1.0, 0.5),
+    models=GPU_MODELS,
+    min_steps=2,
+    max_steps=2,
+    cpu_dx=(1.0,),
+    cpu_steps=2,
+    compare_dx=1.0,
+    compare_steps=3,
+    graph_dx=(1.0,),
+    graph_steps=2,
+    graph_rounds=1,
+    scene={"x_min": -8.0, "x_max": 8.0},
+    asv_bench="TimeGPUStep",
+    ncu_dx=1.0,
 )

@@ -6,10 +6,9 @@ from __future__ import annotations
 
 from pcabench.spec import ALL_CORES, SERIAL, RunSpec
 from pcabench.studies.preset import Preset, spec_of
-from solvers import DEFAULT_SOLVER, PRECISIONS, Scene
+from solvers import DEFAULT_SOLVER, GPU_SOLVER, PRECISIONS, Scene
 
 GPU_PRESET = "gpu"  # the GPU sweep's and its CPU peers' rows carry it
-GPU_SOLVER = "linkedlist-gpu"  # the solver the GPU runs measure (its CUDA graph path, its kernels under ncu)
 GPU_DX = (0.1, 0.05, 0.025, 0.01, 0.005, 0.004)  # 100K .. 62.5M particles on the paper's domain
 GPU_MODELS = ("lagrangian",)
 GPU_STEPS = (10, 100)  # (fewest, most) steps of a GPU run: gpu_steps

@@ -12,14 +12,13 @@ from pathlib import Path
 from pcabench.conformance import SCENES
 from pcabench.execute.run import run
 from pcabench.gpu.agreement import agrees, compare_cases
-from pcabench.gpu.plan import GPU_SOLVER
 from pcabench.gpu.stage import Check, Stage
 from pcabench.gpu.tables import scene_agreement
 from pcabench.reports.md import md_table
 from pcabench.spec import RunSpec
 from pcabench.store.record import STEP_STAGES
 from pcabench.studies.three_d.plan import HIGH_ORDER, STANDARD  # the study's methods: 80 and 894 neighbours
-from solvers import PRECISIONS, Scene
+from solvers import GPU_SOLVER, PRECISIONS, Scene
 
 TITLE = "Sound in three dimensions (the trimmed stencil's kernels)"
 
