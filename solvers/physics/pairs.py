@@ -78,16 +78,12 @@ def separation_rule(jit, mirror: bool, displaced: bool = True):
     return separation
 
 
-def range_sums(jit, gradient, mirror: bool, displaced: bool = True) -> tuple:
-    """The four pair sums over the particles j0..j1-1: of the particles themselves, or (``mirror``) of their
-    mirror images across a rigid wall, x_j' = 2 x_w - x_j with the normal velocity reversed (u_j' = -u_j) and
-    the same v, drho, mass and coefficients, each separation by :func:`separation_rule`. ``mirror`` and
-    ``displaced`` are compile-time constants: each variant has its own loop."""
-    separation = separation_rule(jit, mirror, displaced)
+def continuity_sum(jit, separation, gradient, mirror: bool):
+    """sum_j vol_j u_ij . r_ij G_ij over the particles j0..j1-1 (lyi already shifted), of their mirror images
+    (u_ij = u_i + u_j) where ``mirror``."""
 
     @jit
     def continuity_range(j0, j1, lxi, lyi, sxi, syi, ui, vi, lx, ly, sx, sy, u, v, vol, k):
-        """sum_j vol_j u_ij . r_ij G_ij over the particles j0..j1-1 (lyi already shifted)."""
         acc = k[ZERO]
         for j in range(j0, j1):
             rx, ry = separation(lxi, lyi, sxi, syi, j, lx, ly, sx, sy, k)
@@ -98,9 +94,14 @@ def range_sums(jit, gradient, mirror: bool, displaced: bool = True) -> tuple:
                 acc += vol[j] * g * (uij * rx + (vi - v[j]) * ry)
         return acc
 
+    return continuity_range
+
+
+def momentum_sum(jit, separation, gradient):
+    """sum_j m_j (pr_i + pr_j) G_ij r_ij over j0..j1-1, as (x, y) components."""
+
     @jit
     def momentum_range(j0, j1, lxi, lyi, sxi, syi, pri, lx, ly, sx, sy, mass, pr, k):
-        """sum_j m_j (pr_i + pr_j) G_ij r_ij over j0..j1-1, as (x, y) components."""
         ax = k[ZERO]
         ay = k[ZERO]
         for j in range(j0, j1):
@@ -112,9 +113,14 @@ def range_sums(jit, gradient, mirror: bool, displaced: bool = True) -> tuple:
                 ay += w * ry
         return ax, ay
 
+    return momentum_range
+
+
+def neighbour_count(jit, separation):
+    """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
+
     @jit
     def neighbours_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, k):
-        """Particles j0..j1-1 within the cutoff (the particle itself included if in range)."""
         count = 0
         for j in range(j0, j1):
             rx, ry = separation(lxi, lyi, sxi, syi, j, lx, ly, sx, sy, k)
@@ -122,10 +128,15 @@ def range_sums(jit, gradient, mirror: bool, displaced: bool = True) -> tuple:
                 count += 1
         return count
 
+    return neighbours_range
+
+
+def moment_sums(jit, separation, gradient):
+    """The kernel gradient correction's sums over j0..j1-1: the moment matrix
+    M = -sum_j vol_j G_ij r_ij (x) r_ij as (M_xx, M_xy, M_yy) and Gamma = sum_j vol_j G_ij r_ij as (x, y)."""
+
     @jit
     def moments_range(j0, j1, lxi, lyi, sxi, syi, lx, ly, sx, sy, vol, k):
-        """The kernel gradient correction's sums over j0..j1-1: the moment matrix
-        M = -sum_j vol_j G_ij r_ij (x) r_ij as (M_xx, M_xy, M_yy) and Gamma = sum_j vol_j G_ij r_ij as (x, y)."""
         mxx = k[ZERO]
         mxy = k[ZERO]
         myy = k[ZERO]
@@ -143,7 +154,21 @@ def range_sums(jit, gradient, mirror: bool, displaced: bool = True) -> tuple:
                 myy -= w * ry * ry
         return mxx, mxy, myy, gx, gy
 
-    return continuity_range, momentum_range, neighbours_range, moments_range
+    return moments_range
+
+
+def range_sums(jit, gradient, mirror: bool, displaced: bool = True) -> tuple:
+    """The four pair sums over the particles j0..j1-1, one factory each over one separation rule: of the particles
+    themselves, or (``mirror``) of their mirror images across a rigid wall, x_j' = 2 x_w - x_j with the normal
+    velocity reversed (u_j' = -u_j) and the same v, drho, mass and coefficients. ``mirror`` and ``displaced`` are
+    compile-time constants: each variant has its own loop."""
+    separation = separation_rule(jit, mirror, displaced)
+    return (
+        continuity_sum(jit, separation, gradient, mirror),
+        momentum_sum(jit, separation, gradient),
+        neighbour_count(jit, separation),
+        moment_sums(jit, separation, gradient),
+    )
 
 
 def cell_search(jit) -> dict:
