@@ -62,7 +62,7 @@ SCRIPT = textwrap.dedent("""
     for s in solvers.values():
         s.input(scene)
         s.init()
-        sweeps(scene.precision, scene.kernel, True, across(scene), scene.dims)["probe"] = probe
+        sweeps(scene.precision, scene.kernel, True, across(scene), scene.dims, s.displaced)["probe"] = probe
     seen = []
     for _ in range(3):
         for n, s in solvers.items():
