@@ -170,7 +170,7 @@ def scene_fronts(points, out: Path, pid: str):
         size=(6.0 * ncols + 2.5, 4.3 * nrows),
     ) as axes:
         for ax in axes[len(scenes) :]:
-            ax.set_visible(False)
+            ax.set_axis_off()  # a spare panel: no labels either (the figure's frame skips an axes that is off)
         for ax, scene in zip(axes, scenes):
             mine = [p for p in points if p["scene"] == scene and np.isclose(p["mach"], 0.05)]
             for model in ("linear", "lagrangian"):
