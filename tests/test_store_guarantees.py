@@ -600,3 +600,34 @@ def test_a_held_store_written_behind_the_sweeps_back_is_found(tmp_path):
         with pytest.warns(store.StoreWarning, match="changed behind the sweep's back"):
             lock.append(record(4), path)
     assert len(path.read_text().splitlines()) == 4
+
+
+def test_a_full_store_closes_as_a_segment_and_the_next_sweep_still_skips_its_runs(tmp_path, monkeypatch):
+    """Past SEGMENT_BYTES a sweep closes the store as ``<store>.001.jsonl`` (its lines unchanged) and appends to a
+    fresh file; the sweep and the study still count the segment's runs as stored, and a folder's readers read
+    every run of both; a store with a torn last line is not closed until a sweep has mended it."""
+    from pcabench import store as S
+    from pcabench.cli.study import own_run_ids
+    from pcabench.execute.sweep import run_here, sweep
+    from pcabench.spec import RunSpec
+    from solvers import Scene
+
+    path = tmp_path / "m--h.jsonl"
+    specs = [RunSpec("linkedlist-cpu", Scene(dx=dx, steps=2, model="linear")) for dx in (1.0, 0.8)]
+    first = sweep(specs[:1], path, 60.0, 300.0, runner=run_here)
+    before = path.read_bytes()
+    monkeypatch.setattr(S, "SEGMENT_BYTES", len(before))  # the store is now full
+    rows = sweep(specs, path, 60.0, 300.0, runner=run_here)
+    part = tmp_path / "m--h.001.jsonl"
+    assert part.read_bytes() == before and S.segments(path) == [part]
+    assert len(rows) == 1 and rows[0]["run_id"] != first[0]["run_id"]  # the first run skipped: it is stored
+    assert len(path.read_bytes().splitlines()) == 1  # only the new run in the fresh file
+    both = {first[0]["run_id"], rows[0]["run_id"]}
+    assert {r["run_id"] for r in S.read_rows(tmp_path)} == both and own_run_ids(path, specs) == both
+    path.write_bytes(path.read_bytes() + b'{"torn')
+    assert S.roll_over(path, limit=1) == [] and S.segments(path) == [part]
+    lines = path.read_bytes().splitlines(keepends=True)[:1] * 3  # three whole lines: one a segment, at a limit
+    path.write_bytes(b"".join(lines))  # of one line and a half
+    made = S.roll_over(path, limit=len(lines[0]) * 3 // 2)
+    assert [m.name for m in made] == ["m--h.002.jsonl", "m--h.003.jsonl", "m--h.004.jsonl"] and not path.exists()
+    assert all(m.read_bytes() == lines[0] for m in made)

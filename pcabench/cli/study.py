@@ -110,11 +110,11 @@ def own_run_ids(store_path: Path, specs: list[RunSpec]) -> set:
     (run now or found stored)."""
     from pcabench.machine.profiles import machine_id
     from pcabench.spec import row_identity
-    from pcabench.store import read_rows
+    from pcabench.store import read_rows, store_files
     from pcabench.store.provenance import code_key, host_id
 
     keys = {s.resolved().key(machine_id(), code_key(), host_id()) for s in specs}  # as the sweep keys its runs
-    rows = read_rows(store_path) if store_path.exists() else []
+    rows = read_rows(store_files(store_path))
     return {r["run_id"] for r in rows if row_identity(r) in keys}
 
 

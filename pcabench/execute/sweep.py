@@ -574,7 +574,7 @@ def sweep(
     store.check_writable(store_path)
     with store.SweepLock(store_path) as lock:
         store_path = Path(store_path)
-        rows = store.read_rows(store_path) if store_path.exists() else []
+        rows = store.read_rows(store.store_files(store_path))  # its segments too: their runs are stored
         executor = LocalExecutor(machine_id(), host_id(), git_commit(), runner, stream)
         return run_specs(
             specs, executor, StoreFile(store_path, lock), rows, run_budget, sweep_budget, stream, retry_failed

@@ -24,6 +24,9 @@ writer at a time.
   (:func:`validate`): a bad row is skipped with one warning naming the file,
   line and field; a row of a newer schema is kept in the file and skipped
   with one warning; nothing crashes on them.
+- A store past :data:`SEGMENT_BYTES` is closed, when a sweep on it starts, as segments
+  ``<store>.001.jsonl``, ... (:func:`roll_over`): its lines unchanged, in order; a sweep counts their runs
+  as stored (:func:`store_files`) and a folder's readers read them before the store.
 - Only regular files of the store folder are read, up to
   :data:`MAX_STORE_BYTES` each: a link, a FIFO or a device named ``*.jsonl``
   is skipped with one warning.
@@ -42,6 +45,7 @@ from __future__ import annotations
 import errno
 import fcntl
 import hashlib
+import itertools
 import json
 import math
 import os
@@ -61,6 +65,7 @@ from solvers import Scene, SceneError
 MIN_FREE_BYTES = 1 << 20  # a sweep needs room for its records: refuse to start with less free space
 RESERVE_BYTES = 1 << 18  # <store>.reserve: room for the record that meets a full disk
 MAX_STORE_BYTES = 1 << 30  # a store file larger than this is not read (a link to /dev/zero, a stray dump)
+SEGMENT_BYTES = 4 << 20  # a store past this is closed as segments when a sweep starts (files a review can read)
 NAME = schema.NAME  # a machine or host name, safe as a file name
 
 
@@ -129,6 +134,59 @@ def store_name(profile_id: str, host: str | None = None) -> str:
     from pcabench.store.provenance import host_id
 
     return f"{check_name(profile_id, 'profile_id')}--{check_name(host or host_id(), 'host')}.jsonl"
+
+
+def _segment(path: Path, k: int) -> Path:
+    """The ``k``-th segment's name: ``<store>.001.jsonl`` (numbered so that a folder's name order is the order
+    they were closed in)."""
+    return path.with_name(f"{path.name[: -len('.jsonl')]}.{k:03d}.jsonl")
+
+
+def segments(path) -> list[Path]:
+    """The closed segments of the store at ``path``, oldest first (:func:`roll_over` made them); a folder's
+    readers read them, before the store itself, as the stores they are."""
+    path = Path(path)
+    found = []
+    for k in itertools.count(1):
+        if not _segment(path, k).exists():
+            return found
+        found.append(_segment(path, k))
+
+
+def store_files(path) -> list[Path]:
+    """The files of the store at ``path`` that exist, in the order they were written: its segments, then itself."""
+    path = Path(path)
+    return segments(path) + ([path] if path.exists() else [])
+
+
+def roll_over(path, limit: int | None = None) -> list[Path]:
+    """Close the store at ``path`` as segments when it holds ``limit`` bytes (:data:`SEGMENT_BYTES`) or more and
+    ends with a whole line (a sweep does so under its lock, before it appends): its lines, in order and
+    unchanged, in files of under ``limit`` bytes each (a longer line alone in one), each written whole, then
+    the store removed; the next record begins a fresh file. Interrupted between, a row read twice is one run.
+    The segments made ([] when none)."""
+    from pcabench.store.safeio import write_file
+
+    path, limit = Path(path), SEGMENT_BYTES if limit is None else limit
+    try:
+        if not path.is_file() or path.is_symlink() or path.stat().st_size < limit:
+            return []
+        data = path.read_bytes()
+    except OSError:
+        return []
+    if not data.endswith(b"\n"):
+        return []  # a torn last line: the sweep's hold mends it first, the next sweep closes the store
+    chunks, chunk = [], b""
+    for line in data.splitlines(keepends=True):
+        if chunk and len(chunk) + len(line) >= limit:
+            chunks.append(chunk)
+            chunk = b""
+        chunk += line
+    chunks.append(chunk)
+    first = len(segments(path)) + 1
+    made = [write_file(_segment(path, first + i), c) for i, c in enumerate(chunks)]
+    path.unlink()
+    return made
 
 
 def _open(path, flags: int, mode: int = 0o644) -> int:
@@ -378,6 +436,7 @@ class SweepLock:
                     self.folder / self.FOLDER_LOCK, fcntl.LOCK_SH, f"results folder {self.folder} (a cluster sweep)"
                 )
                 fd = self._lock(Path(f"{self.store}.lock"), fcntl.LOCK_EX, f"results store {self.store}")
+                roll_over(self.store)  # locked, not yet held: a full store becomes segments, the sweep a fresh file
             os.ftruncate(fd, 0)
             os.pwrite(fd, f"pid {os.getpid()}".encode(), 0)
             if self.store is not None:
