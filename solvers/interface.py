@@ -243,7 +243,11 @@ class Solver(abc.ABC):
             bool(np.any(self.to_host(self.arrays[name]))) for name in ("sx", "sy", "sz") if name in self.arrays
         )
         if self.neighbour_search is not None:
-            self.nnps = self.neighbour_search(self.scene, self.launch, self.xp)
+            self.nnps = self.search_for_scene()
+
+    def search_for_scene(self):
+        """The neighbour search (``neighbour_search``) built for the scene, once the particles are placed."""
+        return self.neighbour_search(self.scene, self.launch, self.xp)
 
     @abc.abstractmethod
     def snp(self) -> None:

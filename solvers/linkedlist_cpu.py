@@ -121,6 +121,11 @@ class LinkedListCPU(CellListSolver):
                 "GiB available; use --pair-loop gather (or auto)"
             )
 
+    def search_for_scene(self):
+        """The cell list; where no particle leaves its site (``displaced`` False), on the sites' grid that the
+        loops are then compiled for in 3D (solvers/search/sites.py, solvers.physics.pairs3d.site_rule)."""
+        return self.neighbour_search(self.scene, self.launch, self.xp, on_sites=not self.displaced)
+
     def probe(self) -> "LinkedListCPU":
         return type(self)(threads=self.threads, pair_loop=self.pair_loop)
 

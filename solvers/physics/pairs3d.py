@@ -12,7 +12,8 @@ cell list's stencil is the rows along x at the y and z offsets the grid's reach 
 (solvers.interface.stencil_reach), each trimmed to the cells the cutoff's sphere reaches (:func:`stencil_rule`)
 and one contiguous range of particles sorted by cell, shifted across the y and z seams by whole periods
 (``k[NY]``, ``k[NZ]``), with the periodic images across the x seam (``k[NX]``) as a second range per row, as in
-2D. :func:`make_pairs3d` assembles them into a module object that
+2D; particles that stay on their sites have one cell a site and one table of rows (:func:`site_rule`).
+:func:`make_pairs3d` assembles them into a module object that
 numba resolves inside the sweeps (solvers/loops/cells3d.py, allpair3d.py).
 """
 
@@ -185,6 +186,21 @@ def corrected_passes(jit):
     return corrected_velocity_at, corrected_continuity_at, corrected_momentum_at
 
 
+def seam_rule(jit):
+    """``shifted(c, n, li, period)``: (cell index, i's coordinate) for a stencil offset that may cross a seam of
+    ``period`` lattice rows (0: a free edge: the cell index -1 means no cell)."""
+
+    @jit
+    def shifted(c, n, li, period):
+        if c < 0:
+            return (c + n, li + period) if period > 0 else (-1, li)
+        if c >= n:
+            return (c - n, li - period) if period > 0 else (-1, li)
+        return c, li
+
+    return shifted
+
+
 def stencil_rule(jit, across: bool):
     """The 3D stencil as a loop: ``over_stencil(range_sum)`` gives the function that adds ``range_sum`` over every
     particle within the cutoff of particle i (and some beyond, which the sums' own test drops). The grid
@@ -198,15 +214,7 @@ def stencil_rule(jit, across: bool):
     trim is widened by ``TRIM_SLACK`` of the cutoff, so that a particle a rounding within it is never trimmed
     away."""
 
-    @jit
-    def shifted(c, n, li, period):
-        """(cell index, i's coordinate) for a stencil offset that may cross a seam of ``period`` lattice rows (0:
-        a free edge: the cell index -1 means no cell)."""
-        if c < 0:
-            return (c + n, li + period) if period > 0 else (-1, li)
-        if c >= n:
-            return (c - n, li - period) if period > 0 else (-1, li)
-        return c, li
+    shifted = seam_rule(jit)
 
     @jit
     def gap(p, d, size):
@@ -269,6 +277,48 @@ def stencil_rule(jit, across: bool):
     return over_stencil
 
 
+def site_rule(jit, across: bool):
+    """The 3D stencil of particles on their lattice sites (``displaced`` False): ``over_sites(range_sum)`` gives
+    the function that adds ``range_sum`` over the sites within the cutoff of particle i's. The grid
+    (solvers.search.sites.SiteGrid3D) has one cell a site, so every particle's stencil is the same table of
+    ``rows`` (dy, dz, m: solvers.search.sites.site_rows): row (dy, dz) is cells cx - m..cx + m of the line dy, dz
+    away, one contiguous range of particles, i shifted across the y and z seams and the part beyond the x seam a
+    second range, as in :func:`stencil_rule`, whose chord and trim this needs neither."""
+    shifted = seam_rule(jit)
+
+    def over_sites(range_sum):
+        @jit
+        def site_sum(i, cell, begin, ncx, ncy, ncz, rows, lx, ly, lz, sx, sy, sz, k, acc, fields):
+            c = cell[i]
+            cx = c % ncx
+            cy0 = c // ncx % ncy
+            cz0 = c // (ncx * ncy)
+            for r in range(rows.shape[0]):
+                cz, lzi = shifted(cz0 + rows[r, 1], ncz, lz[i], k[NZ])
+                cy, lyi = shifted(cy0 + rows[r, 0], ncy, ly[i], k[NY])
+                if cz < 0 or cy < 0:
+                    continue
+                x0, x1 = cx - rows[r, 2], cx + rows[r, 2]
+                row = (cz * ncy + cy) * ncx
+                if across and k[NX] > 0:
+                    if x0 < 0:  # the row's left end lies beyond the seam: the row's last cells, i a period right
+                        a0, a1 = begin[row + ncx + x0], begin[row + ncx]
+                        acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                    elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
+                        a0, a1 = begin[row], begin[row + x1 - ncx + 1]
+                        acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                x0 = max(x0, 0)
+                x1 = min(x1, ncx - 1)
+                if x1 >= x0:
+                    a0, a1 = begin[row + x0], begin[row + x1 + 1]
+                    acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+            return acc
+
+        return site_sum
+
+    return over_sites
+
+
 def minimum_image_rule(jit):
     """The all-pair search as a loop: ``over_all(range_sum)`` adds ``range_sum`` over every particle j, i shifted
     to the nearest image of j along each periodic axis (exact)."""
@@ -300,7 +350,8 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True,
     """The 3D pair functions compiled with ``jit`` for ``kernel`` (normalised in 3D) in ``precision``: each sum
     over a range, over the stencil (``*_cells``) and over every particle (``*_allpair``), and the cell index of a
     position. ``across``: whether x has a periodic seam; ``displaced``: whether particles can leave their lattice
-    sites (:func:`separation_rule`; both compile-time)."""
+    sites (:func:`separation_rule`; False: the stencil of :func:`site_rule` over the sites' grid, else
+    :func:`stencil_rule`'s; both compile-time)."""
     gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg), dims=3))
     separation = separation_rule(jit, displaced)
     continuity_range = continuity_sum(jit, separation, gradient)
@@ -309,7 +360,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True,
     neighbours_range = neighbour_count(jit, separation)
     moments_range = moment_sums(jit, separation, gradient)
     corrected_velocity_at, corrected_continuity_at, corrected_momentum_at = corrected_passes(jit)
-    over_stencil = stencil_rule(jit, across)
+    over_stencil = stencil_rule(jit, across) if displaced else site_rule(jit, across)
     over_all = minimum_image_rule(jit)
     continuity_stencil, continuity_all = over_stencil(continuity_range), over_all(continuity_range)
     continuity_split_stencil = over_stencil(continuity_split_range)

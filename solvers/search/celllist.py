@@ -3,7 +3,8 @@
 Cells are one cutoff wide in x and at least one cutoff tall in y (a whole
 number of rows fills the lattice's height; :class:`CellGrid`); in 3D an eighth
 of a cutoff wide in x and a cutoff or half a cutoff in y and z, each stencil
-row trimmed to the cutoff's sphere (:class:`CellGrid3D`). SNP finds each
+row trimmed to the cutoff's sphere (:class:`CellGrid3D`), or, for particles
+that stay on their sites, one cell a site (solvers/search/sites.py). SNP finds each
 particle's cell (particleIndex), orders particles by cell
 (cellParticleOrder) and marks where each cell starts (cellBegin, with the
 end sentinel): that is the search's job (:class:`CellList`). The solver then
@@ -28,6 +29,7 @@ import numpy as np
 
 from solvers.interface import POSITIONS, Solver, cell_grid, cell_grid_3d, tiny_scene
 from solvers.physics.backend import cpu_sorting
+from solvers.search.sites import SiteGrid3D
 
 
 @dataclass(frozen=True)
@@ -110,12 +112,17 @@ class CellList:
 
     :meth:`bin` finds the cells and their order for the current positions; the solver puts its arrays in
     that order, then :meth:`settle` puts the cells in it too. A variant overrides :meth:`cell_ids` or
-    :meth:`cell_order` alone.
+    :meth:`cell_order` alone. ``on_sites``: no particle leaves its lattice site for the run (the solver's loops
+    are compiled for that): a 3D scene's grid is then the sites' (solvers/search/sites.py).
     """
 
-    def __init__(self, scene, launch, xp=np):
+    def __init__(self, scene, launch, xp=np, on_sites: bool = False):
         self.scene, self.launch, self.xp = scene, launch, xp
-        self.grid = CellGrid3D.of(scene) if scene.dims == 3 else CellGrid.of(scene)
+        self.on_sites = on_sites and scene.dims == 3  # the sites' grid (solvers/search/sites.py): 3D only
+        if self.on_sites:
+            self.grid = SiteGrid3D.of(scene)
+        else:
+            self.grid = CellGrid3D.of(scene) if scene.dims == 3 else CellGrid.of(scene)
         self.positions = POSITIONS[scene.dims]  # the arrays it bins: lattice coordinates, then displacements
         self.ncells = self.grid.ncells
         self.stencil = tuple(
@@ -172,7 +179,7 @@ class CellList:
     def count(self, arrays, k) -> int:
         """Neighbours within the cutoff summed over particles at the positions in ``arrays``, on a search of
         its own over copies of the positions: ``arrays`` and this search are left as they are."""
-        fresh = type(self)(self.scene, self.launch, self.xp)
+        fresh = type(self)(self.scene, self.launch, self.xp, self.on_sites)
         copies = [arrays[name].copy() for name in self.positions]  # the kernel may wrap them
         order = fresh.bin(*copies)
         fresh.settle()
