@@ -96,29 +96,56 @@ def method_of(r) -> tuple[str, float, float, str, str]:
 FREE_END_SCENE = "plane-pulse"  # where the free end's limits are measured (the high-order study's long runs)
 
 
-def free_ended(name: str, edges: str) -> bool:
-    """Whether a closed run of scene ``name`` (no ``edges`` opened) has a free edge: a lattice edge with no wall,
-    seam or layer beyond it, where a particle has half its neighbours (solvers.scenes.base.SceneKind.boundaries)."""
+def free_ended(name: str, edges: str, wall: str = "") -> bool:
+    """Whether a run of scene ``name`` has a free end: closed (no ``edges`` opened) with a lattice edge with no
+    wall, seam or layer beyond it, where a particle has half its neighbours (solvers.scenes.base.SceneKind.boundaries),
+    or a body whose wall (``wall``: its boundary method) leaves the fluid beside it part of its neighbours as such an
+    edge does (``BoundaryMethod.free_end``: the weak wall and its cut cells; the sphere's long runs blow up where the
+    free end's do, docs/accuracy.md "The sphere's stable step")."""
     from solvers import scene_kind
+    from solvers.boundaries.bodies import boundary_method_named
 
     try:
         kind = scene_kind(name)
     except (KeyError, ValueError):  # a scene whose plug-in is not installed: no claim about its edges
         return False
+    if kind.body and wall:
+        try:
+            if boundary_method_named(wall).free_end:
+                return True
+        except (KeyError, ValueError):  # a wall whose plug-in is not installed: no claim about it
+            pass
     closed = not edges and not kind.defaults.get("open")
     return closed and bool({"free-x", "free-y"} & kind.boundaries())
 
 
+def body_wall(r, name: str) -> str:
+    """The boundary method of the wall of ``r``'s body: the one it names or ran, else the default for its
+    correction (solvers.body.BodyOptions); "" for a scene without a body (or one whose plug-in is not installed)."""
+    from solvers import scene_kind
+    from solvers.body import BodyOptions
+
+    try:
+        if not scene_kind(name).body:
+            return ""
+    except (KeyError, ValueError):
+        return ""
+    named = _value(r, "boundary_method") or _value(r, "boundary_method_used")
+    return str(named) if named else BodyOptions().boundary_method_used(method_of(r)[4])
+
+
 def measured_limit(r) -> float | None:
     """The smallest CFL at which long runs of ``r``'s scene, model and method blew up (:func:`measured_limits`),
-    or None (a run without a scene is of the paper's). A closed scene with a free edge and no row of its own
-    takes the free end's limit measured on :data:`FREE_END_SCENE` (the same edge: half the neighbours)."""
+    or None (a run without a scene is of the paper's). A scene with a free end (:func:`free_ended`: a closed
+    scene's free edge, or a body's wall without ghosts) and no row of its own takes the free end's limit measured
+    on :data:`FREE_END_SCENE`."""
     from solvers import DEFAULT_SCENE
     from solvers.kernels import truncated
 
     kernel, h, cut, integrator, correction = method_of(r)
     name, model_r = str(_value(r, "scene", DEFAULT_SCENE)), _value(r, "model", "")
-    names = [name] + ([FREE_END_SCENE] if free_ended(name, str(_value(r, "open", "") or "")) else [])
+    edges = str(_value(r, "open", "") or "")
+    names = [name] + ([FREE_END_SCENE] if free_ended(name, edges, body_wall(r, name)) else [])
     for want in names:
         for (scene, model, k, hh, cc, integ, corr), (limit, _bounded) in measured_limits().items():
             if (
@@ -143,7 +170,8 @@ def stable_cfl(r) -> float:
     from solvers.method import Method
 
     if isinstance(r, Scene):
-        r = {"scene": r.name, "model": r.model, "open": r.open, **Method.of(r).scene_fields()}
+        wall = r.boundary_method_used if r.body is not None else ""
+        r = {"scene": r.name, "model": r.model, "open": r.open, "boundary_method": wall, **Method.of(r).scene_fields()}
     linear, measured = _limits(*method_of(r))[0], measured_limit(r)
     return linear if measured is None else min(linear, measured)
 

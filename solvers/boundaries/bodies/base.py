@@ -41,6 +41,9 @@ class BoundaryMethod:
     summary: str = ""
     dims: tuple = (2,)  # the dimensions of the bodies it models (the ghost bodies place particles in a plane)
     needs_correction: bool = False  # whether it makes a wall only with a kernel correction (solvers/corrections/)
+    # Whether the fluid at its wall has part of its neighbourhood empty, as at a free edge: a run's stable step is
+    # then the free end's (pcabench/predict/stability.py, measured_limits.csv)
+    free_end: bool = False
     # Where its wall is known to blow up with a kernel correction: what was measured, one clause ("" where it holds)
     fails_with_correction: str = ""
 

@@ -28,6 +28,7 @@ class Weak(BoundaryMethod):
     )
     dims = (2, 3)
     needs_correction = True
+    free_end = True  # no ghosts: beside the wall a particle's neighbours inside the body are missing
 
     def place(self, scene, x, y) -> tuple:
         _r, inside = sites_inside(scene, x, y)
