@@ -42,8 +42,8 @@ def sweeps(
     """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool, with or
     without the pairs across an x seam or wall (``across``; solvers/loops/cells.py, compiled once per
     machine), with or without the displacements in the separations (``displaced``), and the per-particle
-    updates; in 3D the trimmed stencil's loops and their updates
-    (solvers/loops/cells3d.py)."""
+    updates; in 3D the trimmed stencil's loops (``displaced``) or the sites' (solvers/search/sites.py) and their
+    updates (solvers/loops/cells3d.py)."""
     if dims == 3:
         loops = cpu_loops("cells3d", precision, kernel, parallel, across, displaced)
         return {

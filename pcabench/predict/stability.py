@@ -111,7 +111,7 @@ def free_ended(name: str, edges: str, wall: str = "") -> bool:
         return False
     if kind.body and wall:
         try:
-            if boundary_method_named(wall).free_end:
+            if getattr(boundary_method_named(wall), "free_end", False):
                 return True
         except (KeyError, ValueError):  # a wall whose plug-in is not installed: no claim about it
             pass

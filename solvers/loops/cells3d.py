@@ -1,6 +1,7 @@
 """The linked-list CPU solver's interaction loops in 3D over the trimmed stencil
-(solvers.physics.pairs3d.stencil_rule), serial or on numba's thread pool, and its per-particle updates. A template
-of solvers.jitcache, specialised by solvers.linkedlist_cpu.sweeps."""
+(solvers.physics.pairs3d.stencil_rule; ``box`` its grid's box) or, for particles that stay on their sites, the
+sites' table (site_rule; ``box`` is then the table of rows), serial or on numba's thread pool, and its per-particle
+updates. A template of solvers.jitcache, specialised by solvers.linkedlist_cpu.sweeps."""
 
 from numba import prange
 

@@ -179,7 +179,7 @@ class CellList:
     def count(self, arrays, k) -> int:
         """Neighbours within the cutoff summed over particles at the positions in ``arrays``, on a search of
         its own over copies of the positions: ``arrays`` and this search are left as they are."""
-        fresh = type(self)(self.scene, self.launch, self.xp, self.on_sites)
+        fresh = type(self)(self.scene, self.launch, self.xp, on_sites=self.on_sites)
         copies = [arrays[name].copy() for name in self.positions]  # the kernel may wrap them
         order = fresh.bin(*copies)
         fresh.settle()

@@ -6,7 +6,7 @@ the same: the lines of sites the cutoff's sphere reaches, each trimmed to the si
 (:func:`site_rows`) is computed once per scene; a row's set-up in the loop (solvers.physics.pairs3d.site_rule)
 is then two cellBegin reads instead of a chord and two divisions, and a candidate is a neighbour (the trimmed
 grid of :func:`solvers.interface.cell_grid_3d` looks at about three candidates a neighbour). Measured
-(``python -m benchmarks.bench_three_d``): docs/performance.md "A pair in 3D".
+(``python -m benchmarks.bench_three_d``): docs/performance.md "One cell a site".
 """
 
 from __future__ import annotations
