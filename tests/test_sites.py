@@ -13,8 +13,8 @@ import pytest
 from solvers import Scene
 from solvers.physics.integrators import advance_steps, evolve
 from solvers.registry import make_solver
-from solvers.search.celllist import CellGrid3D
-from solvers.search.sites import TRIM_SLACK, SiteGrid3D, site_rows
+from solvers.search.celllist import CellGrid3D, SiteGrid3D
+from solvers.search.sites import TRIM_SLACK, site_rows
 
 CUBE = dict(x_min=-4.0, x_max=4.0, y_min=-4.0, y_max=4.0, z_min=-4.0, z_max=4.0, pulse_width=1.5, pulse_center=1.0)
 CUBE.update(kernel="wendland-c2", h_factor=1.3, cfl=0.5, t_end=1.5, model="linear")
@@ -70,7 +70,7 @@ def test_the_sphere_on_the_sites_grid_is_the_trimmed_grids_run():
         if forced:
             solver.displaced = True  # the general loops and their search: the trimmed grid
             solver.nnps = solver.search_for_scene()
-        assert isinstance(solver.nnps.grid, CellGrid3D if forced else SiteGrid3D)
+        assert type(solver.nnps.grid) is (CellGrid3D if forced else SiteGrid3D)
         advance_steps(solver, scene.integrator, scene.n_steps)
         runs.append(solver)
     got, ref = fields_of(runs[0]), fields_of(runs[1])
@@ -83,4 +83,4 @@ def test_moving_particles_keep_the_trimmed_grid():
     solver = make_solver("linkedlist-cpu")
     solver.input(Scene(0.5, "acoustic-pulse-3d", **{**CUBE, "model": "lagrangian"}))
     solver.init()
-    assert solver.displaced and isinstance(solver.nnps.grid, CellGrid3D)
+    assert solver.displaced and type(solver.nnps.grid) is CellGrid3D

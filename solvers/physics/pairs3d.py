@@ -201,6 +201,33 @@ def seam_rule(jit):
     return shifted
 
 
+def row_rule(jit, across: bool):
+    """``over_row(range_sum)``: the function that adds ``range_sum`` over cells x0..x1 of the stencil row starting
+    at cell ``row`` (i's y and z already shifted: ``lyi``, ``lzi``), the part beyond the x seam as a second range
+    with i shifted a period (``across`` False: x has no seam, a compile-time constant); both stencils' rows."""
+
+    def over_row(range_sum):
+        @jit
+        def row_sum(row, x0, x1, ncx, begin, i, lyi, lzi, lx, ly, lz, sx, sy, sz, k, acc, fields):
+            if across and k[NX] > 0:
+                if x0 < 0:  # the row's left end lies beyond the seam: the row's last cells, i a period right
+                    a0, a1 = begin[row + ncx + x0], begin[row + ncx]
+                    acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
+                    a0, a1 = begin[row], begin[row + x1 - ncx + 1]
+                    acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+            x0 = max(x0, 0)
+            x1 = min(x1, ncx - 1)
+            if x1 >= x0:
+                a0, a1 = begin[row + x0], begin[row + x1 + 1]
+                acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+            return acc
+
+        return row_sum
+
+    return over_row
+
+
 def stencil_rule(jit, across: bool):
     """The 3D stencil as a loop: ``over_stencil(range_sum)`` gives the function that adds ``range_sum`` over every
     particle within the cutoff of particle i (and some beyond, which the sums' own test drops). The grid
@@ -226,6 +253,8 @@ def stencil_rule(jit, across: bool):
         return 0.0
 
     def over_stencil(range_sum):
+        row_sum = row_rule(jit, across)(range_sum)
+
         @jit
         def stencil_sum(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, acc, fields):
             c = cell[i]
@@ -258,18 +287,7 @@ def stencil_rule(jit, across: bool):
                     x0 = max(cx + int(math.floor((px - chord) / box[2])), cx - rx)
                     x1 = min(cx + int(math.floor((px + chord) / box[2])), cx + rx)
                     row = (cz * ncy + cy) * ncx
-                    if across and k[NX] > 0:
-                        if x0 < 0:  # the chord's left end lies beyond the seam: the row's last cells, i a period right
-                            a0, a1 = begin[row + ncx + x0], begin[row + ncx]
-                            acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
-                        elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
-                            a0, a1 = begin[row], begin[row + x1 - ncx + 1]
-                            acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
-                    x0 = max(x0, 0)
-                    x1 = min(x1, ncx - 1)
-                    if x1 >= x0:
-                        a0, a1 = begin[row + x0], begin[row + x1 + 1]
-                        acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                    acc = row_sum(row, x0, x1, ncx, begin, i, lyi, lzi, lx, ly, lz, sx, sy, sz, k, acc, fields)
             return acc
 
         return stencil_sum
@@ -280,13 +298,15 @@ def stencil_rule(jit, across: bool):
 def site_rule(jit, across: bool):
     """The 3D stencil of particles on their lattice sites (``displaced`` False): ``over_sites(range_sum)`` gives
     the function that adds ``range_sum`` over the sites within the cutoff of particle i's. The grid
-    (solvers.search.sites.SiteGrid3D) has one cell a site, so every particle's stencil is the same table of
+    (solvers.search.celllist.SiteGrid3D) has one cell a site, so every particle's stencil is the same table of
     ``rows`` (dy, dz, m: solvers.search.sites.site_rows): row (dy, dz) is cells cx - m..cx + m of the line dy, dz
     away, one contiguous range of particles, i shifted across the y and z seams and the part beyond the x seam a
     second range, as in :func:`stencil_rule`, whose chord and trim this needs neither."""
     shifted = seam_rule(jit)
 
     def over_sites(range_sum):
+        row_sum = row_rule(jit, across)(range_sum)
+
         @jit
         def site_sum(i, cell, begin, ncx, ncy, ncz, rows, lx, ly, lz, sx, sy, sz, k, acc, fields):
             c = cell[i]
@@ -300,18 +320,7 @@ def site_rule(jit, across: bool):
                     continue
                 x0, x1 = cx - rows[r, 2], cx + rows[r, 2]
                 row = (cz * ncy + cy) * ncx
-                if across and k[NX] > 0:
-                    if x0 < 0:  # the row's left end lies beyond the seam: the row's last cells, i a period right
-                        a0, a1 = begin[row + ncx + x0], begin[row + ncx]
-                        acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
-                    elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
-                        a0, a1 = begin[row], begin[row + x1 - ncx + 1]
-                        acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
-                x0 = max(x0, 0)
-                x1 = min(x1, ncx - 1)
-                if x1 >= x0:
-                    a0, a1 = begin[row + x0], begin[row + x1 + 1]
-                    acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                acc = row_sum(row, x0, x1, ncx, begin, i, lyi, lzi, lx, ly, lz, sx, sy, sz, k, acc, fields)
             return acc
 
         return site_sum

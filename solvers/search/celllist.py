@@ -22,6 +22,7 @@ the all-pair reference.
 from __future__ import annotations
 
 import abc
+import math
 import time
 from dataclasses import dataclass
 
@@ -29,7 +30,7 @@ import numpy as np
 
 from solvers.interface import POSITIONS, Solver, cell_grid, cell_grid_3d, tiny_scene
 from solvers.physics.backend import cpu_sorting
-from solvers.search.sites import SiteGrid3D
+from solvers.search.sites import site_rows
 
 
 @dataclass(frozen=True)
@@ -104,6 +105,35 @@ class CellGrid3D:
         g = self
         box = np.array([dx, g.x_grid, g.cw, g.ch, g.cd, g.reach_x, g.reach_y, g.reach_z], np.float64)
         return self.ncx, self.ncy, self.ncz, box
+
+
+@dataclass(frozen=True)
+class SiteGrid3D(CellGrid3D):
+    """:class:`solvers.search.celllist.CellGrid3D` with cells of one lattice spacing, site (lx, ly, lz) in cell
+    (lx + spare, ly, lz) (along a free x a cutoff's whole cells spare each side, ``x_grid`` = -spare dx), and the
+    cutoff (m) its table of rows is made for (:meth:`stencil_arguments`)."""
+
+    cutoff: float
+
+    @classmethod
+    def of(cls, scene) -> SiteGrid3D:
+        reach = int(math.ceil(scene.cutoff / scene.dx))
+        spare = 0 if scene.periodic_x else reach
+        periods = (
+            span if periodic else 0.0
+            for span, periodic in (
+                (scene.width, scene.periodic_x),
+                (scene.height, scene.periodic_y),
+                (scene.depth, scene.periodic_z),
+            )
+        )
+        d = scene.dx
+        counts = (scene.nx + 2 * spare, scene.ny, scene.nz)
+        return cls(d, d, d, *counts, -spare * d, *periods, reach, reach, reach, scene.cutoff)
+
+    def stencil_arguments(self, dx: float) -> tuple:
+        """What the site loops take after cellBegin: the cell counts and the table of rows (:func:`site_rows`)."""
+        return self.ncx, self.ncy, self.ncz, site_rows(self.cutoff, dx)
 
 
 class CellList:
