@@ -201,33 +201,6 @@ def seam_rule(jit):
     return shifted
 
 
-def row_rule(jit, across: bool):
-    """``over_row(range_sum)``: the function that adds ``range_sum`` over cells x0..x1 of the stencil row starting
-    at cell ``row`` (i's y and z already shifted: ``lyi``, ``lzi``), the part beyond the x seam as a second range
-    with i shifted a period (``across`` False: x has no seam, a compile-time constant); both stencils' rows."""
-
-    def over_row(range_sum):
-        @jit
-        def row_sum(row, x0, x1, ncx, begin, i, lyi, lzi, lx, ly, lz, sx, sy, sz, k, acc, fields):
-            if across and k[NX] > 0:
-                if x0 < 0:  # the row's left end lies beyond the seam: the row's last cells, i a period right
-                    a0, a1 = begin[row + ncx + x0], begin[row + ncx]
-                    acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
-                elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
-                    a0, a1 = begin[row], begin[row + x1 - ncx + 1]
-                    acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
-            x0 = max(x0, 0)
-            x1 = min(x1, ncx - 1)
-            if x1 >= x0:
-                a0, a1 = begin[row + x0], begin[row + x1 + 1]
-                acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
-            return acc
-
-        return row_sum
-
-    return over_row
-
-
 def stencil_rule(jit, across: bool):
     """The 3D stencil as a loop: ``over_stencil(range_sum)`` gives the function that adds ``range_sum`` over every
     particle within the cutoff of particle i (and some beyond, which the sums' own test drops). The grid
@@ -253,8 +226,6 @@ def stencil_rule(jit, across: bool):
         return 0.0
 
     def over_stencil(range_sum):
-        row_sum = row_rule(jit, across)(range_sum)
-
         @jit
         def stencil_sum(i, cell, begin, ncx, ncy, ncz, box, lx, ly, lz, sx, sy, sz, k, acc, fields):
             c = cell[i]
@@ -287,7 +258,18 @@ def stencil_rule(jit, across: bool):
                     x0 = max(cx + int(math.floor((px - chord) / box[2])), cx - rx)
                     x1 = min(cx + int(math.floor((px + chord) / box[2])), cx + rx)
                     row = (cz * ncy + cy) * ncx
-                    acc = row_sum(row, x0, x1, ncx, begin, i, lyi, lzi, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                    if across and k[NX] > 0:
+                        if x0 < 0:  # the chord's left end lies beyond the seam: the row's last cells, i a period right
+                            a0, a1 = begin[row + ncx + x0], begin[row + ncx]
+                            acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                        elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
+                            a0, a1 = begin[row], begin[row + x1 - ncx + 1]
+                            acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                    x0 = max(x0, 0)
+                    x1 = min(x1, ncx - 1)
+                    if x1 >= x0:
+                        a0, a1 = begin[row + x0], begin[row + x1 + 1]
+                        acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
             return acc
 
         return stencil_sum
@@ -305,8 +287,6 @@ def site_rule(jit, across: bool):
     shifted = seam_rule(jit)
 
     def over_sites(range_sum):
-        row_sum = row_rule(jit, across)(range_sum)
-
         @jit
         def site_sum(i, cell, begin, ncx, ncy, ncz, rows, lx, ly, lz, sx, sy, sz, k, acc, fields):
             c = cell[i]
@@ -320,7 +300,18 @@ def site_rule(jit, across: bool):
                     continue
                 x0, x1 = cx - rows[r, 2], cx + rows[r, 2]
                 row = (cz * ncy + cy) * ncx
-                acc = row_sum(row, x0, x1, ncx, begin, i, lyi, lzi, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                if across and k[NX] > 0:
+                    if x0 < 0:  # the row's left end lies beyond the seam: the row's last cells, i a period right
+                        a0, a1 = begin[row + ncx + x0], begin[row + ncx]
+                        acc = range_sum(a0, a1, lx[i] + k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                    elif x1 > ncx - 1:  # its right end: the row's first cells, i a period left
+                        a0, a1 = begin[row], begin[row + x1 - ncx + 1]
+                        acc = range_sum(a0, a1, lx[i] - k[NX], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
+                x0 = max(x0, 0)
+                x1 = min(x1, ncx - 1)
+                if x1 >= x0:
+                    a0, a1 = begin[row + x0], begin[row + x1 + 1]
+                    acc = range_sum(a0, a1, lx[i], lyi, lzi, i, lx, ly, lz, sx, sy, sz, k, acc, fields)
             return acc
 
         return site_sum
