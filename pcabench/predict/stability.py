@@ -66,19 +66,40 @@ def _value(r, key, default=None):
 
 @lru_cache(maxsize=1024)
 def _limits(
-    kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str = "none"
+    kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str = "none", dims: int = 2
 ) -> tuple[float, float]:
-    """(stable CFL, largest c0 |D| dt per unit CFL) of one method (:class:`solvers.method.Method`). Both are the
-    same at every dx (the lattice's offsets are in units of dx, and dx |D| depends on h/dx only), so dx = 1
-    stands for all."""
+    """(stable CFL, largest c0 |D| dt per unit CFL) of one method (:class:`solvers.method.Method`) on the periodic
+    square (``dims`` 2) or cubic (3) lattice. Both are the same at every dx (the lattice's offsets are in units of
+    dx, and dx |D| depends on h/dx only), so dx = 1 stands for all."""
     from solvers.kernels import truncated
     from solvers.method import Method
-    from solvers.reference.dispersion import largest_symbol, unit_scene
+    from solvers.reference.dispersion import largest_stable_z, largest_symbol, unit_scene
     from solvers.reference.dispersion import predicted_stable_cfl as lattice_limit
 
+    if dims == 3:
+        from solvers.reference.dispersion3d import largest_unit_symbol
+
+        z_per_cfl = largest_unit_symbol(kernel, h_factor, cutoff_factor, integrator, correction)
+        return largest_stable_z(integrator) / z_per_cfl, z_per_cfl
     method = Method(kernel, h_factor, cutoff_factor if truncated(kernel) else None, 1.0, integrator, correction)
     scene = unit_scene(**method.scene_fields())
     return lattice_limit(method), scene.dx * largest_symbol(scene)
+
+
+def dims_of(r) -> int:
+    """The dimension of ``r``'s scene (its kind's; 2 for a run without a scene, the paper's, or a scene whose
+    plug-in is not installed here)."""
+    from solvers import DEFAULT_SCENE, scene_kind
+
+    try:
+        return int(scene_kind(str(_value(r, "scene", DEFAULT_SCENE))).dims)
+    except (KeyError, ValueError):
+        return 2
+
+
+def lattice_limits(r) -> tuple[float, float]:
+    """:func:`_limits` of ``r``'s method on its scene's lattice (square or cubic)."""
+    return _limits(*method_of(r), dims_of(r))
 
 
 def method_of(r) -> tuple[str, float, float, str, str]:
@@ -172,7 +193,7 @@ def stable_cfl(r) -> float:
     if isinstance(r, Scene):
         wall = r.boundary_method_used if r.body is not None else ""
         r = {"scene": r.name, "model": r.model, "open": r.open, "boundary_method": wall, **Method.of(r).scene_fields()}
-    linear, measured = _limits(*method_of(r))[0], measured_limit(r)
+    linear, measured = lattice_limits(r)[0], measured_limit(r)
     return linear if measured is None else min(linear, measured)
 
 
@@ -197,7 +218,7 @@ def e_foldings(r, steps: int) -> float:
     step matrix's spectral radius, largest over the modes up to the lattice's largest |D|, times the steps."""
     from solvers.reference.dispersion import amplification_radius
 
-    _, z_per_cfl = _limits(*method_of(r))
+    _, z_per_cfl = lattice_limits(r)
     z = np.linspace(0.0, float(r["cfl"]) * z_per_cfl, 200)[1:]
     radius = float(amplification_radius(method_of(r)[3], z).max())
     return max(0.0, math.log(radius)) * int(steps)
@@ -209,7 +230,7 @@ def assess(r) -> dict:
     ``limit_from``
     ("prediction", or "long runs" where the limit long runs of its scene measured is the lower) and
     ``predicted`` (the periodic lattice's predicted limit)."""
-    limit, cfl, predicted = stable_cfl(r), float(r["cfl"]), _limits(*method_of(r))[0]
+    limit, cfl, predicted = stable_cfl(r), float(r["cfl"]), lattice_limits(r)[0]
     fraction = cfl / limit if limit > 0 else math.inf
     return {
         "stable_cfl": limit,

@@ -71,18 +71,31 @@ def largest_symbol(scene, points: int = 33) -> float:
 
 
 @lru_cache(maxsize=256)
-def lattice_stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str) -> float:
-    """The largest stable CFL of a method on the periodic cubic lattice (the same at every dx: D scales as 1/dx)."""
+def unit_cube(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str):
+    """The 3D pulse's periodic cube at dx = 1 m with a method's fields, wide enough for its stencil: what depends on
+    h/dx only (dx |D|, the stable CFL) is computed on it."""
     from solvers.scene import Scene
 
     reach = h_factor * max(cutoff_factor, 2.0)
     half = math.ceil(1.5 * reach) + 1.0
     cube = {f"{axis}_{end}": sign * half for axis in "xyz" for end, sign in (("min", -1), ("max", 1))}
-    unit = Scene(
+    return Scene(
         1.0, "acoustic-pulse-3d", pulse_width=0.1, model="linear", kernel=kernel, h_factor=h_factor,
         cutoff_factor=cutoff_factor, integrator=integrator, correction=correction, **cube,
     )  # fmt: skip
-    return largest_stable_z(integrator) / (unit.dx * largest_symbol(unit))
+
+
+@lru_cache(maxsize=256)
+def largest_unit_symbol(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str) -> float:
+    """dx max |D| of a method on the cubic lattice (:func:`largest_symbol` on :func:`unit_cube`; the same at every
+    dx): c0 |D| dt per unit CFL."""
+    unit = unit_cube(kernel, h_factor, cutoff_factor, integrator, correction)
+    return unit.dx * largest_symbol(unit)
+
+
+def lattice_stable_cfl(kernel: str, h_factor: float, cutoff_factor: float, integrator: str, correction: str) -> float:
+    """The largest stable CFL of a method on the periodic cubic lattice (the same at every dx: D scales as 1/dx)."""
+    return largest_stable_z(integrator) / largest_unit_symbol(kernel, h_factor, cutoff_factor, integrator, correction)
 
 
 def predicted_stable_cfl(scene) -> float:

@@ -61,6 +61,11 @@ class Sphere(SceneKind):
     def body_of(self, scene) -> tuple:
         return 0.0, 0.0, float(scene.sphere_radius)
 
+    def sized_domain(self, size: float) -> dict:
+        """A cube of side ``size`` m centred on the sphere (``--domain-size``; the layer beyond its faces)."""
+        half = 0.5 * size
+        return {"x_min": -half, "x_max": half, "y_min": -half, "y_max": half, "z_min": -half, "z_max": half}
+
     def headline(self, t_end: float) -> str:
         start, end = self.window
         if t_end < start:
