@@ -106,6 +106,18 @@ def test_the_measured_limits_are_the_reference_stores_long_runs():
             else:
                 assert key not in data, (key, r)  # no limit below the prediction where the runs found none
     assert checked == len(data) > 0  # every row checked against its runs, and there are rows
+    # the 3D long runs (pcabench study --three-d long): no row of their own (the cube's limits are the cubic
+    # lattice's; the sphere's wall takes the free end's, found no higher than where the sphere blew up), and the
+    # step the suite takes for each is below the smallest CFL that blew up
+    from pcabench.predict.stability import stable_cfl
+
+    three_d = [r for r in long_run_limits(df, "three-d-long") if r["blew_up_from"] is not None]
+    assert {r["scene"] for r in three_d} == {"acoustic-pulse-3d", "sphere"} and len(three_d) >= 6
+    for r in three_d:
+        key = (r["scene"], r["model"], r["kernel"], r["h_factor"], r["integrator"], r["correction"])
+        assert key not in data and stable_cfl(r) < r["blew_up_from"], (key, stable_cfl(r), r)
+        if r["scene"] == "acoustic-pulse-3d":
+            assert r["blew_up_from"] >= r["predicted"] and (r["bounded_to"] or 0) < r["predicted"], r
 
 
 def test_the_paper_method_is_named_in_words_from_scenes_defaults():

@@ -14,6 +14,7 @@ from pcabench.reports.md import fmt, md_table
 from pcabench.reports.section import Section
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import latest
+from pcabench.studies.three_d.long_runs import SECTION as LONG_RUNS  # the study's second section
 from pcabench.studies.three_d.plan import COST_STEPS, T_END, THREE_D, THREE_D_FINE
 from solvers.method import Method
 from solvers.reference.sphere import scene_drho
@@ -342,3 +343,5 @@ SECTION = Section(
     order=159,
     reads=(THREE_D, THREE_D_FINE),
 )
+
+__all__ = ["SECTION", "LONG_RUNS"]  # the registry finds both here
