@@ -42,8 +42,8 @@ def sweeps(
     """The interaction loops for ``precision`` and ``kernel``, serial or on numba's thread pool, with or
     without the pairs across an x seam or wall (``across``; solvers/loops/cells.py, compiled once per
     machine), with or without the displacements in the separations (``displaced``), and the per-particle
-    updates; in 3D the trimmed stencil's loops (``displaced``) or the sites' (solvers/search/sites.py) and their
-    updates (solvers/loops/cells3d.py)."""
+    updates; in 3D the loops over the sites' grid (solvers/search/sites.py) and their updates
+    (solvers/loops/cells3d.py)."""
     if dims == 3:
         loops = cpu_loops("cells3d", precision, kernel, parallel, across, displaced)
         return {
@@ -122,9 +122,9 @@ class LinkedListCPU(CellListSolver):
             )
 
     def search_for_scene(self):
-        """The cell list; where no particle leaves its site (``displaced`` False), on the sites' grid that the
-        loops are then compiled for in 3D (solvers/search/sites.py, solvers.physics.pairs3d.site_rule)."""
-        return self.neighbour_search(self.scene, self.launch, self.xp, on_sites=not self.displaced)
+        """The cell list; in 3D on the sites' grid that the loops are compiled for (solvers/search/sites.py,
+        solvers.physics.pairs3d.site_rule)."""
+        return self.neighbour_search(self.scene, self.launch, self.xp, on_sites=True)
 
     def probe(self) -> "LinkedListCPU":
         return type(self)(threads=self.threads, pair_loop=self.pair_loop)

@@ -1,7 +1,7 @@
 """Particles that never leave their lattice sites: the separations without the displacements
-(solvers/physics/pairs.py and pairs3d.py, ``separation_rule``) give the same bits as with them in 2D, and in 3D,
-where such particles are searched on the sites' grid (solvers/search/sites.py), the same fields to rounding; a
-run takes that variant only where every displacement is zero."""
+(solvers/physics/pairs.py and pairs3d.py, ``separation_rule``) give the same bits as with them, in 2D and in 3D
+(where every particle is searched on the sites' grid, solvers/search/sites.py); a run takes that variant only
+where every displacement is zero."""
 
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ def fields(solver: str, options: dict, scene: Scene, displaced: bool | None):
     decided = run.displaced
     if displaced is not None:
         run.displaced = displaced  # the general rule forced on particles that stay on their sites
-        run.nnps = run.search_for_scene()  # and its search (3D: the trimmed grid instead of the sites')
+        run.nnps = run.search_for_scene()  # and its search
     advance_steps(run, scene.integrator, scene.steps)
     f = run.output()
     return decided, {c: getattr(f, c) for c in ("x", "y", "z", "u", "v", "w", "drho") if getattr(f, c) is not None}
@@ -54,11 +54,8 @@ def test_fixed_particles_give_the_same_bits_without_their_displacements(case):
     assert decided is False  # the linear model on the lattice: every displacement zero
     _, general = fields(solver, options, scene, True)
     assert np.abs(fixed["drho"]).max() > 1e-6  # the pulse is there
-    for c, values in fixed.items():
-        if scene.dims == 2:
-            assert np.array_equal(values, general[c]), c
-        else:  # the sites' stencil (solvers/search/sites.py) sums the same pairs in another order
-            assert np.abs(values - general[c]).max() <= 1e-13 * np.abs(general[c]).max(), c
+    for c, values in fixed.items():  # 3D: both on the sites' grid (solvers/search/sites.py), in the same order
+        assert np.array_equal(values, general[c]), c
 
 
 def test_moving_particles_and_a_bodys_shifted_sites_keep_the_displacements():

@@ -64,7 +64,7 @@ def test_the_open_closed_form_and_the_periodic_fft_agree_while_the_images_are_fa
 
 
 def test_every_cpu_solver_gives_the_all_pair_solvers_3d_fields():
-    """The trimmed stencil (serial and threaded) against every pair tested with the nearest image: the same sums,
+    """The sites' stencil (serial and threaded) against every pair tested with the nearest image: the same sums,
     to round-off, with the pulse crossing the periodic faces; the neighbour count is the sphere's."""
     scene = small()
     fields = {}
@@ -81,10 +81,11 @@ def test_every_cpu_solver_gives_the_all_pair_solvers_3d_fields():
 
 
 @pytest.mark.parametrize("edges", ["periodic", "open"])
-def test_the_trimmed_stencil_finds_every_pair_of_scattered_particles(edges):
-    """Cells half a cutoff wide and each stencil row trimmed to the cutoff's sphere: with every particle moved
-    up to 0.45 dx off its site (into other cells, across the periodic seams and past the free faces), the cell
-    list counts every pair the all-pair search counts, and its rates are the all-pair rates."""
+def test_the_sites_stencil_finds_every_pair_of_scattered_particles(edges):
+    """One cell a site, the table of rows widened by twice the largest displacement: with every particle moved
+    up to 0.45 dx off its site along each axis (into other cells, across the periodic seams and past the free
+    faces), the cell list counts every pair the all-pair search counts, and its rates are the all-pair rates;
+    the table of particles on their sites misses pairs of these."""
     scene = small(dx=0.5, open="xyz") if edges == "open" else small()
     solvers = [make_solver(name) for name in ("allpair-cpu", "linkedlist-cpu")]
     counts, rates = [], []
@@ -104,6 +105,10 @@ def test_the_trimmed_stencil_finds_every_pair_of_scattered_particles(edges):
         rates.append(np.array([a[name][order] for name in ("dd", "ax", "ay", "az")]))
     assert counts[0] > 40 * scene.n_particles and counts[1] == counts[0]
     assert np.abs(rates[1] - rates[0]).max() < 1e-10 * np.abs(rates[0]).max()
+    cells = solvers[1]
+    assert cells.nnps.allowance > 0.45 * scene.dx
+    cells.nnps.stencil = cells.nnps.stencil_for(0.0)  # the table of particles on their sites, for these
+    assert int(cells.launch("neighbours", *cells.nnps.arguments(cells.arrays), cells.k)) < counts[0]
 
 
 def test_the_3d_pulse_converges_to_its_exact_solution():

@@ -39,14 +39,15 @@ def cpu_pairs(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True,
 
 @lru_cache(maxsize=None)
 def cpu_pairs3d(precision: str, kernel: str = DEFAULT_KERNEL, across: bool = True, displaced: bool = True):
-    """The 3D pair functions (solvers/physics/pairs3d.py) for numba's CPU target, as :func:`cpu_pairs`."""
+    """The 3D pair functions (solvers/physics/pairs3d.py) for numba's CPU target, as :func:`cpu_pairs`; the cell
+    list's stencil the sites' (solvers/search/sites.py)."""
     import numba
 
     from solvers.kernels.constants import make_exp_neg_table
     from solvers.physics.pairs3d import make_pairs3d
 
     exp_neg = make_exp_neg_table(precision)
-    return make_pairs3d(numba.njit(inline="always"), exp_neg, kernel, precision, across, displaced)
+    return make_pairs3d(numba.njit(inline="always"), exp_neg, kernel, precision, across, displaced, sites=True)
 
 
 def pair_sources(kernel: str = DEFAULT_KERNEL, dims: int = 2) -> tuple:

@@ -278,8 +278,9 @@ def stencil_rule(jit, across: bool):
 
 
 def site_rule(jit, across: bool):
-    """The 3D stencil of particles on their lattice sites (``displaced`` False): ``over_sites(range_sum)`` gives
-    the function that adds ``range_sum`` over the sites within the cutoff of particle i's. The grid
+    """The 3D stencil over the sites' grid: ``over_sites(range_sum)`` gives the function that adds ``range_sum``
+    over the cells within the table's reach of particle i's (the cutoff, widened by twice the largest
+    displacement where particles move: solvers.search.celllist.CellList.widen). The grid
     (solvers.search.celllist.SiteGrid3D) has one cell a site, so every particle's stencil is the same table of
     ``rows`` (dy, dz, m: solvers.search.sites.site_rows): row (dy, dz) is cells cx - m..cx + m of the line dy, dz
     away, one contiguous range of particles, i shifted across the y and z seams and the part beyond the x seam a
@@ -346,12 +347,14 @@ def minimum_image_rule(jit):
     return over_all
 
 
-def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True, displaced: bool = True) -> ModuleType:
+def make_pairs3d(
+    jit, exp_neg, kernel: str, precision: str, across: bool = True, displaced: bool = True, sites: bool = False
+) -> ModuleType:
     """The 3D pair functions compiled with ``jit`` for ``kernel`` (normalised in 3D) in ``precision``: each sum
     over a range, over the stencil (``*_cells``) and over every particle (``*_allpair``), and the cell index of a
     position. ``across``: whether x has a periodic seam; ``displaced``: whether particles can leave their lattice
-    sites (:func:`separation_rule`; False: the stencil of :func:`site_rule` over the sites' grid, else
-    :func:`stencil_rule`'s; both compile-time)."""
+    sites (:func:`separation_rule`); ``sites``: the stencil of :func:`site_rule` over the sites' grid (the CPU's),
+    else :func:`stencil_rule`'s over the trimmed grid (the GPU's); all three compile-time."""
     gradient = jit(kernel_named(kernel).compiled_gradient(precision, jit(exp_neg), dims=3))
     separation = separation_rule(jit, displaced)
     continuity_range = continuity_sum(jit, separation, gradient)
@@ -360,7 +363,7 @@ def make_pairs3d(jit, exp_neg, kernel: str, precision: str, across: bool = True,
     neighbours_range = neighbour_count(jit, separation)
     moments_range = moment_sums(jit, separation, gradient)
     corrected_velocity_at, corrected_continuity_at, corrected_momentum_at = corrected_passes(jit)
-    over_stencil = stencil_rule(jit, across) if displaced else site_rule(jit, across)
+    over_stencil = site_rule(jit, across) if sites else stencil_rule(jit, across)
     over_all = minimum_image_rule(jit)
     continuity_stencil, continuity_all = over_stencil(continuity_range), over_all(continuity_range)
     continuity_split_stencil = over_stencil(continuity_split_range)

@@ -1,10 +1,10 @@
 """The paper's uniform cell list as an object a solver holds (PySPH's NNPS), and the solvers built on it.
 
 Cells are one cutoff wide in x and at least one cutoff tall in y (a whole
-number of rows fills the lattice's height; :class:`CellGrid`); in 3D an eighth
+number of rows fills the lattice's height; :class:`CellGrid`); in 3D one cell
+a site (:class:`SiteGrid3D`, solvers/search/sites.py: the CPU's), or an eighth
 of a cutoff wide in x and a cutoff or half a cutoff in y and z, each stencil
-row trimmed to the cutoff's sphere (:class:`CellGrid3D`), or, for particles
-that stay on their sites, one cell a site (solvers/search/sites.py). SNP finds each
+row trimmed to the cutoff's sphere (:class:`CellGrid3D`: the GPU's). SNP finds each
 particle's cell (particleIndex), orders particles by cell
 (cellParticleOrder) and marks where each cell starts (cellBegin, with the
 end sentinel): that is the search's job (:class:`CellList`). The solver then
@@ -131,9 +131,11 @@ class SiteGrid3D(CellGrid3D):
         counts = (scene.nx + 2 * spare, scene.ny, scene.nz)
         return cls(d, d, d, *counts, -spare * d, *periods, reach, reach, reach, scene.cutoff)
 
-    def stencil_arguments(self, dx: float) -> tuple:
-        """What the site loops take after cellBegin: the cell counts and the table of rows (:func:`site_rows`)."""
-        return self.ncx, self.ncy, self.ncz, site_rows(self.cutoff, dx)
+    def stencil_arguments(self, dx: float, allowance: float = 0.0) -> tuple:
+        """What the site loops take after cellBegin: the cell counts and the table of rows (:func:`site_rows`) for
+        particles at most ``allowance`` (m) from their cells' centres: every pair within the cutoff is then within
+        the cutoff and twice the allowance of its cells' centres."""
+        return self.ncx, self.ncy, self.ncz, site_rows(self.cutoff + 2.0 * allowance, dx)
 
 
 class CellList:
@@ -142,8 +144,8 @@ class CellList:
 
     :meth:`bin` finds the cells and their order for the current positions; the solver puts its arrays in
     that order, then :meth:`settle` puts the cells in it too. A variant overrides :meth:`cell_ids` or
-    :meth:`cell_order` alone. ``on_sites``: no particle leaves its lattice site for the run (the solver's loops
-    are compiled for that): a 3D scene's grid is then the sites' (solvers/search/sites.py).
+    :meth:`cell_order` alone. ``on_sites``: a 3D scene's grid is the sites' (solvers/search/sites.py; the solver's
+    loops are compiled for it), its table widened as the particles move (:meth:`widen`).
     """
 
     def __init__(self, scene, launch, xp=np, on_sites: bool = False):
@@ -155,11 +157,29 @@ class CellList:
             self.grid = CellGrid3D.of(scene) if scene.dims == 3 else CellGrid.of(scene)
         self.positions = POSITIONS[scene.dims]  # the arrays it bins: lattice coordinates, then displacements
         self.ncells = self.grid.ncells
-        self.stencil = tuple(
-            xp.asarray(a) if isinstance(a, np.ndarray) else a for a in self.grid.stencil_arguments(scene.dx)
-        )
+        self.allowance = 0.0  # m: the sites' table holds pairs whose particles are this far from their sites
+        self.stencil = self.stencil_for(0.0)
         self.valid = False  # whether the cells are those of the current positions
         self.allocate()
+
+    def stencil_for(self, allowance: float) -> tuple:
+        """The grid's stencil arguments as the loops take them (the sites' table for ``allowance``, m)."""
+        dx = self.scene.dx
+        args = self.grid.stencil_arguments(dx, allowance) if self.on_sites else self.grid.stencil_arguments(dx)
+        return tuple(self.xp.asarray(a) if isinstance(a, np.ndarray) else a for a in args)
+
+    def widen(self, shifts) -> None:
+        """The sites' table for particles displaced by ``shifts`` (sx, sy, sz, m) from their sites. A particle is
+        no further from its cell's centre than from its site (the site is its own cell's centre; in another
+        cell, each axis's distance to that cell's centre is at most half a cell, less than it moved along that
+        axis), so with the table widened by twice the largest displacement no pair within the cutoff is missed.
+        Made again at every search where the largest displacement changed (a table is a few hundred rows at
+        most); none while no particle moves."""
+        xp = self.xp
+        largest = math.sqrt(float(xp.max(sum(s * s for s in shifts)))) if len(shifts[0]) else 0.0
+        if largest != self.allowance:
+            self.allowance = largest
+            self.stencil = self.stencil_for(largest)
 
     def allocate(self) -> None:
         n = self.scene.n_particles
@@ -173,6 +193,8 @@ class CellList:
     def bin(self, *positions):
         """particleIndex, cellParticleOrder and cellBegin for particles at lattice sites ``lx, ly`` (and ``lz``)
         shifted by ``sx, sy`` (and ``sz``, m); returns cellParticleOrder, the order to put the particle arrays in."""
+        if self.on_sites:
+            self.widen(positions[3:])
         self.cell_ids(*positions)
         order, begin = self.cell_order()
         if begin is not self.begin:

@@ -1,12 +1,13 @@
-"""The stencil of 3D particles that stay on their lattice sites: one cell a site, one table of rows.
+"""The stencil of 3D particles on the CPU: one cell a site, one table of rows.
 
-When no particle ever leaves its site (the linear model: :attr:`solvers.interface.Solver.displaced` False),
-cells one lattice spacing along every axis, each site in the middle of its own, make every particle's stencil
+Cells one lattice spacing along every axis, each site in the middle of its own, make every particle's stencil
 the same: the lines of sites the cutoff's sphere reaches, each trimmed to the sites within it. The table
-(:func:`site_rows`, for the grid :class:`solvers.search.celllist.SiteGrid3D`) is computed once per scene; a
-row's set-up in the loop (solvers.physics.pairs3d.site_rule)
+(:func:`site_rows`, for the grid :class:`solvers.search.celllist.SiteGrid3D`) is computed once per scene where no
+particle leaves its site (the linear model: :attr:`solvers.interface.Solver.displaced` False), and at each search
+for twice the largest displacement more where particles move (:meth:`solvers.search.celllist.CellList.widen`);
+a row's set-up in the loop (solvers.physics.pairs3d.site_rule)
 is then two cellBegin reads instead of a chord and two divisions, and a candidate is a neighbour (the trimmed
-grid of :func:`solvers.interface.cell_grid_3d` looks at about three candidates a neighbour). Measured
+grid of :func:`solvers.interface.cell_grid_3d`, the GPU's, looks at about three candidates a neighbour). Measured
 (``python -m benchmarks.bench_three_d``): docs/performance.md "One cell a site".
 """
 
