@@ -20,7 +20,8 @@ and its machine code again, bit for bit. Files are created once (written aside, 
 two processes filling the cache at once agree, and a process killed mid-write leaves no partial file.
 
 Where: ``$PCABENCH_CACHE``, else ``$XDG_CACHE_HOME/pcabench``, else ``~/.cache/pcabench`` (:func:`cache_root`);
-``pcabench cache`` shows and clears it. Faults end in a correct run with one :class:`JitCacheWarning`: an
+``pcabench cache`` shows and clears it (``$NUMBA_CACHE_DIR`` does not move these loops: it is numba's for other
+functions). Faults end in a correct run with one :class:`JitCacheWarning`: an
 unwritable or full cache folder (the loops are compiled in memory), a corrupt cache file (dropped and
 rebuilt), a cache cleared under a running process (that process keeps its loops; later ones rebuild).
 Nothing another user could have written is loaded (numba's index files are pickles, which run code): a
@@ -297,15 +298,22 @@ def _module_name(name: str) -> str:
 def _load(path: Path, name: str, functions: dict) -> ModuleType:
     """Import the generated file as a module of its own (registered in sys.modules: numba rebuilds a cached
     function's environment from its module's name), its compiled functions guarded against cache faults."""
+    from numba.core import config as numba_config
+
     modname = _module_name(name)
     spec = importlib.util.spec_from_file_location(modname, path)
     module = importlib.util.module_from_spec(spec)
     sys.modules[modname] = module
+    # numba picks a function's cache folder when it is decorated: $NUMBA_CACHE_DIR would take these loops out of
+    # this folder and so out of this module's checks (a corrupt file rebuilt, a folder others can write refused)
+    held, numba_config.CACHE_DIR = numba_config.CACHE_DIR, ""
     try:
         spec.loader.exec_module(module)
     except Exception:
         sys.modules.pop(modname, None)
         raise
+    finally:
+        numba_config.CACHE_DIR = held
     for fn in functions:
         _guard(getattr(module, fn))
     return module

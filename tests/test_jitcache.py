@@ -105,6 +105,17 @@ def test_a_second_process_loads_every_loop_and_gets_the_same_numbers(tmp_path):
     assert not warm["warnings"]
 
 
+def test_numba_cache_dir_does_not_take_the_loops_out_of_the_cache(tmp_path):
+    """With $NUMBA_CACHE_DIR set, numba would keep the loops in that folder, outside jitcache's checks: they are
+    kept in jitcache's folder all the same, and loaded from there by the next process."""
+    elsewhere = tmp_path / "numba"
+    elsewhere.mkdir()
+    cold = probe(tmp_path / "cache", NUMBA_CACHE_DIR=str(elsewhere))
+    assert cold["compiled"] > 0 and code_files(tmp_path / "cache") and not any(elsewhere.rglob("*.nb[ic]"))
+    warm = probe(tmp_path / "cache", NUMBA_CACHE_DIR=str(elsewhere))
+    assert warm["compiled"] == 0 and warm["loaded"] == cold["compiled"] and warm["digest"] == cold["digest"]
+
+
 def test_an_edit_to_a_plugin_kernel_recompiles_and_undoing_it_restores_the_machine_code(tmp_path):
     plugin = tmp_path / "plugin_kernel.py"
     cache = tmp_path / "cache"
