@@ -596,3 +596,30 @@ def test_a_plug_in_kind_that_states_its_stable_cfl_by_the_earlier_name_is_still_
     scene = small()
     assert Legacy().predicted_stable_cfl(scene) == 0.123
     assert predicted_stable_cfl(scene) == AcousticPulse3D().predicted_stable_cfl(scene) > 1.0
+
+
+def test_the_3d_long_runs_section_brackets_each_limit_from_the_reference_store(tmp_path):
+    """`pcabench study --three-d long`'s runs in the reference store: on the periodic cube each method held below
+    the cubic lattice's predicted stable CFL and blew up past it, a step between the cube's and the square's
+    limits among them (standard SPH's 2.28 and 2.35), which the section says; the sphere's wall blew up below the
+    cube's prediction, and the limit the suite uses for it lies below where it blew up."""
+    from pcabench import paths
+    from pcabench.reports import frame
+    from pcabench.reports.section import Context
+    from pcabench.studies.three_d import long_runs
+    from pcabench.studies.three_d.plan import THREE_D_LONG
+
+    df = frame.load(paths.reference_results())
+    df = df[df.preset == THREE_D_LONG]
+    rows = long_runs.rows(df)
+    cube = [r for r in rows if r["scene"] == "acoustic-pulse-3d"]
+    sphere = [r for r in rows if r["scene"] == "sphere"]
+    assert len(cube) >= 4 and sphere
+    for r in cube:
+        assert r["bounded_to"] < r["predicted"] <= r["blew_up_from"], r
+    between = [r for r in cube if r["blew_up_from"] < r["square"]]
+    assert between and all(r["kernel"] == "wendland-c2" for r in between)
+    for r in sphere:
+        assert r["blew_up_from"] < r["predicted"] and r["held"] is not None and r["held"] < r["blew_up_from"], r
+    text = "\n".join(long_runs.text(rows, Context(df, df, "m", tmp_path)))
+    assert "short of the square's" in text and text.count("| sphere |") == len(sphere)

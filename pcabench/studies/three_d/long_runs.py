@@ -90,13 +90,13 @@ def text(rows, ctx) -> list[str]:
                 f"lattice's {r['predicted']:.3g}, from CFL {blew:g}"
                 + (f" (bounded at {bounded:g})" if bounded is not None else "")
                 + ": its wall or edges set the limit"
-                + (f"; advise takes {r['held']:g}." if r["held"] is not None else "; no row yet.")
+                + (f"; the suite steps below {r['held']:g}." if r["held"] is not None else "; no row yet.")
             )
         elif blew < r["square"] and (bounded is None or bounded < r["predicted"]):
             lines.append(
                 f"- **{r['scene']}, {r['model']}, {r['kernel']} {r['integrator']}**: CFL {blew:g} blew up, past "
                 f"the cubic lattice's {r['predicted']:.3g} and short of the square's {r['square']:.3g}: a 3D run "
-                "steps by the cube's limit (its diagonal modes), not a 2D run's."
+                "steps by the cube's limit, not a 2D run's."
             )
     return lines + [""]
 

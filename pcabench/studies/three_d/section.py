@@ -45,6 +45,7 @@ def rows(df) -> dict | None:
             "seconds": float(r.t_solution) if ok else None,
             "steps": int(r.steps),
             "pi": float(r.t_pi) if ok else None,
+            "threads": int(r.threads),
         }
         if scene.steps == COST_STEPS and scene.t_end is None:
             cost.append(row)
@@ -257,6 +258,53 @@ def error_figure(data, ctx):
     return path
 
 
+def work_precision_figure(data, ctx):
+    """Work-precision (SciML's diagram): the error against the time to solution (init and steps; threads named), per
+    method across dx; the 3D pulse on the left, the sphere (its probes, per wall) on the right: each its own
+    measure, so each its own panel."""
+    if not data:
+        return None
+
+    def point(r):
+        return r["seconds"], r["error"], f"{r['dx']:g}" + (f", {r['threads']} threads" if r["threads"] > 1 else "")
+
+    pulse = {k: [point(r) for r in rs if r["error"] and r["seconds"]] for k, rs in methods(data["accuracy"]).items()}
+    sphere: dict = {}
+    for r in data.get("sphere") or []:
+        if r["error"] and r["seconds"]:
+            sphere.setdefault((r["label"], r["wall"], r["faces"]), []).append(point(r))
+    panels = [(f"the 3D pulse, t = {T_END:g} s: relative RMS of drho", pulse),
+              ("the sphere, t = 4 s: relative RMS of p at the probes", sphere)]  # fmt: skip
+    panels = [(title, {k: sorted(v) for k, v in lines.items() if v}) for title, lines in panels]
+    panels = [(title, lines) for title, lines in panels if lines]
+    if not panels:
+        return None
+    path = ctx.out / "three_d_work_precision.png"
+    with F.figure(
+        path,
+        f"Work-precision in 3D ({ctx.name}): error against the time to solution, each method across dx (labels: dx, m; "
+        "serial where not said)",
+        "time to solution (s: init and steps)",
+        "relative RMS error",
+        ncols=len(panels),
+        logx=True,
+        logy=True,
+        size=(7.0 * len(panels), 6.0),
+        legend="below",
+    ) as axes:
+        for ax, (title, lines) in zip(axes, panels):
+            colours = dict(zip(lines, F.palette(len(lines))))
+            for key, pts in lines.items():
+                label = key[0] + (f", CFL {key[1]:g}" if len(key) == 2 else f", {key[1]} wall, {key[2]}")
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-", color=colours[key], ms=5, label=label)
+                for t, e, where in pts:
+                    ax.annotate(where, (t, e), textcoords="offset points", xytext=(4, 4), fontsize=7)
+            ax.set_title(title, fontsize=9)
+            F.nice_log_ticks(ax, [p[1] for pts in lines.values() for p in pts])
+            F.nice_log_ticks(ax, [p[0] for pts in lines.values() for p in pts], axis="x")
+    return path
+
+
 def slice_figure(data, ctx):
     """The 3D pulse's drho on the plane z = 0 at the run's end: the finest run with a stored plane (the most
     accurate method's), the exact solution there, and their difference (its own scale)."""
@@ -338,7 +386,7 @@ SECTION = Section(
     "three-d",
     lambda ctx: rows(ctx.runs),
     text,
-    (error_figure, slice_figure, sphere_figure),
+    (error_figure, work_precision_figure, slice_figure, sphere_figure),
     all_scenes=True,
     order=159,
     reads=(THREE_D, THREE_D_FINE),
