@@ -107,3 +107,22 @@ def test_the_spheres_wall_lowers_its_stable_step_to_the_measured_one():
     held = run_spec(RunSpec("linkedlist-cpu", scene.replace(cfl=margin("linear") * limit)))
     blown = run_spec(RunSpec("linkedlist-cpu", scene.replace(cfl=0.93 * lattice, steps=12)))
     assert held.status == "ok" and blown.status == "unstable" and 0 < blown.failed_step < 12, (held, blown)
+
+
+@pytest.mark.parametrize(
+    "size, words",
+    [
+        ("-3", "--domain-size must be > 0 m (got -3)"),
+        ("1", "--pulse-center must be inside the domain"),
+        ("3.2", "--pulse-center: the pulse must be inside the cube, 1.5 pulse widths from its faces"),
+    ],
+)
+def test_the_spheres_cube_from_domain_size_is_checked_in_one_line(size, words, capsys):
+    from .conftest import cli_main
+
+    method = "--kernel laguerre-gauss --cutoff 4 --h-factor 1.5 --correction gradient".split()
+    rc, _out, err = cli_main(
+        "run", "--solver", "linkedlist-cpu", "--scene", "sphere", "--dx", "0.125", "--steps", "1", "--domain-size",
+        size, *method, capsys=capsys,
+    )  # fmt: skip
+    assert rc == 2 and words in err and len(err.strip().splitlines()) == 1, err

@@ -202,6 +202,8 @@ def domain_of(args) -> dict:
     """The domain ``--domain-size`` asks for (nothing when not given), for the scene named."""
     if getattr(args, "domain_size", None) is None:
         return {}
+    if not args.domain_size > 0:
+        raise OptionError(f"--domain-size must be > 0 m (got {args.domain_size:g})")
     try:
         return scene_kind(args.scene or DEFAULT_SCENE).sized_domain(args.domain_size)
     except ValueError as exc:

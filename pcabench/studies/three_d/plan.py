@@ -141,7 +141,7 @@ THREE_D_LONG_PRESET = Preset(
     flag="three-d",
     choice="long",
     help="where methods fail in 3D: long runs either side of each method's stable CFL on the periodic cube (the "
-    "cubic lattice's limits) and at the sphere's wall ({size}; about 15 min here, serial)",
+    "cubic lattice's limits) and at the sphere's wall ({size}; about 20 min here, serial)",
     order=59.7,
     scored=False,  # runs long to measure a stable step, not an error
 )
