@@ -73,7 +73,7 @@ def test_the_sphere_on_the_sites_grid_gives_the_all_pair_fields(model):
         assert np.abs(got[c] - values).max() < 1e-12 * np.abs(values).max(), c
 
 
-@pytest.mark.parametrize("open_faces", [None, "xyz"])
+@pytest.mark.parametrize("open_faces", [None, pytest.param("xyz", marks=pytest.mark.tier2)])  # xyz: 8,000 all-pair
 def test_moving_particles_widen_the_sites_table_and_give_the_all_pair_fields(open_faces):
     """The Lagrangian cube at Mach 0.3 (particles a third of dx off their sites by the tenth step, the pulse
     across the seams): the table grows with the largest displacement (solvers.search.celllist.CellList.widen)

@@ -294,6 +294,14 @@ def site_rule(jit, across: bool):
             cx = c % ncx
             cy0 = c // ncx % ncy
             cz0 = c // (ncx * ncy)
+            n = -rows[0, 1]  # the table's reach in cells (its first row is the lowest line, its own row m = n)
+            if n <= cx < ncx - n and n <= cy0 < ncy - n and n <= cz0 < ncz - n:  # no row meets a seam or an edge
+                lxi, lyi, lzi = lx[i], ly[i], lz[i]
+                for r in range(rows.shape[0]):
+                    mid = c + (rows[r, 1] * ncy + rows[r, 0]) * ncx
+                    acc = range_sum(begin[mid - rows[r, 2]], begin[mid + rows[r, 2] + 1], lxi, lyi, lzi, i, lx, ly,
+                                    lz, sx, sy, sz, k, acc, fields)  # fmt: skip
+                return acc
             for r in range(rows.shape[0]):
                 cz, lzi = shifted(cz0 + rows[r, 1], ncz, lz[i], k[NZ])
                 cy, lyi = shifted(cy0 + rows[r, 0], ncy, ly[i], k[NY])
