@@ -126,6 +126,9 @@ def limit_words(stable_cfl: float) -> str:
     return f"{stable_cfl:.3g}" if stable_cfl > 0 else "none (grows at every CFL)"
 
 
+OUTCOME_COLUMNS = ["bounded up to CFL", "blew up at CFL", "e-foldings"]  # the header of :func:`outcome_cells`
+
+
 def outcome_cells(r) -> list[str]:
     """A long-run row's outcome in a table's cells: bounded to (the largest CFL that stayed bounded), blew up at
     (each CFL, with its step), the e-foldings of the growth."""

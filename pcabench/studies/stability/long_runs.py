@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pcabench.reports.long_runs import long_run_limits
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.section import Section, limit_words, outcome_cells
+from pcabench.reports.section import OUTCOME_COLUMNS, Section, limit_words, outcome_cells
 
 
 def text(rows, ctx) -> list[str]:
@@ -51,9 +51,7 @@ def text(rows, ctx) -> list[str]:
                 "run",
                 "CFLs run",
                 "predicted stable CFL",
-                "bounded up to CFL",
-                "blew up at CFL",
-                "e-foldings",
+                *OUTCOME_COLUMNS,
                 "limit used",
             ],
             table,

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pcabench.reports.long_runs import long_run_limits
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.section import Section, limit_words, outcome_cells
+from pcabench.reports.section import OUTCOME_COLUMNS, Section, limit_words, outcome_cells
 from pcabench.studies.three_d.plan import THREE_D_LONG
 
 
@@ -71,9 +71,7 @@ def text(rows, ctx) -> list[str]:
                 "CFLs run",
                 "predicted (cube)",
                 "square",
-                "bounded up to CFL",
-                "blew up at CFL",
-                "e-foldings",
+                *OUTCOME_COLUMNS,
                 "limit used",
             ],
             table,

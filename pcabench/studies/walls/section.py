@@ -14,7 +14,7 @@ import numpy as np
 
 from pcabench.reports.long_runs import long_run_limits
 from pcabench.reports.md import fmt, md_table
-from pcabench.reports.section import Section, outcome_cells, stored_measure
+from pcabench.reports.section import OUTCOME_COLUMNS, Section, outcome_cells, stored_measure
 from pcabench.spec import scene_from_row
 from pcabench.store.rows import is_paper_method, latest
 from pcabench.studies.protocols import FRONT_T_END as T_FINAL
@@ -386,9 +386,7 @@ def _stability_text(rows) -> list[str]:
                 "method",
                 "CFLs run",
                 "predicted stable CFL",
-                "bounded up to CFL",
-                "blew up at CFL",
-                "e-foldings",
+                *OUTCOME_COLUMNS,
                 "free counterpart's long runs",
                 "limit used",
             ],
