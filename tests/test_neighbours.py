@@ -103,6 +103,7 @@ print(json.dumps({"same": bool(same), "mean": mean, "resorted": int(counts.sum()
 """
 
 
+@pytest.mark.tier2  # 11 s warm in the simulator: the README command kept within 5 minutes (2026-12-08)
 def test_simulated_gpu_mean_neighbours_leaves_the_state_as_it_was():
     out = in_simulator(SIM_SCRIPT)
     assert out["same"] and out["mean"] == out["resorted"] == pytest.approx(out["cpu"]), out

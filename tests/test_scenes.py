@@ -74,6 +74,7 @@ def test_every_cpu_solver_agrees_on_the_periodic_square(model):
             assert np.abs(getattr(got, field) - getattr(ref, field)).max() < 1e-14, (kw, field)
 
 
+@pytest.mark.tier2  # 15 s warm: the README command kept within 5 minutes (2026-12-08)
 def test_moving_particles_cross_the_x_seam_and_keep_their_neighbours():
     """The pulse sits on the square's left edge, so lagrangian particles cross the periodic seam: the cell list
     (which moves a crossing particle's lattice coordinate by a period) agrees with the all-pair minimum image."""

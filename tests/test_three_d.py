@@ -320,6 +320,7 @@ def test_the_pml_sends_back_less_than_the_sponge_of_the_same_width():
     assert left["pml"] < 0.5 * left["sponge"] and left["sponge"] < 0.05, left
 
 
+@pytest.mark.tier2  # 15 s warm: the README command kept within 5 minutes (2026-12-08)
 def test_the_three_d_sections_rows_orders_and_pair_cost_from_stored_runs(tmp_path):
     """The report section of ``study --three-d`` from stored records: each method's errors by dx with the
     prediction beside them, the orders, the issue's target line, and a pair's cost (ns per particle-neighbour-
