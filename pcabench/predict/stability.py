@@ -73,14 +73,14 @@ def _limits(
     dx, and dx |D| depends on h/dx only), so dx = 1 stands for all."""
     from solvers.kernels import truncated
     from solvers.method import Method
-    from solvers.reference.dispersion import largest_stable_z, largest_symbol, unit_scene
+    from solvers.reference.dispersion import largest_symbol, unit_scene
     from solvers.reference.dispersion import predicted_stable_cfl as lattice_limit
 
     if dims == 3:
-        from solvers.reference.dispersion3d import largest_unit_symbol
+        from solvers.reference.dispersion3d import largest_unit_symbol, lattice_stable_cfl
 
-        z_per_cfl = largest_unit_symbol(kernel, h_factor, cutoff_factor, integrator, correction)
-        return largest_stable_z(integrator) / z_per_cfl, z_per_cfl
+        method = (kernel, h_factor, cutoff_factor, integrator, correction)
+        return lattice_stable_cfl(*method), largest_unit_symbol(*method)
     method = Method(kernel, h_factor, cutoff_factor if truncated(kernel) else None, 1.0, integrator, correction)
     scene = unit_scene(**method.scene_fields())
     return lattice_limit(method), scene.dx * largest_symbol(scene)
